@@ -1,0 +1,119 @@
+# fem_add_chapter(NN name [DEPENDS MM ...])
+#
+# Registers chapter NN_name, the one way a chapter enters the build:
+#   fem_chNN            its library: the chapter's functions, compiled from solutions/NN_name
+#                       (default), exercises/NN_name (when NN is in FEM_EXERCISES or it is "all"),
+#                       or, in the grading build, from solutions with run-time stub switches;
+#   fem_chNN_reference  what later chapters link: always the reference solution, so a student
+#                       working on chapter 05 keeps chapters 06+ running;
+#   chNN_name           its executable in <build>/bin, from chapters/NN_name/main.cpp;
+#   test_chNN           its Catch2 tests from tests/NN_name/*.cpp (ctest labels chNN, unit);
+#   chNN_quick_run      ctest: the executable in --quick mode, its files and figures against
+#                       tests/NN_name/expected (label chNN, run);
+#   chNN_docs           ctest: docs/NN_name.md names only functions and exercises that exist and
+#                       quotes the numbers the executable prints (label chNN, docs).
+# DEPENDS lists earlier chapters whose headers this chapter includes; a later one is an error.
+
+set(FEM_ALL_CHAPTERS "" CACHE INTERNAL "registered chapters")
+add_custom_target(fem_tests)
+add_custom_target(fem_chapter_libs)
+
+function(fem_add_chapter number name)
+  cmake_parse_arguments(PARSE_ARGV 2 CH "" "" "DEPENDS")
+  set(id ${number}_${name})
+  set(lib fem_ch${number})
+  foreach(dep IN LISTS CH_DEPENDS)
+    if(NOT dep LESS number)
+      message(FATAL_ERROR "chapter ${id} depends on chapter ${dep}: a chapter may use earlier chapters only")
+    endif()
+    if(NOT TARGET fem_ch${dep}_reference)
+      message(FATAL_ERROR "chapter ${id} depends on chapter ${dep}, which is not registered before it")
+    endif()
+  endforeach()
+
+  file(GLOB solution_sources CONFIGURE_DEPENDS ${FEM_ROOT}/solutions/${id}/*.cpp)
+  if(NOT solution_sources)
+    message(FATAL_ERROR "chapter ${id}: no sources in solutions/${id}")
+  endif()
+
+  set(from_exercises OFF)
+  if(FEM_EXERCISES STREQUAL "all" OR number IN_LIST FEM_EXERCISES)
+    set(from_exercises ON)
+  endif()
+
+  if(FEM_GRADING)
+    # Solutions with every exercise region behind a run-time switch, generated at build time.
+    set(graded_dir ${CMAKE_BINARY_DIR}/graded/${id})
+    set(sources "")
+    foreach(src IN LISTS solution_sources)
+      get_filename_component(file_name ${src} NAME)
+      list(APPEND sources ${graded_dir}/${file_name})
+    endforeach()
+    add_custom_command(
+      OUTPUT ${sources}
+      COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/exercises.py graded --root ${FEM_ROOT}
+              --chapter ${id} --out ${graded_dir}
+      DEPENDS ${solution_sources} ${FEM_ROOT}/tools/exercises.py
+      COMMENT "Generating graded sources of chapter ${id}")
+  elseif(from_exercises)
+    set(sources "")
+    foreach(src IN LISTS solution_sources)
+      get_filename_component(file_name ${src} NAME)
+      list(APPEND sources ${FEM_ROOT}/exercises/${id}/${file_name})
+    endforeach()
+  else()
+    set(sources ${solution_sources})
+  endif()
+
+  add_library(${lib} STATIC ${sources})
+  target_include_directories(${lib} PUBLIC ${FEM_ROOT}/chapters)
+  target_link_libraries(${lib} PUBLIC fem_common PRIVATE fem_flags)
+  foreach(dep IN LISTS CH_DEPENDS)
+    target_link_libraries(${lib} PUBLIC fem_ch${dep}_reference)
+  endforeach()
+  if(from_exercises AND NOT FEM_GRADING)
+    # A stub leaves its parameters and the helpers its solution used unused.
+    target_compile_options(${lib} PRIVATE -Wno-unused-parameter -Wno-unused-variable
+                           -Wno-unused-but-set-variable -Wno-unused-function)
+    # Later chapters keep running on the reference solution of this one.
+    add_library(${lib}_reference STATIC ${solution_sources})
+    target_include_directories(${lib}_reference PUBLIC ${FEM_ROOT}/chapters)
+    target_link_libraries(${lib}_reference PUBLIC fem_common PRIVATE fem_flags)
+    foreach(dep IN LISTS CH_DEPENDS)
+      target_link_libraries(${lib}_reference PUBLIC fem_ch${dep}_reference)
+    endforeach()
+  else()
+    add_library(${lib}_reference ALIAS ${lib})
+  endif()
+  add_dependencies(fem_chapter_libs ${lib})
+
+  set(exe ch${number}_${name})
+  add_executable(${exe} ${FEM_ROOT}/chapters/${id}/main.cpp)
+  target_link_libraries(${exe} PRIVATE ${lib} fem_flags)
+
+  if(FEM_BUILD_TESTS)
+    file(GLOB test_sources CONFIGURE_DEPENDS ${FEM_ROOT}/tests/${id}/*.cpp)
+    if(NOT test_sources)
+      message(FATAL_ERROR "chapter ${id}: no tests in tests/${id}")
+    endif()
+    set(test_exe test_ch${number})
+    add_executable(${test_exe} ${test_sources})
+    target_link_libraries(${test_exe} PRIVATE ${lib} fem_test_main fem_flags)
+    target_compile_definitions(${test_exe} PRIVATE FEM_TEST_OUTPUT_DIR="${CMAKE_BINARY_DIR}/test_output/${id}")
+    catch_discover_tests(${test_exe} TEST_PREFIX "ch${number}: " PROPERTIES LABELS "ch${number};unit")
+    add_dependencies(fem_tests ${test_exe})
+
+    add_test(NAME ch${number}_quick_run
+             COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/check_run.py
+                     --exe $<TARGET_FILE:${exe}> --expected ${FEM_ROOT}/tests/${id}/expected
+                     --out ${CMAKE_BINARY_DIR}/check_runs/${id})
+    set_tests_properties(ch${number}_quick_run PROPERTIES LABELS "ch${number};run")
+    add_test(NAME ch${number}_docs
+             COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/check_docs.py --root ${FEM_ROOT}
+                     --chapter ${id} --bin ${CMAKE_BINARY_DIR}/bin
+                     --out ${CMAKE_BINARY_DIR}/check_docs/${id})
+    set_tests_properties(ch${number}_docs PROPERTIES LABELS "ch${number};docs")
+  endif()
+
+  set(FEM_ALL_CHAPTERS ${FEM_ALL_CHAPTERS} ${id} CACHE INTERNAL "registered chapters")
+endfunction()

@@ -1,0 +1,68 @@
+#pragma once
+// PNG figures drawn with VTK offscreen: line charts (log-log where it fits) and meshes or grids
+// coloured by a field. Every chart is also saved as CSV with the same numbers.
+//
+// Debian's VTK renders only through an X display and aborts without one, so every function here
+// first checks that a display can be opened. Without one it draws nothing, returns false, and the
+// first such call prints one line saying that PNGs were skipped and how to get them
+// (run under `xvfb-run -a`). VTK files and CSVs never depend on a display.
+
+#include "common/vtk_io.hpp"
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace fem::fig {
+
+/// True when an X display can be opened (probed once per process).
+bool display_available();
+
+/// One line of a chart.
+struct Series {
+    std::string name;
+    std::vector<double> x;
+    std::vector<double> y;
+};
+
+struct LineChart {
+    std::string title;
+    std::string x_label;
+    std::string y_label;
+    bool log_x = false;
+    bool log_y = false;
+    std::vector<Series> series;
+    int width = 900;
+    int height = 650;
+};
+
+/// Writes <stem>.csv (columns: series, x_label, y_label; every point of every series) and, when figures is true
+/// and a display is available, <stem>.png. On a log axis, points with a value ≤ 0 or non-finite
+/// values are left out of the PNG (they stay in the CSV). Returns whether the PNG was written.
+bool save_chart(const LineChart& chart, const std::filesystem::path& stem, bool figures = true);
+
+/// How to colour and frame a rendered mesh or grid.
+struct RenderOptions {
+    std::string title;                 ///< drawn at the top of the image
+    std::string field;                 ///< name of a point or cell field of the mesh
+    int component = -1;                ///< -1: the magnitude for vectors, the value for scalars
+    std::optional<std::pair<double, double>> range;  ///< colour range; default: the field's range
+    std::array<double, 3> view_direction{0.0, 0.0, -1.0};  ///< camera looks along this direction
+    std::array<double, 3> view_up{0.0, 1.0, 0.0};
+    bool show_edges = false;
+    int width = 900;
+    int height = 700;
+};
+
+/// Renders the mesh's surface coloured by options.field, with a scalar bar, to a PNG file.
+/// Returns false (and writes nothing) without a display; fem::Error if the field is missing.
+bool render_mesh_png(const std::filesystem::path& path, const io::MeshData& mesh,
+                     const RenderOptions& options);
+
+/// Renders a 2D or 3D regular grid coloured by a point field (a heat map for a 2D grid).
+bool render_grid_png(const std::filesystem::path& path, const io::ImageGrid& grid,
+                     const RenderOptions& options);
+
+}  // namespace fem::fig

@@ -1,0 +1,41 @@
+#pragma once
+// Wall-clock timing for the speed-against-error tables. Timings are printed, never asserted.
+
+#include <chrono>
+
+namespace fem {
+
+/// A stopwatch: starts on construction; seconds() reads the elapsed wall time.
+class Timer {
+public:
+    Timer() : start_(Clock::now()) {}
+    void restart() { start_ = Clock::now(); }
+    /// Elapsed wall-clock seconds since construction or the last restart().
+    double seconds() const { return std::chrono::duration<double>(Clock::now() - start_).count(); }
+
+private:
+    using Clock = std::chrono::steady_clock;
+    Clock::time_point start_;
+};
+
+/// The best (smallest) wall time in seconds of one call of work(), over repeated calls that stop
+/// after min_total_seconds of measuring or max_repeats calls, whichever comes first. The minimum
+/// filters out noise from the rest of the machine.
+template <typename Work>
+double best_time(Work&& work, double min_total_seconds = 0.2, int max_repeats = 1000)
+{
+    double best = 1e300;
+    Timer total;
+    for (int repeat = 0; repeat < max_repeats; ++repeat) {
+        Timer once;
+        work();
+        const double t = once.seconds();
+        if (t < best)
+            best = t;
+        if (total.seconds() >= min_total_seconds)
+            break;
+    }
+    return best;
+}
+
+}  // namespace fem

@@ -1,0 +1,86 @@
+#pragma once
+// Meshes and fields to and from VTK's XML files, written with VTK's own writers so that ParaView
+// opens every result: .vtu (unstructured grids), .vti (regular grids), .vtp (surfaces) and .pvd
+// (time series, written by hand: VTK 9.1 has no .pvd writer). Every write is atomic, and refuses
+// non-finite values and out-of-range indices with an fem::Error.
+
+#include "common/types.hpp"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace fem::io {
+
+/// A named field: one row per point (or cell), one column per component (1 scalar, 3 vector,
+/// 9 tensor in row-major order).
+struct Field {
+    std::string name;
+    Eigen::MatrixXd values;
+};
+
+/// Points, cells and their fields. cells has one row per cell and 1, 2, 3 or 4 columns: vertices,
+/// line segments, triangles or tetrahedra (VTK_VERTEX, VTK_LINE, VTK_TRIANGLE, VTK_TETRA).
+struct MeshData {
+    MatrixX3d points;
+    MatrixXiR cells;
+    std::vector<Field> point_data;
+    std::vector<Field> cell_data;
+
+    /// The field of that name in point_data or cell_data (fem::Error if absent).
+    const Field& field(const std::string& name) const;
+};
+
+/// A regular grid of dims[0]×dims[1]×dims[2] points (use 1 for unused dimensions), point (i,j,k)
+/// at origin + (i,j,k)·spacing. Field rows run over points with i fastest, then j, then k.
+struct ImageGrid {
+    std::array<int, 3> dims{1, 1, 1};
+    std::array<double, 3> spacing{1.0, 1.0, 1.0};
+    std::array<double, 3> origin{0.0, 0.0, 0.0};
+    std::vector<Field> point_data;
+};
+
+/// Checks counts, indices and finiteness; fem::Error naming the field, row and value otherwise.
+void validate(const MeshData& mesh);
+void validate(const ImageGrid& grid);
+
+/// Writes mesh as a .vtu file (binary, compressed) with vtkXMLUnstructuredGridWriter.
+void write_vtu(const std::filesystem::path& path, const MeshData& mesh);
+
+/// Reads a .vtu file written by write_vtu or ParaView (cells of one type among the four above).
+MeshData read_vtu(const std::filesystem::path& path);
+
+/// Writes mesh (cells: lines or triangles) as a .vtp surface with vtkXMLPolyDataWriter.
+void write_vtp(const std::filesystem::path& path, const MeshData& mesh);
+
+/// Writes grid as a .vti image with vtkXMLImageDataWriter.
+void write_vti(const std::filesystem::path& path, const ImageGrid& grid);
+
+/// A time series: frames are written to <stem>/<stem>_0000.vtu (or .vti) beside <stem>.pvd, and
+/// the .pvd collection is rewritten (atomically) after each frame, so a run that stops early still
+/// leaves a valid series of the frames it finished.
+class PvdSeries {
+public:
+    /// pvd_path: e.g. out/01_finite_differences/heat_rod.pvd
+    explicit PvdSeries(std::filesystem::path pvd_path);
+
+    void add(double time, const MeshData& frame);
+    void add(double time, const ImageGrid& frame);
+
+    std::size_t frames() const { return entries_.size(); }
+
+private:
+    std::filesystem::path next_frame_path(const char* extension) const;
+    void record(double time, const std::filesystem::path& frame_path);
+
+    std::filesystem::path pvd_path_;
+    std::vector<std::pair<double, std::string>> entries_;
+};
+
+/// The (time, file) entries of a .pvd collection, file relative to the .pvd's folder.
+std::vector<std::pair<double, std::string>> read_pvd(const std::filesystem::path& path);
+
+}  // namespace fem::io

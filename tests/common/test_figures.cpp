@@ -1,0 +1,121 @@
+// Figures: with a display, PNGs of the right size and with real content; without one, CSVs only.
+#include "common/error.hpp"
+#include "common/figures.hpp"
+#include "common/test_support.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <vtkDataArray.h>
+#include <vtkImageData.h>
+#include <vtkNew.h>
+#include <vtkPNGReader.h>
+#include <vtkPointData.h>
+
+#include <cmath>
+#include <fstream>
+#include <set>
+
+namespace {
+
+/// The number of distinct RGB colours in a PNG, and its size.
+struct PngSummary {
+    int width = 0, height = 0;
+    std::size_t colours = 0;
+};
+
+PngSummary read_png(const std::filesystem::path& path)
+{
+    vtkNew<vtkPNGReader> reader;
+    reader->SetFileName(path.c_str());
+    reader->Update();
+    vtkImageData* image = reader->GetOutput();
+    PngSummary summary;
+    int dims[3];
+    image->GetDimensions(dims);
+    summary.width = dims[0];
+    summary.height = dims[1];
+    vtkDataArray* pixels = image->GetPointData()->GetScalars();
+    std::set<long> colours;
+    for (vtkIdType i = 0; i < pixels->GetNumberOfTuples(); ++i) {
+        long rgb = 0;
+        for (int c = 0; c < 3; ++c)
+            rgb = rgb * 256 + static_cast<long>(pixels->GetComponent(i, c));
+        colours.insert(rgb);
+    }
+    summary.colours = colours.size();
+    return summary;
+}
+
+}  // namespace
+
+TEST_CASE("a log-log chart is saved as CSV always and as PNG when a display exists", "[common][figures]")
+{
+    const auto dir = fem::test::fresh_output_dir("chart");
+    fem::fig::LineChart chart{"error against h", "h", "error", true, true, {}};
+    std::vector<double> h, e1, e2;
+    for (int k = 1; k <= 12; ++k) {
+        h.push_back(std::pow(10.0, -k));
+        e1.push_back(h.back() + 1e-16 / h.back());
+        e2.push_back(h.back() * h.back());
+    }
+    e2[3] = 0.0;  // a zero cannot be drawn on a log axis: kept in the CSV, left out of the PNG
+    chart.series = {{"forward", h, e1}, {"central", h, e2}};
+    const bool drew = fem::fig::save_chart(chart, dir / "errors");
+
+    std::ifstream csv(dir / "errors.csv");
+    int lines = 0;
+    for (std::string line; std::getline(csv, line);)
+        ++lines;
+    CHECK(lines == 1 + 24);
+    CHECK(drew == fem::fig::display_available());
+    CHECK(std::filesystem::exists(dir / "errors.png") == drew);
+    if (drew) {
+        const auto png = read_png(dir / "errors.png");
+        CHECK(png.width == chart.width);
+        CHECK(png.height == chart.height);
+        CHECK(png.colours > 20);  // lines, labels and legend, not a blank canvas
+    }
+    CHECK_FALSE(fem::fig::save_chart(chart, dir / "no_png", false));
+    CHECK_FALSE(std::filesystem::exists(dir / "no_png.png"));
+
+    chart.series[0].y.pop_back();
+    CHECK_THROWS_AS(fem::fig::save_chart(chart, dir / "bad"), fem::Error);
+}
+
+TEST_CASE("a mesh coloured by a field renders with its scalar bar", "[common][figures]")
+{
+    const auto dir = fem::test::fresh_output_dir("render");
+    fem::io::MeshData mesh;
+    const int n = 10;
+    mesh.points.resize(n * n, 3);
+    Eigen::MatrixXd u(n * n, 1);
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            mesh.points.row(j * n + i) << i / (n - 1.0), j / (n - 1.0), 0.0;
+            u(j * n + i) = std::sin(3.0 * i / n) * std::cos(2.0 * j / n);
+        }
+    mesh.cells.resize(2 * (n - 1) * (n - 1), 3);
+    int t = 0;
+    for (int j = 0; j + 1 < n; ++j)
+        for (int i = 0; i + 1 < n; ++i) {
+            const int a = j * n + i;
+            mesh.cells.row(t++) << a, a + 1, a + n + 1;
+            mesh.cells.row(t++) << a, a + n + 1, a + n;
+        }
+    mesh.point_data = {{"u", u}};
+
+    fem::fig::RenderOptions options;
+    options.title = "u on a square";
+    options.field = "u";
+    options.show_edges = true;
+    const bool drew = fem::fig::render_mesh_png(dir / "square.png", mesh, options);
+    CHECK(drew == fem::fig::display_available());
+    if (drew) {
+        const auto png = read_png(dir / "square.png");
+        CHECK(png.width == options.width);
+        CHECK(png.colours > 50);  // a colour ramp, not a flat fill
+    }
+    options.field = "no_such_field";
+    CHECK_THROWS_AS(fem::fig::render_mesh_png(dir / "bad.png", mesh, options), fem::Error);
+    CHECK_FALSE(std::filesystem::exists(dir / "bad.png"));
+}

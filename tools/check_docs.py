@@ -1,0 +1,216 @@
+#!/usr/bin/env python3
+"""Keeps docs/NN_name.md from drifting away from the code (a ctest test per chapter).
+
+Checks:
+  1. every exercise of the chapter has a heading "### Exercise NN.k: function_name", every
+     "exercise NN.k" the text mentions exists, and every exercise's docs section (#anchor) is a
+     heading of the page;
+  2. every function or type the page names in backticks (snake_case calls like
+     `central_difference(f, x, h)` and qualified names like `fem::fd::HeatRod`) is declared in the
+     headers of this chapter, an earlier one, or common/;
+  3. the tables between <!-- fem:table NAME.csv --> and <!-- /fem:table --> hold the numbers the
+     executable prints today: the page's <!-- fem:run chNN_name [args] --> line says how to run it;
+     measured columns (times, rates) are skipped (see csv_compare.py);
+  4. every image the page shows exists.
+
+--update reruns the executable, rewrites the tables and copies the figures named by
+<!-- fem:figure NAME.png --> into docs/figures/NN_name/ (run it under xvfb-run -a).
+"""
+
+import argparse
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from csv_compare import as_number, close, is_measured, read_csv  # noqa: E402
+from exercises import all_exercises  # noqa: E402
+
+RUN = re.compile(r"<!-- fem:run (?P<exe>\S+)(?P<args>[^>]*?)\s*-->")
+TABLE = re.compile(r"(<!-- fem:table (?P<csv>\S+) -->\n)(?P<body>.*?)(<!-- /fem:table -->)", re.S)
+FIGURE = re.compile(r"<!-- fem:figure (?P<png>\S+) -->")
+IMAGE = re.compile(r"!\[[^\]]*\]\((?P<path>[^)\s]+)\)")
+HEADING = re.compile(r"^(#{1,6})\s+(?P<text>.+?)\s*$", re.M)
+EXERCISE_HEADING = re.compile(r"^###\s+Exercise\s+(?P<id>\d\d\.\d+):\s+`?(?P<function>\w+)", re.M)
+EXERCISE_MENTION = re.compile(r"[Ee]xercises?\s+(?P<id>\d\d\.\d+)")
+CODE_SPAN = re.compile(r"`([^`\n]+)`")
+CALL = re.compile(r"^(?:fem::(?:\w+::)*)?(?P<name>[a-z]\w*_\w+)\(")
+QUALIFIED = re.compile(r"^fem::(?:\w+::)*(?P<name>\w+)$")
+RELATIVE_TOLERANCE = 2e-3  # the tables print 4 significant digits
+
+
+def slug(heading):
+    """GitHub's anchor for a heading."""
+    text = re.sub(r"[`*_]", lambda m: "_" if m.group(0) == "_" else "", heading.strip().lower())
+    text = re.sub(r"[^\w\- ]", "", text)
+    return text.replace(" ", "-")
+
+
+def format_number(value):
+    if value == int(value) and abs(value) < 1e6:
+        return str(int(value))
+    if 1e-2 <= abs(value) < 1e4:
+        return f"{value:.4g}"
+    return f"{value:.3e}"
+
+
+def markdown_table(csv_path):
+    header, rows = read_csv(csv_path)
+    escape = lambda text: text.replace("|", "\\|")
+    lines = ["| " + " | ".join(map(escape, header)) + " |", "|" + "|".join("---:" for _ in header) + "|"]
+    for row in rows:
+        cells = [format_number(float(c)) if as_number(c) is not None else escape(c) for c in row]
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def parse_markdown_table(body):
+    lines = [l.strip() for l in body.strip().splitlines() if l.strip().startswith("|")]
+    split = lambda l: [c.strip().replace("\\|", "|") for c in re.split(r"(?<!\\)\|", l.strip()[1:-1])]
+    return split(lines[0]), [split(l) for l in lines[2:]]
+
+
+def declared_names(root, chapter):
+    number = int(chapter[:2])
+    headers = list((root / "common").glob("*.hpp"))
+    for folder in (root / "chapters").iterdir():
+        if folder.is_dir() and int(folder.name[:2]) <= number:
+            headers += list(folder.glob("*.hpp"))
+    return "\n".join(h.read_text() for h in headers)
+
+
+def check_names(text, root, chapter):
+    declarations = declared_names(root, chapter)
+    problems = []
+    for span in set(CODE_SPAN.findall(text)):
+        match = CALL.match(span) or QUALIFIED.match(span)
+        if not match:
+            continue
+        name = match["name"]
+        pattern = rf"(\b{name}\s*\(|\b(struct|class|enum class|enum|using|namespace)\s+{name}\b)"
+        if not re.search(pattern, declarations):
+            problems.append(f"the docs name `{span}`, but no header of chapters ≤ {chapter[:2]} "
+                            f"or common/ declares {name}")
+    return problems
+
+
+def check_exercises(text, root, chapter):
+    problems = []
+    anchors = {slug(m["text"]) for m in HEADING.finditer(text)}
+    exercises = {e.id: e for e in all_exercises(root)}
+    headed = {m["id"]: m["function"] for m in EXERCISE_HEADING.finditer(text)}
+    for e in exercises.values():
+        if e.chapter != chapter:
+            continue
+        if e.id not in headed:
+            problems.append(f"exercise {e.id} ({e.function}) has no heading '### Exercise {e.id}: "
+                            f"{e.function}' in docs/{chapter}.md")
+        elif headed[e.id] != e.function:
+            problems.append(f"the heading of exercise {e.id} names {headed[e.id]}, the code {e.function}")
+        if e.section not in anchors:
+            problems.append(f"exercise {e.id} points at #{e.section}, which is no heading of docs/{chapter}.md")
+    for m in list(EXERCISE_MENTION.finditer(text)) + list(EXERCISE_HEADING.finditer(text)):
+        if m["id"] not in exercises:
+            problems.append(f"the docs mention exercise {m['id']}, which does not exist")
+    return problems
+
+
+def run_executable(text, bin_dir, out):
+    match = RUN.search(text)
+    if not match:
+        return None, ["the page has tables but no <!-- fem:run chNN_name [args] --> line"]
+    if out.exists():
+        shutil.rmtree(out)
+    command = [str(bin_dir / match["exe"]), *match["args"].split(), "--out", str(out)]
+    result = subprocess.run(command, capture_output=True, text=True, timeout=3000)
+    if result.returncode != 0:
+        return None, [f"`{' '.join(command)}` failed ({result.returncode}):\n{result.stdout}{result.stderr}"]
+    return out, []
+
+
+def check_tables(text, out):
+    problems = []
+    for block in TABLE.finditer(text):
+        name = block["csv"]
+        if not (out / name).is_file():
+            problems.append(f"the executable wrote no {name}")
+            continue
+        want_header, want_rows = parse_markdown_table(block["body"])
+        header, rows = parse_markdown_table(markdown_table(out / name))
+        if want_header != header:
+            problems.append(f"{name}: the docs table has columns {want_header}, the executable {header}")
+            continue
+        if len(want_rows) != len(rows):
+            problems.append(f"{name}: the docs table has {len(want_rows)} rows, the executable {len(rows)}")
+            continue
+        for r, (want, got) in enumerate(zip(want_rows, rows)):
+            if len(want) != len(header):
+                problems.append(f"{name}, row {r + 1}: the docs row has {len(want)} cells, expected {len(header)}")
+                continue
+            for c, column in enumerate(header):
+                if is_measured(column):
+                    continue
+                a, b = as_number(want[c]), as_number(got[c])
+                same = close(a, b, RELATIVE_TOLERANCE) if a is not None and b is not None else want[c] == got[c]
+                if not same:
+                    problems.append(f"{name}, row {r + 1}, column '{column}': the docs say {want[c]}, "
+                                    f"the executable prints {got[c]}")
+    return problems
+
+
+def update(doc, text, out, root, chapter):
+    def replace(block):
+        return block.group(1) + markdown_table(out / block["csv"]) + block.group(4)
+    text = TABLE.sub(replace, text)
+    figures = root / "docs" / "figures" / chapter
+    for m in FIGURE.finditer(text):
+        source = out / m["png"]
+        if source.is_file():
+            figures.mkdir(parents=True, exist_ok=True)
+            shutil.copy(source, figures / m["png"])
+        else:
+            print(f"warning: {m['png']} was not drawn (no display?); run under xvfb-run -a")
+    doc.write_text(text)
+    print(f"updated {doc}")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--root", type=Path, default=Path(__file__).resolve().parent.parent)
+    parser.add_argument("--chapter", required=True, help="e.g. 01_finite_differences")
+    parser.add_argument("--bin", type=Path, help="the build's bin/ folder (for the tables)")
+    parser.add_argument("--out", type=Path, help="a scratch folder for the executable's output")
+    parser.add_argument("--update", action="store_true")
+    args = parser.parse_args()
+
+    doc = args.root / "docs" / f"{args.chapter}.md"
+    if not doc.is_file():
+        print(f"FAIL docs/{args.chapter}.md does not exist")
+        return 1
+    text = doc.read_text()
+    problems = check_exercises(text, args.root, args.chapter) + check_names(text, args.root, args.chapter)
+    for m in IMAGE.finditer(text):
+        if not (doc.parent / m["path"]).is_file():
+            problems.append(f"the docs show {m['path']}, which does not exist")
+    if TABLE.search(text):
+        if not (args.bin and args.out):
+            problems.append("--bin and --out are needed to check the tables")
+        else:
+            out, run_problems = run_executable(text, args.bin, args.out)
+            problems += run_problems
+            if out and args.update:
+                update(doc, text, out, args.root, args.chapter)
+                return 0
+            if out:
+                problems += check_tables(text, out)
+    for problem in problems:
+        print(f"FAIL {problem}")
+    if not problems:
+        print(f"OK: docs/{args.chapter}.md names what exists and quotes what the executable prints")
+    return 1 if problems else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

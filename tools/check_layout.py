@@ -1,0 +1,58 @@
+#!/usr/bin/env python3
+"""Checks the course layout (a ctest test): every chapter registered in CMakeLists.txt has its
+header(s), main.cpp, solutions, tests, stored quick-run expectations and docs; a chapter includes
+only its own and earlier chapters' headers, each of them listed in its DEPENDS; common/ includes no
+chapter at all."""
+
+import argparse
+import re
+import sys
+from pathlib import Path
+
+REGISTER = re.compile(r"^fem_add_chapter\((?P<number>\d\d)\s+(?P<name>\w+)(?:\s+DEPENDS(?P<deps>[\s\d]+))?\)",
+                      re.M)
+INCLUDE = re.compile(r'^\s*#\s*include\s+"(?P<chapter>\d\d)_\w+/', re.M)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--root", type=Path, default=Path(__file__).resolve().parent.parent)
+    root = parser.parse_args().root
+    problems = []
+    registered = {m["number"]: (m["name"], set((m["deps"] or "").split()))
+                  for m in REGISTER.finditer((root / "CMakeLists.txt").read_text())}
+    if not registered:
+        problems.append("CMakeLists.txt registers no chapter with fem_add_chapter")
+    for number, (name, deps) in sorted(registered.items()):
+        chapter = f"{number}_{name}"
+        required = [root / "chapters" / chapter / "main.cpp", root / "docs" / f"{chapter}.md",
+                    root / "tests" / chapter / "expected" / "files.txt"]
+        for path in required:
+            if not path.is_file():
+                problems.append(f"chapter {chapter}: {path.relative_to(root)} is missing")
+        for folder, pattern in [("chapters", "*.hpp"), ("solutions", "*.cpp"), ("exercises", "*.cpp"),
+                                ("tests", "*.cpp")]:
+            if not list((root / folder / chapter).glob(pattern)):
+                problems.append(f"chapter {chapter}: no {pattern} in {folder}/{chapter}")
+        for folder in ["chapters", "solutions", "tests"]:
+            for source in sorted((root / folder / chapter).glob("*.?pp")):
+                for m in INCLUDE.finditer(source.read_text()):
+                    used = m["chapter"]
+                    where = source.relative_to(root)
+                    if used > number:
+                        problems.append(f"{where} includes chapter {used}: a chapter may use earlier chapters only")
+                    elif used != number and used not in deps:
+                        problems.append(f"{where} includes chapter {used}, which is not in the DEPENDS "
+                                        f"of fem_add_chapter({number} {name} ...)")
+    for source in sorted((root / "common").glob("*.?pp")):
+        if INCLUDE.search(source.read_text()):
+            problems.append(f"{source.relative_to(root)} includes a chapter: common/ holds no chapter's math")
+    for problem in problems:
+        print(f"FAIL {problem}")
+    if not problems:
+        print(f"OK: {len(registered)} chapters, each complete and including only earlier chapters")
+    return 1 if problems else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
