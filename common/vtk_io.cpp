@@ -24,7 +24,6 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-#include <regex>
 #include <sstream>
 
 namespace fem::io {
@@ -353,11 +352,20 @@ std::vector<std::pair<double, std::string>> read_pvd(const std::filesystem::path
     const std::string content = text.str();
     if (content.find("type=\"Collection\"") == std::string::npos)
         throw Error(str("'", path.string(), "' is not a VTK collection (.pvd) file"));
-    const std::regex dataset(R"re(<DataSet\s+timestep="([^"]+)"[^>]*\bfile="([^"]+)")re");
+    // The value of attribute `name` inside the tag [begin, end), or fem::Error.
+    const auto attribute = [&](std::size_t begin, std::size_t end, const std::string& name) {
+        const std::size_t at = content.find(" " + name + "=\"", begin);
+        if (at == std::string::npos || at > end)
+            throw Error(str("'", path.string(), "': a DataSet has no ", name, " attribute"));
+        const std::size_t value = at + name.size() + 3;
+        return content.substr(value, content.find('"', value) - value);
+    };
     std::vector<std::pair<double, std::string>> entries;
-    for (auto it = std::sregex_iterator(content.begin(), content.end(), dataset);
-         it != std::sregex_iterator(); ++it)
-        entries.emplace_back(std::stod((*it)[1].str()), (*it)[2].str());
+    for (std::size_t tag = content.find("<DataSet"); tag != std::string::npos;
+         tag = content.find("<DataSet", tag + 1)) {
+        const std::size_t end = content.find('>', tag);
+        entries.emplace_back(std::stod(attribute(tag, end, "timestep")), attribute(tag, end, "file"));
+    }
     return entries;
 }
 

@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages the course uses, when any is missing (needs root or sudo).
+# Both README commands call it; running it again does nothing once everything is there.
+set -euo pipefail
+
+packages=(
+  g++ cmake ninja-build python3           # toolchain
+  libeigen3-dev catch2 libcli11-dev       # linear algebra, tests, command lines
+  libvtk9-dev libx11-dev xvfb xauth       # VTK files and figures; a virtual display
+  libsuitesparse-dev libopenblas0-pthread # CHOLMOD, the speed reference of chapters 08-09
+  tetgen                                  # tetrahedral meshes from surfaces
+)
+
+missing=()
+for package in "${packages[@]}"; do
+    if ! dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed"; then
+        missing+=("$package")
+    fi
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+
+echo "installing: ${missing[*]}"
+sudo=""
+if [ "$(id -u)" -ne 0 ]; then
+    command -v sudo >/dev/null || { echo "error: need root (or sudo) to install: ${missing[*]}" >&2; exit 1; }
+    sudo=sudo
+fi
+$sudo apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+echo "installed: ${missing[*]}"

@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# The course's full check (what CI runs): every stage must pass.
+#   1. grading   each exercise, stubbed alone, fails at least one of its tagged tests (a table)
+#   2. exercises every chapter compiles from exercises/ (the stubs students start from)
+#   3. asan      the unit tests pass under AddressSanitizer + UndefinedBehaviorSanitizer
+#   4. release   every test passes on the reference solutions: unit tests, the layout and
+#                exercise-sync checks, each executable's --quick run against stored numbers, and
+#                each chapter's docs against its executable
+set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
+cd "$FEM_ROOT"
+export ASAN_OPTIONS="detect_leaks=0:abort_on_error=1" UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+
+"$FEM_ROOT/tools/setup.sh"
+
+step "exercises/ in sync with solutions/"
+python3 tools/exercises.py check
+
+step "1/4 grading build: every exercise must fail its tests as a stub"
+cmake --preset grading -DFEM_WERROR=ON >/dev/null
+cmake --build --preset grading -j "$JOBS"
+with_display python3 tools/exercises.py grade --build build/grading
+
+step "2/4 every chapter compiles from exercises/"
+cmake --preset exercises -DFEM_WERROR=ON >/dev/null
+cmake --build --preset exercises -j "$JOBS"
+
+step "3/4 unit tests under AddressSanitizer + UndefinedBehaviorSanitizer"
+cmake --preset asan -DFEM_WERROR=ON >/dev/null
+cmake --build --preset asan -j "$JOBS" --target fem_tests
+with_display ctest --preset asan
+
+step "4/4 release: all tests on the reference solutions"
+cmake --preset release -DFEM_WERROR=ON >/dev/null
+cmake --build --preset release -j "$JOBS"
+with_display ctest --preset release
