@@ -6,7 +6,8 @@
 //   ch01_finite_differences --quick          the small run ctest checks
 //   ch01_finite_differences --c 0.5 --points 201 --ratio 0.99
 //
-// Writes: tables derivative_table.csv, heat_convergence_table.csv, heat_stability_table.csv;
+// Writes: tables derivative_table.csv, stencil_cost_table.csv, heat_convergence_table.csv,
+// heat_stability_table.csv;
 // charts (PNG + CSV) derivative_errors, heat_convergence, heat_cost, heat_profiles;
 // the time series heat_rod.pvd (+ frames in heat_rod/).
 // docs/01_finite_differences.md
@@ -21,6 +22,7 @@
 #include "common/timer.hpp"
 #include "common/vtk_io.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 
@@ -40,23 +42,30 @@ struct Settings {
 void derivative_study(const RunContext& run)
 {
     const ScalarFunction f = [](double x) { return std::sin(x); };
-    const double x = 1.0, exact_first = std::cos(x), exact_second = -std::sin(x);
-    const char* names[4] = {"forward", "backward", "central", "second central"};
+    const double x = 1.0;
+    struct Stencil {
+        const char* name;
+        double (*apply)(const ScalarFunction&, double, double);
+        double exact;           // the derivative it approximates, at x
+        int evaluations;        // samples of f per call
+    };
+    const Stencil stencils[4] = {{"forward", forward_difference, std::cos(x), 2},
+                                 {"backward", backward_difference, std::cos(x), 2},
+                                 {"central", central_difference, std::cos(x), 2},
+                                 {"second central", central_second_difference, -std::sin(x), 3}};
 
     std::vector<double> h;
     std::vector<double> error[4];
     for (int k = 1; k <= 15; ++k) {
         h.push_back(std::pow(10.0, -k));
-        error[0].push_back(std::abs(forward_difference(f, x, h.back()) - exact_first));
-        error[1].push_back(std::abs(backward_difference(f, x, h.back()) - exact_first));
-        error[2].push_back(std::abs(central_difference(f, x, h.back()) - exact_first));
-        error[3].push_back(std::abs(central_second_difference(f, x, h.back()) - exact_second));
+        for (int s = 0; s < 4; ++s)
+            error[s].push_back(std::abs(stencils[s].apply(f, x, h.back()) - stencils[s].exact));
     }
 
     std::vector<Column> columns{{"h", Format::scientific, 0}};
-    for (const char* name : names) {
-        columns.push_back({std::string(name) + " error", Format::scientific, 2});
-        columns.push_back({std::string(name) + " order", Format::fixed, 2});
+    for (const Stencil& stencil : stencils) {
+        columns.push_back({std::string(stencil.name) + " error", Format::scientific, 2});
+        columns.push_back({std::string(stencil.name) + " order", Format::fixed, 2});
     }
     Table table("Derivatives of sin at x = 1: absolute error and observed order against h", columns);
     std::vector<double> orders[4];
@@ -73,10 +82,29 @@ void derivative_study(const RunContext& run)
     table.print(std::cout);
     table.write_csv(run.file("derivative_table.csv"));
 
+    // Speed against error: what each stencil costs per call, and the best accuracy it reaches.
+    Table cost("Cost and best accuracy of each stencil (sin at x = 1)",
+               {{"stencil", Format::text}, {"f evaluations", Format::integer},
+                {"time per call [ns]", Format::fixed, 1}, {"best h", Format::scientific, 0},
+                {"best error", Format::scientific, 2}});
+    for (int s = 0; s < 4; ++s) {
+        const int calls = 100000;
+        volatile double sink = 0.0;
+        const double seconds = best_time([&] {
+            for (int c = 0; c < calls; ++c)
+                sink = sink + stencils[s].apply(f, x + 1e-9 * c, 1e-4);
+        });
+        const auto best = std::min_element(error[s].begin(), error[s].end()) - error[s].begin();
+        cost.add_row({std::string(stencils[s].name), double(stencils[s].evaluations),
+                      1e9 * seconds / calls, h[best], error[s][best]});
+    }
+    cost.print(std::cout);
+    cost.write_csv(run.file("stencil_cost_table.csv"));
+
     fig::LineChart chart{"Finite differences of sin at x = 1: truncation meets round-off",
                          "step h", "absolute error", true, true, {}};
     for (int s = 0; s < 4; ++s)
-        chart.series.push_back({names[s], h, error[s]});
+        chart.series.push_back({stencils[s].name, h, error[s]});
     fig::save_chart(chart, run.out_dir / "derivative_errors", run.figures);
 }
 
