@@ -3,8 +3,9 @@
 //
 // Column naming rule (tools/check_run.py and tools/check_docs.py rely on it): a column whose value
 // depends on the machine (a wall time, a rate, a bandwidth) carries its unit in brackets with a
-// time in it: "time [s]", "rate [1/s]", "bandwidth [GB/s]". Those columns are reported but never
-// compared against stored numbers; every other column must reproduce.
+// time in it: "time [s]", "rate [1/s]", "bandwidth [GB/s]", or "[measured]" for a machine-dependent
+// ratio ("fraction of triad [measured]"). Those columns are reported but never compared against
+// stored numbers; every other column must reproduce.
 
 #include <filesystem>
 #include <iosfwd>

@@ -2,7 +2,8 @@
 
 A column is *measured* (depends on the machine: wall times, rates, bandwidths) when its header ends
 with a unit in brackets that contains a time: "time [s]", "rate [1/s]", "bandwidth [GB/s]",
-"[ms]", "[us]", "[ns]". Measured columns are reported but never compared; every other column must
+"[ms]", "[us]", "[ns]", or with "[measured]" for a machine-dependent ratio ("fraction of triad
+[measured]"). Measured columns are reported but never compared; every other column must
 reproduce (numbers within a relative tolerance, text exactly). common/table.hpp states the same rule.
 """
 
@@ -10,7 +11,7 @@ import csv
 import math
 import re
 
-MEASURED = re.compile(r"\[(s|ms|us|ns|[^\]]*/\s*(s|ms|us|ns))\]\s*$")
+MEASURED = re.compile(r"\[(s|ms|us|ns|measured|[^\]]*/\s*(s|ms|us|ns))\]\s*$")
 
 
 def is_measured(header):
