@@ -15,7 +15,7 @@
 #include <vtkChartXY.h>
 #include <vtkColorTransferFunction.h>
 #include <vtkContextScene.h>
-#include <vtkContextView.h>
+#include <vtkContextActor.h>
 #include <vtkDataSetSurfaceFilter.h>
 #include <vtkDoubleArray.h>
 #include <vtkImageData.h>
@@ -36,6 +36,8 @@
 #include <vtkWindowToImageFilter.h>
 
 #include <array>
+#include <chrono>
+#include <thread>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -44,16 +46,25 @@
 namespace fem::fig {
 namespace {
 
-bool probe_display()
+/// The process's one connection to the X server, or nullptr when there is no display.
+/// Opening a connection to Xvfb fails now and then on this course's machines (the server hangs up
+/// at once), and VTK aborts the process when its own attempt fails. So the connection is opened
+/// here, retried a few times, and handed to every render window (SetDisplayId), which then never
+/// opens one itself.
+Display* shared_display()
 {
-    const char* name = std::getenv("DISPLAY");
-    if (name == nullptr || *name == '\0')
-        return false;
-    Display* display = XOpenDisplay(nullptr);
-    if (display == nullptr)
-        return false;
-    XCloseDisplay(display);
-    return true;
+    static Display* const display = [] {
+        const char* name = std::getenv("DISPLAY");
+        if (name == nullptr || *name == '\0')
+            return static_cast<Display*>(nullptr);
+        for (int attempt = 0; attempt < 20; ++attempt) {
+            if (Display* opened = XOpenDisplay(nullptr))
+                return opened;
+            std::this_thread::sleep_for(std::chrono::milliseconds(25));
+        }
+        return static_cast<Display*>(nullptr);
+    }();
+    return display;
 }
 
 /// Returns whether PNGs can be drawn; says once per process why not.
@@ -187,6 +198,7 @@ bool render_dataset(const std::filesystem::path& path, vtkDataSet* data, bool ce
     camera->Zoom(1.1);
 
     vtkNew<vtkRenderWindow> window;
+    window->SetDisplayId(shared_display());
     window->SetOffScreenRendering(1);
     window->SetSize(options.width, options.height);
     window->AddRenderer(renderer);
@@ -199,8 +211,7 @@ bool render_dataset(const std::filesystem::path& path, vtkDataSet* data, bool ce
 
 bool display_available()
 {
-    static const bool available = probe_display();
-    return available;
+    return shared_display() != nullptr;
 }
 
 bool save_chart(const LineChart& chart, const std::filesystem::path& stem, bool figures)
@@ -225,17 +236,27 @@ bool save_chart(const LineChart& chart, const std::filesystem::path& stem, bool 
     if (!can_draw(figures))
         return false;
 
-    vtkNew<vtkContextView> view;
-    view->GetRenderer()->SetBackground(1.0, 1.0, 1.0);
-    view->GetRenderWindow()->SetOffScreenRendering(1);
-    view->GetRenderWindow()->SetSize(chart.width, chart.height);
+    // A plain offscreen window with a context actor: vtkContextView would also create an X
+    // interactor, whose initialisation crashes intermittently on a virtual display.
+    vtkNew<vtkRenderer> renderer;
+    renderer->SetBackground(1.0, 1.0, 1.0);
+    vtkNew<vtkRenderWindow> window;
+    window->SetDisplayId(shared_display());
+    window->SetOffScreenRendering(1);
+    window->SetSize(chart.width, chart.height);
+    window->AddRenderer(renderer);
+    vtkNew<vtkContextActor> context;
+    context->GetScene()->SetRenderer(renderer);
+    renderer->AddActor(context);
     vtkNew<vtkChartXY> xy;
-    view->GetScene()->AddItem(xy);
+    context->GetScene()->AddItem(xy);
     xy->SetTitle(chart.title);
     xy->GetTitleProperties()->SetFontSize(18);
     xy->SetShowLegend(true);
-    xy->GetLegend()->SetHorizontalAlignment(vtkChartLegend::RIGHT);
-    xy->GetLegend()->SetVerticalAlignment(vtkChartLegend::BOTTOM);
+    const bool left = chart.legend == Corner::top_left || chart.legend == Corner::bottom_left;
+    const bool top = chart.legend == Corner::top_left || chart.legend == Corner::top_right;
+    xy->GetLegend()->SetHorizontalAlignment(left ? vtkChartLegend::LEFT : vtkChartLegend::RIGHT);
+    xy->GetLegend()->SetVerticalAlignment(top ? vtkChartLegend::TOP : vtkChartLegend::BOTTOM);
     vtkAxis* x_axis = xy->GetAxis(vtkAxis::BOTTOM);
     vtkAxis* y_axis = xy->GetAxis(vtkAxis::LEFT);
     x_axis->SetTitle(chart.x_label);
@@ -271,10 +292,10 @@ bool save_chart(const LineChart& chart, const std::filesystem::path& stem, bool 
         line->SetWidth(2.5);
         line->SetLabel(s.name);
     }
-    view->Render();
+    window->Render();
     std::filesystem::path png_path = stem;
     png_path += ".png";
-    write_png(view->GetRenderWindow(), png_path);
+    write_png(window, png_path);
     return true;
 }
 

@@ -27,6 +27,9 @@ struct Series {
     std::vector<double> y;
 };
 
+/// Where a chart's legend goes: pick the corner the lines leave empty.
+enum class Corner { top_left, top_right, bottom_left, bottom_right };
+
 struct LineChart {
     std::string title;
     std::string x_label;
@@ -36,6 +39,7 @@ struct LineChart {
     std::vector<Series> series;
     int width = 900;
     int height = 650;
+    Corner legend = Corner::bottom_right;
 };
 
 /// Writes <stem>.csv (columns: series, x_label, y_label; every point of every series) and, when figures is true

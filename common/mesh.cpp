@@ -11,28 +11,38 @@
 namespace fem {
 namespace {
 
-void check_finite_vertices(const MatrixX3d& V, std::string_view source)
+std::string vertex_place(const MeshOrigin& origin, Eigen::Index v)
+{
+    return origin.vertex ? origin.vertex(v) : origin.source;
+}
+
+std::string element_place(const MeshOrigin& origin, Eigen::Index e)
+{
+    return origin.element ? origin.element(e) : origin.source;
+}
+
+void check_finite_vertices(const MatrixX3d& V, const MeshOrigin& origin)
 {
     for (Eigen::Index v = 0; v < V.rows(); ++v)
         for (int c = 0; c < 3; ++c)
             if (!std::isfinite(V(v, c)))
-                throw Error(str(source, ": vertex ", v, " has the non-finite coordinate ", V(v, c),
+                throw Error(str(vertex_place(origin, v), ": vertex ", v, " has the non-finite coordinate ", V(v, c),
                                 "; coordinates must be finite numbers"));
 }
 
 template <typename Cells>
-void check_indices(const Cells& cells, Eigen::Index vertex_count, std::string_view source,
+void check_indices(const Cells& cells, Eigen::Index vertex_count, const MeshOrigin& origin,
                    const char* kind)
 {
     for (Eigen::Index e = 0; e < cells.rows(); ++e)
         for (Eigen::Index k = 0; k < cells.cols(); ++k) {
             const int v = cells(e, k);
             if (v < 0 || v >= vertex_count)
-                throw Error(str(source, ": ", kind, " ", e, " refers to vertex ", v,
+                throw Error(str(element_place(origin, e), ": ", kind, " ", e, " refers to vertex ", v,
                                 "; vertices are numbered 0 to ", vertex_count - 1));
             for (Eigen::Index m = 0; m < k; ++m)
                 if (cells(e, m) == v)
-                    throw Error(str(source, ": ", kind, " ", e, " uses vertex ", v,
+                    throw Error(str(element_place(origin, e), ": ", kind, " ", e, " uses vertex ", v,
                                     " twice; its corners must be distinct"));
         }
 }
@@ -121,18 +131,23 @@ TetMesh beam_mesh(double length, double width, double height, int cells_along)
 
 void validate(const TriMesh& mesh, std::string_view source)
 {
+    validate(mesh, MeshOrigin{std::string(source), {}, {}});
+}
+
+void validate(const TriMesh& mesh, const MeshOrigin& origin)
+{
     if (mesh.V.rows() == 0 || mesh.F.rows() == 0)
-        throw Error(str(source, ": the mesh is empty (", mesh.V.rows(), " vertices, ", mesh.F.rows(),
+        throw Error(str(origin.source, ": the mesh is empty (", mesh.V.rows(), " vertices, ", mesh.F.rows(),
                         " triangles)"));
-    check_finite_vertices(mesh.V, source);
-    check_indices(mesh.F, mesh.V.rows(), source, "triangle");
+    check_finite_vertices(mesh.V, origin);
+    check_indices(mesh.F, mesh.V.rows(), origin, "triangle");
     for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
         const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)),
                               c = mesh.V.row(mesh.F(f, 2));
         const double twice_area = (b - a).cross(c - a).norm();
         const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
         if (!(twice_area > 2e-14 * longest * longest))
-            throw Error(str(source, ": triangle ", f, " (vertices ", mesh.F(f, 0), ", ", mesh.F(f, 1),
+            throw Error(str(element_place(origin, f), ": triangle ", f, " (vertices ", mesh.F(f, 0), ", ", mesh.F(f, 1),
                             ", ", mesh.F(f, 2), ") has zero area; triangles must not be degenerate"));
     }
 }
@@ -146,11 +161,16 @@ double tet_signed_volume6(const TetMesh& mesh, int t)
 
 int validate(TetMesh& mesh, std::string_view source, Inverted inverted)
 {
+    return validate(mesh, MeshOrigin{std::string(source), {}, {}}, inverted);
+}
+
+int validate(TetMesh& mesh, const MeshOrigin& origin, Inverted inverted)
+{
     if (mesh.V.rows() == 0 || mesh.T.rows() == 0)
-        throw Error(str(source, ": the mesh is empty (", mesh.V.rows(), " vertices, ", mesh.T.rows(),
+        throw Error(str(origin.source, ": the mesh is empty (", mesh.V.rows(), " vertices, ", mesh.T.rows(),
                         " tetrahedra)"));
-    check_finite_vertices(mesh.V, source);
-    check_indices(mesh.T, mesh.V.rows(), source, "tetrahedron");
+    check_finite_vertices(mesh.V, origin);
+    check_indices(mesh.T, mesh.V.rows(), origin, "tetrahedron");
     int reoriented = 0;
     for (Eigen::Index t = 0; t < mesh.T.rows(); ++t) {
         double longest = 0.0;
@@ -159,13 +179,13 @@ int validate(TetMesh& mesh, std::string_view source, Inverted inverted)
                 longest = std::max(longest, (mesh.V.row(mesh.T(t, i)) - mesh.V.row(mesh.T(t, j))).norm());
         const double volume6 = tet_signed_volume6(mesh, static_cast<int>(t));
         if (!(std::abs(volume6) > 1e-12 * longest * longest * longest))
-            throw Error(str(source, ": tetrahedron ", t, " (vertices ", mesh.T(t, 0), ", ", mesh.T(t, 1),
-                            ", ", mesh.T(t, 2), ", ", mesh.T(t, 3),
+            throw Error(str(element_place(origin, t), ": tetrahedron ", t, " (vertices ", mesh.T(t, 0),
+                            ", ", mesh.T(t, 1), ", ", mesh.T(t, 2), ", ", mesh.T(t, 3),
                             ") has zero volume; tetrahedra must not be flat"));
         if (volume6 < 0.0) {
             if (inverted == Inverted::reject)
-                throw Error(str(source, ": tetrahedron ", t, " (vertices ", mesh.T(t, 0), ", ",
-                                mesh.T(t, 1), ", ", mesh.T(t, 2), ", ", mesh.T(t, 3),
+                throw Error(str(element_place(origin, t), ": tetrahedron ", t, " (vertices ",
+                                mesh.T(t, 0), ", ", mesh.T(t, 1), ", ", mesh.T(t, 2), ", ", mesh.T(t, 3),
                                 ") is inverted (negative volume ", volume6 / 6.0,
                                 "); list its vertices so that (b−a)·((c−a)×(d−a)) > 0, or ask for "
                                 "reorientation"));

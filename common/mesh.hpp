@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 
+#include <functional>
 #include <string>
 #include <string_view>
 
@@ -43,16 +44,29 @@ TetMesh beam_mesh(double length, double width, double height, int cells_along);
 /// What validate() does with a negatively oriented (inverted) tetrahedron.
 enum class Inverted { reject, reorient };
 
+/// Where the vertices and elements of a mesh were read from, for the messages of validate():
+/// vertex(v) and element(e) name the place of vertex v and element e, e.g. "box.node, line 12".
+/// An empty function names `source` instead. The readers of common/mesh_io.hpp pass one.
+struct MeshOrigin {
+    std::string source = "mesh";
+    std::function<std::string(Eigen::Index vertex)> vertex;
+    std::function<std::string(Eigen::Index element)> element;
+};
+
 /// Checks a triangle mesh: V and F non-empty, finite coordinates, indices in range, no repeated
 /// vertex in a triangle, no zero-area triangle (area ≤ 1e-14 · (longest edge)²). fem::Error names
 /// `source` (e.g. a file name), the element and what is allowed.
 void validate(const TriMesh& mesh, std::string_view source = "mesh");
+/// The same checks, each message naming the place origin gives for the vertex or element.
+void validate(const TriMesh& mesh, const MeshOrigin& origin);
 
 /// Checks a tetrahedral mesh like the triangle one, plus orientation: a zero-volume tetrahedron
 /// (|6V| ≤ 1e-12 · (longest edge)³) is always an error; an inverted one is an error with
 /// Inverted::reject, and is repaired by swapping its last two vertices with Inverted::reorient.
 /// Returns the number of tetrahedra reoriented (always 0 with reject).
 int validate(TetMesh& mesh, std::string_view source = "mesh", Inverted inverted = Inverted::reject);
+/// The same checks, each message naming the place origin gives for the vertex or element.
+int validate(TetMesh& mesh, const MeshOrigin& origin, Inverted inverted = Inverted::reject);
 
 /// Six times the signed volume of tetrahedron t: (b−a)·((c−a)×(d−a)).
 double tet_signed_volume6(const TetMesh& mesh, int t);

@@ -5,6 +5,7 @@
 #include "common/vtk_io.hpp"
 
 #include <vtkImageData.h>
+#include <vtkPolyData.h>
 #include <vtkSmartPointer.h>
 #include <vtkUnstructuredGrid.h>
 
@@ -12,6 +13,10 @@ namespace fem::io::detail {
 
 /// The mesh as a VTK unstructured grid with its point and cell fields (validated first).
 vtkSmartPointer<vtkUnstructuredGrid> to_vtk(const MeshData& mesh);
+
+/// The mesh (cells: points, lines or triangles) as VTK poly data with its fields (validated first);
+/// fem::Error for tetrahedra.
+vtkSmartPointer<vtkPolyData> to_vtk_polydata(const MeshData& mesh);
 
 /// The grid as VTK image data with its point fields (validated first).
 vtkSmartPointer<vtkImageData> to_vtk(const ImageGrid& grid);

@@ -263,10 +263,12 @@ MeshData read_vtu(const std::filesystem::path& path)
     return mesh;
 }
 
-void write_vtp(const std::filesystem::path& path, const MeshData& mesh)
+namespace detail {
+
+vtkSmartPointer<vtkPolyData> to_vtk_polydata(const MeshData& mesh)
 {
     validate(mesh);
-    vtkNew<vtkPolyData> poly;
+    auto poly = vtkSmartPointer<vtkPolyData>::New();
     poly->SetPoints(to_vtk_points(mesh.points));
     if (mesh.cells.rows() > 0) {
         const auto cells = to_vtk_cells(mesh.cells);
@@ -280,8 +282,15 @@ void write_vtp(const std::filesystem::path& path, const MeshData& mesh)
         }
     }
     attach_fields(poly, mesh.point_data, mesh.cell_data);
+    return poly;
+}
+
+}  // namespace detail
+
+void write_vtp(const std::filesystem::path& path, const MeshData& mesh)
+{
     vtkNew<vtkXMLPolyDataWriter> writer;
-    writer->SetInputData(poly);
+    writer->SetInputData(detail::to_vtk_polydata(mesh));
     run_writer(writer.Get(), path);
 }
 

@@ -117,6 +117,7 @@ void pareto_study(const RunContext& run, const Settings& settings)
                  {"time [s]", Format::scientific, 2}});
     fig::LineChart chart{"Heat equation: error against wall time (work-precision, lower left wins)",
                          "wall time [s]", "max-norm error at t = 0.05", true, true, {}};
+    chart.legend = fig::Corner::bottom_left;  // the curves run from top left to bottom right
     for (const Refinement& path : paths) {
         fig::Series series{path.label, {}, {}};
         std::vector<double> hs, errors;
