@@ -5,6 +5,7 @@
 #include "common/error.hpp"
 #include "common/mesh.hpp"
 
+#include "04_tet_jacobians/tet_fixtures.hpp"
 #include <catch2/catch.hpp>
 
 #include <Eigen/Geometry>
@@ -14,19 +15,12 @@
 #include <random>
 
 using namespace fem::tet;
+using fem::test::skew_tet;
+using fem::test::random_matrix;
+using fem::test::row_major_vec;
 using Catch::Matchers::Contains;
 
 namespace {
-
-TetVertices skew_tet()
-{
-    TetVertices X;
-    X << 0.1, -0.2, 0.3,
-         1.3, 0.1, -0.1,
-         0.4, 1.1, 0.2,
-         0.2, 0.3, 0.9;
-    return X;
-}
 
 /// The 4×3 vertex rows of a vertex-major 12-vector q_e = (x₀, y₀, z₀, x₁, …).
 TetVertices rows_of(const Eigen::Matrix<double, 12, 1>& q)
@@ -35,26 +29,6 @@ TetVertices rows_of(const Eigen::Matrix<double, 12, 1>& q)
     for (int i = 0; i < 4; ++i)
         x.row(i) = q.segment<3>(3 * i).transpose();
     return x;
-}
-
-/// Row-major vec(F) = (F00, F01, F02, F10, …), written out entry by entry.
-Eigen::Matrix<double, 9, 1> row_major_vec(const Eigen::Matrix3d& F)
-{
-    Eigen::Matrix<double, 9, 1> v;
-    for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b)
-            v[3 * a + b] = F(a, b);
-    return v;
-}
-
-Eigen::Matrix3d random_matrix(std::mt19937& random)
-{
-    std::uniform_real_distribution<double> u(-1.0, 1.0);
-    Eigen::Matrix3d A;
-    for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b)
-            A(a, b) = u(random);
-    return A;
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include "common/error.hpp"
 #include "common/mesh.hpp"
 
+#include "04_tet_jacobians/tet_fixtures.hpp"
 #include <catch2/catch.hpp>
 
 #include <Eigen/Geometry>
@@ -13,20 +14,10 @@
 #include <random>
 
 using namespace fem::tet;
+using fem::test::skew_tet;
 using Catch::Matchers::Contains;
 
 namespace {
-
-/// A deliberately irregular, positively oriented tet (no edge along an axis).
-TetVertices skew_tet()
-{
-    TetVertices X;
-    X << 0.1, -0.2, 0.3,
-         1.3, 0.1, -0.1,
-         0.4, 1.1, 0.2,
-         0.2, 0.3, 0.9;
-    return X;
-}
 
 /// Random barycentric coordinates strictly inside the tet (all ≥ 0.02).
 Eigen::Vector4d random_inside_phi(std::mt19937& random)

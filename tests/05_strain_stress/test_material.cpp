@@ -5,6 +5,7 @@
 
 #include "common/error.hpp"
 
+#include "04_tet_jacobians/tet_fixtures.hpp"
 #include <catch2/catch.hpp>
 
 #include <Eigen/Eigenvalues>
@@ -14,31 +15,14 @@
 #include <random>
 
 using namespace fem::elastic;
+using fem::test::random_matrix;
+using fem::test::row_major_vec;
 using Catch::Matchers::Contains;
 
 namespace {
 
 // Y = 1e5 Pa, ν = 0.45: λ = νY/((1+ν)(1−2ν)), μ = Y/(2(1+ν)), written out by hand.
 const Lame rubber{0.45e5 / (1.45 * 0.1), 1e5 / 2.9};
-
-Eigen::Matrix3d random_matrix(std::mt19937& random)
-{
-    std::uniform_real_distribution<double> u(-1.0, 1.0);
-    Eigen::Matrix3d A;
-    for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b)
-            A(a, b) = u(random);
-    return A;
-}
-
-Eigen::Matrix<double, 9, 1> row_major_vec(const Eigen::Matrix3d& A)
-{
-    Eigen::Matrix<double, 9, 1> v;
-    for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b)
-            v[3 * a + b] = A(a, b);
-    return v;
-}
 
 Eigen::Matrix3d tensor_stress(const Lame& m, const Eigen::Matrix3d& eps)
 {

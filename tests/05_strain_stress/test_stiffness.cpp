@@ -7,6 +7,7 @@
 #include "common/error.hpp"
 #include "common/mesh.hpp"
 
+#include "04_tet_jacobians/tet_fixtures.hpp"
 #include <catch2/catch.hpp>
 
 #include <Eigen/Cholesky>
@@ -16,6 +17,7 @@
 #include <random>
 
 using namespace fem::elastic;
+using fem::test::skew_tet;
 using fem::tet::TetVertices;
 using Catch::Matchers::Contains;
 using Vector12d = Eigen::Matrix<double, 12, 1>;
@@ -23,16 +25,6 @@ using Vector12d = Eigen::Matrix<double, 12, 1>;
 namespace {
 
 const Lame rubber{0.45e5 / (1.45 * 0.1), 1e5 / 2.9};  // Y = 1e5 Pa, ν = 0.45, written out by hand
-
-TetVertices skew_tet()
-{
-    TetVertices X;
-    X << 0.1, -0.2, 0.3,
-         1.3, 0.1, -0.1,
-         0.4, 1.1, 0.2,
-         0.2, 0.3, 0.9;
-    return X;
-}
 
 TetVertices rows_of(const Vector12d& q)
 {

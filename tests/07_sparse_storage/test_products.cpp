@@ -1,0 +1,298 @@
+// Chapter 07: the products y = A x and yᵀ = xᵀ A from COO, CSR, CSC and one stored triangle,
+// against dense Eigen products of the same matrices. docs/07_sparse_storage.md
+#include "07_sparse_storage/sparse_formats.hpp"
+#include "07_sparse_storage/sparse_products.hpp"
+
+#include "common/error.hpp"
+
+#include "sparse_test_support.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <random>
+
+using namespace fem::sparse;
+using namespace fem::sparse::test;
+using Catch::Matchers::Contains;
+
+namespace {
+
+Eigen::VectorXd random_vector(Eigen::Index n, unsigned seed)
+{
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> value(-1.0, 1.0);
+    Eigen::VectorXd x(n);
+    for (Eigen::Index i = 0; i < n; ++i)
+        x[i] = value(rng);
+    return x;
+}
+
+/// Random test matrices: rectangular, with empty rows and columns and rows of every length from
+/// 0 to beyond 8 (the kernels may unroll), and a few special shapes.
+struct Case {
+    int rows, cols;
+    double density;
+    unsigned seed;
+};
+const Case cases[] = {{9, 13, 0.3, 1}, {40, 7, 0.6, 2}, {1, 30, 0.5, 3}, {30, 1, 0.5, 4},
+                      {64, 64, 0.15, 5}, {100, 250, 0.04, 6}, {13, 9, 1.0, 7}};
+
+/// The triplets of a dense matrix with every entry split into two parts, listed in an order
+/// that mixes rows and columns: the product must sum them.
+CooMatrix split_triplets(const Eigen::MatrixXd& D)
+{
+    CooMatrix M;
+    M.rows = static_cast<int>(D.rows());
+    M.cols = static_cast<int>(D.cols());
+    for (int pass = 0; pass < 2; ++pass)
+        for (int j = static_cast<int>(D.cols()) - 1; j >= 0; --j)
+            for (int i = 0; i < D.rows(); ++i)
+                if (D(i, j) != 0.0)
+                    M.add(i, j, pass == 0 ? 0.25 * D(i, j) : 0.75 * D(i, j));
+    return M;
+}
+
+}  // namespace
+
+TEST_CASE("the lecture's COO example (1-based on the slide) times a vector", "[ex07.1]")
+{
+    // {(1,1,1), (2,3,−5), (3,2,4)} on the slide is, 0-based, {(0,0,1), (1,2,−5), (2,1,4)}.
+    CooMatrix M;
+    M.rows = M.cols = 3;
+    M.add(0, 0, 1.0);
+    M.add(1, 2, -5.0);
+    M.add(2, 1, 4.0);
+    Eigen::VectorXd y;
+    coo_times_vector(M, Eigen::Vector3d(1.0, 2.0, 3.0), y);
+    CHECK(y == Eigen::Vector3d(1.0, -15.0, 8.0));
+}
+
+TEST_CASE("COO × vector: duplicates add up, any order, against the dense product", "[ex07.1]")
+{
+    for (const Case& c : cases) {
+        CAPTURE(c.rows, c.cols);
+        const Eigen::MatrixXd D = random_dense(c.rows, c.cols, c.density, c.seed, {0}, {c.cols / 2});
+        const Eigen::VectorXd x = random_vector(c.cols, c.seed + 100);
+        Eigen::VectorXd y = Eigen::VectorXd::Constant(3, 99.0);  // resized and overwritten
+        coo_times_vector(split_triplets(D), x, y);
+        CHECK(close_to_product(y, D, x));
+    }
+    Eigen::MatrixXd sum;
+    const CooMatrix random = random_triplets(20, 15, 400, 8, sum);
+    const Eigen::VectorXd x = random_vector(15, 9);
+    Eigen::VectorXd y;
+    coo_times_vector(random, x, y);
+    CHECK(close_to_product(y, sum, x));
+}
+
+TEST_CASE("the lecture's 4×6 example: A x and xᵀ A from CSR and CSC", "[ex07.2][ex07.3]")
+{
+    const Eigen::VectorXd x = (Eigen::VectorXd(6) << 1, 2, 3, 4, 5, 6).finished();
+    const Eigen::Vector4d Ax(50, 220, 740, 480);  // worked out by hand from the slide's matrix
+    const Eigen::Vector4d w(1, 2, 3, 4);
+    const Eigen::VectorXd wA = (Eigen::VectorXd(6) << 10, 80, 150, 260, 210, 320).finished();
+    Eigen::VectorXd y;
+    SECTION("gather: CSR A x and CSC xᵀA")
+    {
+        csr_times_vector(lecture_csr(), x, y);
+        CHECK(y == Ax);
+        vector_times_csc(w, lecture_csc(), y);
+        CHECK(y == wA);
+    }
+    SECTION("scatter: CSC A x and CSR xᵀA")
+    {
+        csc_times_vector(lecture_csc(), x, y);
+        CHECK(y == Ax);
+        vector_times_csr(w, lecture_csr(), y);
+        CHECK(y == wA);
+    }
+}
+
+TEST_CASE("gather: CSR A x and CSC xᵀA of random matrices against the dense product", "[ex07.2]")
+{
+    for (const Case& c : cases) {
+        CAPTURE(c.rows, c.cols);
+        const Eigen::MatrixXd D = random_dense(c.rows, c.cols, c.density, c.seed, {c.rows - 1}, {0});
+        const Eigen::SparseMatrix<double> E = eigen_sparse(D);
+        const Eigen::VectorXd x = random_vector(c.cols, c.seed + 200);
+        const Eigen::VectorXd w = random_vector(c.rows, c.seed + 300);
+        Eigen::VectorXd y;
+        csr_times_vector(csr_from_eigen(E), x, y);
+        CHECK(close_to_product(y, D, x));
+        vector_times_csc(w, csc_from_eigen(E), y);
+        CHECK(close_to_product(y, D.transpose(), w));
+    }
+}
+
+TEST_CASE("scatter: CSC A x and CSR xᵀA of random matrices against the dense product", "[ex07.3]")
+{
+    for (const Case& c : cases) {
+        CAPTURE(c.rows, c.cols);
+        const Eigen::MatrixXd D = random_dense(c.rows, c.cols, c.density, c.seed, {c.rows / 3}, {c.cols - 1});
+        const Eigen::SparseMatrix<double> E = eigen_sparse(D);
+        const Eigen::VectorXd x = random_vector(c.cols, c.seed + 400);
+        const Eigen::VectorXd w = random_vector(c.rows, c.seed + 500);
+        Eigen::VectorXd y = Eigen::VectorXd::Constant(c.rows, 1e300);  // must be overwritten, not added to
+        csc_times_vector(csc_from_eigen(E), x, y);
+        CHECK(close_to_product(y, D, x));
+        vector_times_csr(w, csr_from_eigen(E), y);
+        CHECK(close_to_product(y, D.transpose(), w));
+    }
+}
+
+TEST_CASE("the gather and scatter kernels on views of raw arrays", "[ex07.2][ex07.3]")
+{
+    const CsrMatrix M = lecture_csr();
+    const std::vector<double> x{1, 2, 3, 4, 5, 6};
+    std::vector<double> y(4, -1.0);
+    gather_product(view(M), x, y);
+    CHECK(y == std::vector<double>{50, 220, 740, 480});
+    std::vector<double> z(4, -1.0);
+    scatter_product(view(lecture_csc()), x, z);
+    CHECK(z == std::vector<double>{50, 220, 740, 480});
+}
+
+TEST_CASE("products of empty matrices: 0×0, n×0 gives zeros, 0×n gives an empty vector",
+          "[ex07.1][ex07.2][ex07.3]")
+{
+    for (auto [rows, cols] : {std::pair{0, 0}, std::pair{3, 0}, std::pair{0, 4}, std::pair{3, 4}}) {
+        CAPTURE(rows, cols);
+        CsrMatrix R;
+        R.rows = rows;
+        R.cols = cols;
+        R.IA.assign(rows + 1, 0);
+        CscMatrix C;
+        C.rows = rows;
+        C.cols = cols;
+        C.IA.assign(cols + 1, 0);
+        CooMatrix T;
+        T.rows = rows;
+        T.cols = cols;
+        const Eigen::VectorXd x = Eigen::VectorXd::Ones(cols);
+        const Eigen::VectorXd zeros = Eigen::VectorXd::Zero(rows);
+        Eigen::VectorXd y = Eigen::VectorXd::Constant(rows, 7.0);
+        csr_times_vector(R, x, y);
+        CHECK(y == zeros);
+        y.setConstant(7.0);
+        csc_times_vector(C, x, y);
+        CHECK(y == zeros);
+        y.setConstant(7.0);
+        coo_times_vector(T, x, y);
+        CHECK(y == zeros);
+        Eigen::VectorXd z = Eigen::VectorXd::Constant(cols, 7.0);
+        vector_times_csr(Eigen::VectorXd::Ones(rows), R, z);
+        CHECK(z == Eigen::VectorXd::Zero(cols));
+    }
+}
+
+TEST_CASE("products refuse vectors of the wrong size and y = x", "[validate]")
+{
+    const CsrMatrix R = lecture_csr();
+    const CscMatrix C = lecture_csc();
+    const CooMatrix T = csr_to_coo(R);
+    Eigen::VectorXd y;
+    const Eigen::VectorXd x5 = Eigen::VectorXd::Ones(5);
+    CHECK_THROWS_WITH(csr_times_vector(R, x5, y), Contains("x has 5 entries") && Contains("needs 6"));
+    CHECK_THROWS_WITH(csc_times_vector(C, x5, y), Contains("x has 5 entries"));
+    CHECK_THROWS_WITH(coo_times_vector(T, x5, y), Contains("x has 5 entries"));
+    CHECK_THROWS_WITH(vector_times_csc(x5, C, y), Contains("x has 5 entries") && Contains("needs 4"));
+    CHECK_THROWS_AS(vector_times_csr(x5, R, y), fem::Error);
+
+    CsrMatrix square;
+    square.rows = square.cols = 2;
+    square.IA = {0, 1, 2};
+    square.JA = {0, 1};
+    square.A = {1.0, 2.0};
+    Eigen::VectorXd v = Eigen::VectorXd::Ones(2);
+    CHECK_THROWS_WITH(csr_times_vector(square, v, v), Contains("same vector"));
+    CHECK_THROWS_WITH(symmetric_times_vector(square, v, v), Contains("same vector"));
+
+    const std::vector<double> a{1, 2, 3, 4, 5, 6};
+    std::vector<double> small(3);
+    CHECK_THROWS_WITH(gather_product(view(R), a, small), Contains("y has 3 entries"));
+    std::vector<double> overlap(10);
+    CHECK_THROWS_WITH(gather_product(view(R), std::span<const double>(overlap.data(), 6),
+                                     std::span<double>(overlap.data() + 5, 4)),
+                      Contains("share memory"));
+
+    CsrMatrix broken = R;
+    broken.IA.pop_back();
+    CHECK_THROWS_WITH(csr_times_vector(broken, Eigen::VectorXd::Ones(6), y), Contains("IA has 4 entries"));
+}
+
+TEST_CASE("symmetric product from the lower triangle equals the full product", "[ex07.6]")
+{
+    for (auto [n, density, seed] : {std::tuple{1, 1.0, 1u}, std::tuple{2, 1.0, 2u}, std::tuple{12, 0.3, 3u},
+                                    std::tuple{50, 0.2, 4u}, std::tuple{200, 0.03, 5u}}) {
+        CAPTURE(n);
+        Eigen::MatrixXd B = random_dense(n, n, density, seed, {n / 2}, {n / 2});
+        const Eigen::MatrixXd S = B + B.transpose();  // symmetric, row and column n/2 empty
+        const Eigen::VectorXd x = random_vector(n, seed + 10);
+        const CsrMatrix L = lower_triangle(csr_from_eigen(eigen_sparse(S)));
+        Eigen::VectorXd y = Eigen::VectorXd::Constant(n, 1e300);
+        symmetric_times_vector(L, x, y);
+        CHECK(close_to_product(y, S, x));
+    }
+}
+
+TEST_CASE("symmetric product: missing diagonal entries, empty rows, and a stiffness-like matrix",
+          "[ex07.6]")
+{
+    // A 1D Laplacian-like tridiagonal matrix with the diagonal of rows 0 and 3 not stored, and row 2
+    // and column 2 empty.
+    Eigen::MatrixXd S = Eigen::MatrixXd::Zero(5, 5);
+    S(0, 1) = S(1, 0) = -1.0;
+    S(1, 1) = 2.0;
+    S(3, 4) = S(4, 3) = -1.5;
+    S(4, 4) = 3.0;
+    S(4, 0) = S(0, 4) = 0.5;
+    const CsrMatrix L = lower_triangle(csr_from_eigen(eigen_sparse(S)));
+    const Eigen::VectorXd x = (Eigen::VectorXd(5) << 1, -2, 3, 0.5, 4).finished();
+    Eigen::VectorXd y;
+    symmetric_times_vector(L, x, y);
+    CHECK(close_to_product(y, S, x));
+
+    // Against Eigen's own symmetric product on the same stored triangle.
+    const Eigen::MatrixXd D = random_dense(80, 80, 0.1, 9);
+    const Eigen::MatrixXd K = D * D.transpose() + Eigen::MatrixXd::Identity(80, 80);
+    const Eigen::SparseMatrix<double> E = eigen_sparse(K);
+    const Eigen::VectorXd z = random_vector(80, 10);
+    symmetric_times_vector(lower_triangle(csr_from_eigen(E)), z, y);
+    const Eigen::VectorXd eigen_y = E.selfadjointView<Eigen::Lower>() * z;
+    CHECK((y - eigen_y).norm() <= 1e-13 * (K.cwiseAbs() * z.cwiseAbs()).norm());
+
+    CsrMatrix empty;
+    symmetric_times_vector(empty, Eigen::VectorXd(), y);
+    CHECK(y.size() == 0);
+}
+
+TEST_CASE("symmetric product reads only the lower triangle: the full matrix gives the same y", "[ex07.6]")
+{
+    const Eigen::MatrixXd B = random_dense(40, 40, 0.2, 21, {7}, {7});
+    const Eigen::MatrixXd S = B + B.transpose();
+    const Eigen::VectorXd x = random_vector(40, 22);
+    Eigen::VectorXd y;
+    symmetric_times_vector(csr_from_eigen(eigen_sparse(S)), x, y);
+    CHECK(close_to_product(y, S, x));
+
+    // Anything above the diagonal is ignored: here it is unrelated to the lower triangle.
+    Eigen::MatrixXd M = S;
+    M.triangularView<Eigen::StrictlyUpper>() = random_dense(40, 40, 0.5, 23);
+    symmetric_times_vector(csr_from_eigen(eigen_sparse(M)), x, y);
+    CHECK(close_to_product(y, S, x));
+}
+
+TEST_CASE("symmetric product refuses a non-square matrix", "[validate]")
+{
+    Eigen::VectorXd y;
+    CHECK_THROWS_WITH(symmetric_times_vector(lecture_csr(), Eigen::VectorXd::Ones(6), y),
+                      Contains("4×6") && Contains("square"));
+}
+
+TEST_CASE("the byte model of an SpMV", "[cost]")
+{
+    // CSR of a 4×6 matrix with 8 entries: 8 × 12 + 5 × 4 + (6 + 4) × 8.
+    CHECK(spmv_bytes(8, 4, 5, 6, 4) == 96 + 20 + 80);
+    // COO: two indices per entry, no pointers.
+    CHECK(spmv_bytes(8, 8, 0, 6, 4) == 128 + 80);
+}
