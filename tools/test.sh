@@ -21,7 +21,7 @@ cmake --preset grading -DFEM_WERROR=ON >/dev/null
 cmake --build --preset grading -j "$JOBS"
 with_display python3 tools/exercises.py grade --build build/grading
 
-step "2/4 every chapter compiles from exercises/"
+step "2/4 every chapter library compiles from exercises/"
 cmake --preset exercises -DFEM_WERROR=ON >/dev/null
 cmake --build --preset exercises -j "$JOBS"
 
