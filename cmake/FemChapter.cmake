@@ -7,7 +7,7 @@
 #   fem_chNN_reference  what later chapters link: always the reference solution, so a student
 #                       working on chapter 05 keeps chapters 06+ running;
 #   chNN_name           its executable in <build>/bin, from chapters/NN_name/main.cpp;
-#   test_chNN           its Catch2 tests from tests/NN_name/*.cpp (ctest labels chNN, unit);
+#   test_chNN           its Catch2 tests from tests/NN_name/*.cpp (ctest label chNN);
 #   chNN_quick_run      ctest: the executable in --quick mode, its files and figures against
 #                       tests/NN_name/expected (label chNN, run);
 #   chNN_docs           ctest: docs/NN_name.md names only functions and exercises that exist and
@@ -100,7 +100,8 @@ function(fem_add_chapter number name)
     add_executable(${test_exe} ${test_sources})
     target_link_libraries(${test_exe} PRIVATE ${lib} fem_test_main fem_flags)
     target_compile_definitions(${test_exe} PRIVATE FEM_TEST_OUTPUT_DIR="${CMAKE_BINARY_DIR}/test_output/${id}")
-    catch_discover_tests(${test_exe} TEST_PREFIX "ch${number}: " PROPERTIES LABELS "ch${number};unit")
+    # One label only: catch_discover_tests splits a list of labels into separate properties.
+    catch_discover_tests(${test_exe} TEST_PREFIX "ch${number}: " PROPERTIES LABELS "ch${number}")
     add_dependencies(fem_tests ${test_exe})
 
     add_test(NAME ch${number}_quick_run
@@ -113,6 +114,13 @@ function(fem_add_chapter number name)
                      --chapter ${id} --bin ${CMAKE_BINARY_DIR}/bin
                      --out ${CMAKE_BINARY_DIR}/check_docs/${id})
     set_tests_properties(ch${number}_docs PROPERTIES LABELS "ch${number};docs")
+  endif()
+
+  # A chapter's own additions to the build (e.g. an optional reference library for its
+  # executable) go in chapters/NN_name/chapter.cmake, included here, where ${lib}, ${exe} and
+  # ${test_exe} name its targets.
+  if(EXISTS ${FEM_ROOT}/chapters/${id}/chapter.cmake)
+    include(${FEM_ROOT}/chapters/${id}/chapter.cmake)
   endif()
 
   set(FEM_ALL_CHAPTERS ${FEM_ALL_CHAPTERS} ${id} CACHE INTERNAL "registered chapters")
