@@ -23,6 +23,7 @@
 #include <vtkPNGWriter.h>
 #include <vtkPen.h>
 #include <vtkPlot.h>
+#include <vtkPlotPoints.h>
 #include <vtkPointData.h>
 #include <vtkPolyDataMapper.h>
 #include <vtkProperty.h>
@@ -285,12 +286,16 @@ bool save_chart(const LineChart& chart, const std::filesystem::path& stem, bool 
         table->AddColumn(xs);
         table->AddColumn(ys);
         tables.push_back(table);
-        vtkPlot* line = xy->AddPlot(vtkChart::LINE);
+        vtkPlot* line = xy->AddPlot(s.markers_only ? vtkChart::POINTS : vtkChart::LINE);
         line->SetInputData(table, 0, 1);
         const auto& rgb = line_colours[k % line_colours.size()];
         line->SetColor(rgb[0], rgb[1], rgb[2], 255);
         line->SetWidth(2.5);
         line->SetLabel(s.name);
+        if (auto* points = vtkPlotPoints::SafeDownCast(line); points && s.markers_only) {
+            points->SetMarkerStyle(vtkPlotPoints::DIAMOND);
+            points->SetMarkerSize(14.0);
+        }
     }
     window->Render();
     std::filesystem::path png_path = stem;

@@ -25,6 +25,7 @@ struct Series {
     std::string name;
     std::vector<double> x;
     std::vector<double> y;
+    bool markers_only = false;  ///< draw the points as markers, not joined by a line (e.g. one point)
 };
 
 /// Where a chart's legend goes: pick the corner the lines leave empty.

@@ -1,0 +1,601 @@
+// Chapter 08: supernodes (fundamental and relaxed), their row structures, and the multifrontal
+// numeric factorization and triangular solves with dense blocks (Eigen, and an AVX2 product kernel).
+// docs/08_direct_solvers.md#supernodes-dense-blocks
+#include "08_direct_solvers/supernodal.hpp"
+
+#include "common/error.hpp"
+
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <numeric>
+#include <vector>
+
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+#include <immintrin.h>
+#endif
+
+namespace fem::direct {
+namespace {
+
+using Block = Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>>;
+using ConstBlock = Eigen::Map<const Eigen::MatrixXd, 0, Eigen::OuterStride<>>;
+
+/// Columns per step of the blocked dense factorization of a front.
+constexpr int panel_width = 64;
+
+// --- C −= A Bᵀ, the operation that does almost all the flops --------------------------------
+//
+// Eigen compiled for baseline x86-64 multiplies with SSE2 (2 doubles per instruction, no fused
+// multiply-add). Most machines have AVX2 and FMA (4 doubles, multiply and add in one), so the
+// product below has a hand-written kernel for them, chosen at run time, in the classic layout of
+// GotoBLAS/BLIS: B is packed in panels of 6 columns of C, A in strips of 8 rows, and an 8×6 block
+// of C stays in 12 vector registers while k runs. Without AVX2 the product is Eigen's.
+
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+#define FEM_AVX2_KERNEL 1
+#endif
+
+#ifdef FEM_AVX2_KERNEL
+constexpr int kernel_rows = 8, kernel_cols = 6;                    // the register block of C
+constexpr int depth_block = 256, row_block = 96, col_block = 2400;  // what stays in L1 / L2 / L3
+
+bool avx2_available()
+{
+    static const bool available = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+    return available;
+}
+
+/// A 64-byte aligned scratch area that grows as needed (one per thread).
+double* scratch(std::vector<double>& storage, std::size_t entries)
+{
+    if (storage.size() < entries + 8)
+        storage.resize(entries + 8);
+    const auto address = reinterpret_cast<std::uintptr_t>(storage.data());
+    return storage.data() + ((64 - address % 64) % 64) / sizeof(double);
+}
+
+/// C(8×6) −= Σ_p a_p b_pᵀ with a packed (8 per p, aligned) and b packed (6 per p). A full tile
+/// is updated in place; a partial one (rows × cols) through a small buffer.
+__attribute__((target("avx2,fma"))) void kernel_8x6(int k, const double* a, const double* b, double* C, int ldc,
+                                                    int rows, int cols)
+{
+    __m256d c0a = _mm256_setzero_pd(), c0b = _mm256_setzero_pd(), c1a = _mm256_setzero_pd(),
+            c1b = _mm256_setzero_pd(), c2a = _mm256_setzero_pd(), c2b = _mm256_setzero_pd(),
+            c3a = _mm256_setzero_pd(), c3b = _mm256_setzero_pd(), c4a = _mm256_setzero_pd(),
+            c4b = _mm256_setzero_pd(), c5a = _mm256_setzero_pd(), c5b = _mm256_setzero_pd();
+    for (int p = 0; p < k; ++p) {
+        const __m256d a0 = _mm256_load_pd(a), a1 = _mm256_load_pd(a + 4);
+        __m256d bj = _mm256_broadcast_sd(b);
+        c0a = _mm256_fmadd_pd(a0, bj, c0a);
+        c0b = _mm256_fmadd_pd(a1, bj, c0b);
+        bj = _mm256_broadcast_sd(b + 1);
+        c1a = _mm256_fmadd_pd(a0, bj, c1a);
+        c1b = _mm256_fmadd_pd(a1, bj, c1b);
+        bj = _mm256_broadcast_sd(b + 2);
+        c2a = _mm256_fmadd_pd(a0, bj, c2a);
+        c2b = _mm256_fmadd_pd(a1, bj, c2b);
+        bj = _mm256_broadcast_sd(b + 3);
+        c3a = _mm256_fmadd_pd(a0, bj, c3a);
+        c3b = _mm256_fmadd_pd(a1, bj, c3b);
+        bj = _mm256_broadcast_sd(b + 4);
+        c4a = _mm256_fmadd_pd(a0, bj, c4a);
+        c4b = _mm256_fmadd_pd(a1, bj, c4b);
+        bj = _mm256_broadcast_sd(b + 5);
+        c5a = _mm256_fmadd_pd(a0, bj, c5a);
+        c5b = _mm256_fmadd_pd(a1, bj, c5b);
+        a += kernel_rows;
+        b += kernel_cols;
+    }
+    const __m256d sums[kernel_cols][2] = {{c0a, c0b}, {c1a, c1b}, {c2a, c2b}, {c3a, c3b}, {c4a, c4b}, {c5a, c5b}};
+    if (rows == kernel_rows && cols == kernel_cols) {
+        for (int j = 0; j < kernel_cols; ++j) {
+            double* const column = C + static_cast<long long>(j) * ldc;
+            _mm256_storeu_pd(column, _mm256_sub_pd(_mm256_loadu_pd(column), sums[j][0]));
+            _mm256_storeu_pd(column + 4, _mm256_sub_pd(_mm256_loadu_pd(column + 4), sums[j][1]));
+        }
+        return;
+    }
+    alignas(32) double tile[kernel_rows * kernel_cols];
+    for (int j = 0; j < kernel_cols; ++j) {
+        _mm256_store_pd(tile + kernel_rows * j, sums[j][0]);
+        _mm256_store_pd(tile + kernel_rows * j + 4, sums[j][1]);
+    }
+    for (int j = 0; j < cols; ++j)
+        for (int i = 0; i < rows; ++i)
+            C[i + static_cast<long long>(j) * ldc] -= tile[i + kernel_rows * j];
+}
+
+/// The packed, blocked C −= A Bᵀ (all column-major).
+__attribute__((target("avx2,fma"))) void subtract_product_avx2(int m, int n, int k, const double* A, int lda,
+                                                               const double* B, int ldb, double* C, int ldc)
+{
+    thread_local std::vector<double> a_storage, b_storage;
+    for (int jc = 0; jc < n; jc += col_block) {
+        const int nb = std::min(col_block, n - jc);
+        const int n_strips = (nb + kernel_cols - 1) / kernel_cols;
+        for (int pc = 0; pc < k; pc += depth_block) {
+            const int kb = std::min(depth_block, k - pc);
+            // B's rows jc … jc+nb−1, columns pc … pc+kb−1, in strips of 6: b[strip][p][0..5]
+            double* const b_packed = scratch(b_storage, static_cast<std::size_t>(n_strips) * kernel_cols * kb);
+            for (int s = 0; s < n_strips; ++s) {
+                const int j0 = jc + s * kernel_cols, width = std::min(kernel_cols, n - j0);
+                double* out = b_packed + static_cast<std::size_t>(s) * kernel_cols * kb;
+                for (int p = 0; p < kb; ++p, out += kernel_cols) {
+                    const double* column = B + j0 + static_cast<long long>(pc + p) * ldb;
+                    for (int j = 0; j < width; ++j)
+                        out[j] = column[j];
+                    for (int j = width; j < kernel_cols; ++j)
+                        out[j] = 0.0;
+                }
+            }
+            for (int ic = 0; ic < m; ic += row_block) {
+                const int mb = std::min(row_block, m - ic);
+                const int m_strips = (mb + kernel_rows - 1) / kernel_rows;
+                double* const a_packed = scratch(a_storage, static_cast<std::size_t>(m_strips) * kernel_rows * kb);
+                for (int s = 0; s < m_strips; ++s) {
+                    const int i0 = ic + s * kernel_rows, height = std::min(kernel_rows, m - i0);
+                    double* out = a_packed + static_cast<std::size_t>(s) * kernel_rows * kb;
+                    for (int p = 0; p < kb; ++p, out += kernel_rows) {
+                        const double* column = A + i0 + static_cast<long long>(pc + p) * lda;
+                        for (int i = 0; i < height; ++i)
+                            out[i] = column[i];
+                        for (int i = height; i < kernel_rows; ++i)
+                            out[i] = 0.0;
+                    }
+                }
+                for (int sj = 0; sj < n_strips; ++sj) {
+                    const int j0 = jc + sj * kernel_cols, cols = std::min(kernel_cols, n - j0);
+                    const double* const b = b_packed + static_cast<std::size_t>(sj) * kernel_cols * kb;
+                    for (int si = 0; si < m_strips; ++si) {
+                        const int i0 = ic + si * kernel_rows, rows = std::min(kernel_rows, m - i0);
+                        kernel_8x6(kb, a_packed + static_cast<std::size_t>(si) * kernel_rows * kb, b,
+                                   C + i0 + static_cast<long long>(j0) * ldc, ldc, rows, cols);
+                    }
+                }
+            }
+        }
+    }
+}
+#endif
+
+/// C −= A Bᵀ for column-major C (m×n, leading dimension ldc), A (m×k) and B (n×k).
+void subtract_product(int m, int n, int k, const double* A, int lda, const double* B, int ldb, double* C, int ldc)
+{
+    if (m == 0 || n == 0 || k == 0)
+        return;
+#ifdef FEM_AVX2_KERNEL
+    if (avx2_available() && m >= kernel_rows && n >= kernel_cols) {
+        subtract_product_avx2(m, n, k, A, lda, B, ldb, C, ldc);
+        return;
+    }
+#endif
+    Block target(C, m, n, Eigen::OuterStride<>(ldc));
+    const ConstBlock left(A, m, k, Eigen::OuterStride<>(lda)), right(B, n, k, Eigen::OuterStride<>(ldb));
+    target.noalias() -= left * right.transpose();
+}
+
+/// C −= A Aᵀ on the lower triangle of the square C (q×q, leading dimension ldc), A q×k (lda), by
+/// column panels: each panel also computes the upper half of its small diagonal block (wasted,
+/// but a plain product runs faster than a triangular one).
+void lower_rank_update(int q, int k, const double* A, int lda, double* C, int ldc)
+{
+    constexpr int width = 120;
+    for (int c0 = 0; c0 < q; c0 += width) {
+        const int cb = std::min(width, q - c0);
+        subtract_product(q - c0, cb, k, A + c0, lda, A + c0, lda, C + c0 + static_cast<long long>(c0) * ldc, ldc);
+    }
+}
+
+/// Dense Cholesky of the kb×kb lower triangle at D (leading dimension ld), right-looking, one
+/// column at a time; the pivot of column j must exceed tiny[j] (pivot_thresholds). Returns the
+/// local index of a failed pivot (and its value), or −1.
+int unblocked_cholesky(double* D, int kb, int ld, const double* tiny, double& failed_pivot)
+{
+    for (int j = 0; j < kb; ++j) {
+        double* const column = D + static_cast<long long>(j) * ld;
+        const double d = column[j];
+        if (!(d > tiny[j])) {
+            failed_pivot = d;
+            return j;
+        }
+        const double l_jj = std::sqrt(d);
+        column[j] = l_jj;
+        for (int i = j + 1; i < kb; ++i)
+            column[i] /= l_jj;
+        for (int c = j + 1; c < kb; ++c) {
+            double* const target = D + static_cast<long long>(c) * ld;
+            const double l_cj = column[c];
+            for (int i = c; i < kb; ++i)
+                target[i] -= column[i] * l_cj;
+        }
+    }
+    return -1;
+}
+
+/// The partial Cholesky of a front: the m×ns block F (leading dimension m) holds the supernode's
+/// columns of the frontal matrix; on return its top ns×ns lower triangle is L_11 and the rows
+/// below are L_21 = F_21 L_11⁻ᵀ. Blocked, right-looking: per panel of columns an unblocked
+/// Cholesky of the diagonal block, a triangular solve for the rows below, and a rank-kb update
+/// of the remaining columns. tiny: the pivot thresholds of the ns columns. Returns the local failed
+/// column (pivot in failed_pivot), or −1.
+int partial_cholesky(double* F, int m, int ns, const double* tiny, double& failed_pivot)
+{
+    Block front(F, m, ns, Eigen::OuterStride<>(m));
+    for (int k0 = 0; k0 < ns; k0 += panel_width) {
+        const int kb = std::min(panel_width, ns - k0);
+        const int failed = unblocked_cholesky(F + static_cast<long long>(k0) * m + k0, kb, m, tiny + k0, failed_pivot);
+        if (failed >= 0)
+            return k0 + failed;
+        const int below = m - k0 - kb;
+        if (below == 0)
+            break;
+        const auto D = front.block(k0, k0, kb, kb);
+        auto P = front.block(k0 + kb, k0, below, kb);
+        D.triangularView<Eigen::Lower>().transpose().solveInPlace<Eigen::OnTheRight>(P);
+        const int q = ns - k0 - kb;  // columns of the supernode still to factor
+        if (q > 0) {
+            const double* const panel = F + (k0 + kb) + static_cast<long long>(k0) * m;  // P, leading dimension m
+            double* const trailing = F + (k0 + kb) + static_cast<long long>(k0 + kb) * m;
+            lower_rank_update(q, kb, panel, m, trailing, m);
+            subtract_product(m - ns, q, kb, panel + q, m, panel, m, trailing + q, m);
+        }
+    }
+    return -1;
+}
+
+}  // namespace
+
+SupernodalCholesky::SupernodalCholesky(const SymbolicCholesky& symbolic, const sparse::CscMatrix& C_upper,
+                                       const SupernodeRelaxation& relaxation)
+    : n_(symbolic.n), perm_(symbolic.perm)
+{
+    const int n = n_;
+    if (C_upper.cols != n || C_upper.rows != n || static_cast<int>(symbolic.parent.size()) != n ||
+        static_cast<int>(symbolic.counts.size()) != n || static_cast<int>(perm_.size()) != n)
+        throw Error(str("supernodes: the symbolic factorization is for ", symbolic.n, " unknowns, the matrix is ",
+                        C_upper.rows, "×", C_upper.cols));
+    const std::vector<int>& parent = symbolic.parent;
+    const std::vector<int>& counts = symbolic.counts;
+    std::vector<int> children(n, 0);
+    for (int j = 0; j < n; ++j) {
+        if (parent[j] != -1 && (parent[j] <= j || parent[j] >= n))
+            throw Error(str("supernodes: parent[", j, "] = ", parent[j], "; the tree must be postordered (parent > child)"));
+        if (parent[j] >= 0)
+            ++children[parent[j]];
+    }
+
+    // 1. Fundamental supernodes: chains j → j+1 with one child and counts dropping by one.
+    std::vector<int> start;  // first column of each fundamental supernode
+    for (int j = 0; j < n; ++j)
+        if (j == 0 || !(parent[j - 1] == j && children[j] == 1 && counts[j - 1] == counts[j] + 1))
+            start.push_back(j);
+    const int fundamental = static_cast<int>(start.size());
+    std::vector<int> end(fundamental), owner(n);
+    for (int s = 0; s < fundamental; ++s) {
+        end[s] = s + 1 < fundamental ? start[s + 1] : n;
+        for (int j = start[s]; j < end[s]; ++j)
+            owner[j] = s;
+    }
+
+    // 2. Relaxed merges: a supernode absorbs the child that ends right where it starts, while the
+    //    merged block stays dense enough. merged_into is a union-find towards the surviving parent.
+    std::vector<int> super_parent(fundamental), merged_into(fundamental);
+    std::vector<long long> rows_of(fundamental), exact(fundamental);
+    std::iota(merged_into.begin(), merged_into.end(), 0);
+    for (int s = 0; s < fundamental; ++s) {
+        const int last = end[s] - 1;
+        super_parent[s] = parent[last] < 0 ? -1 : owner[parent[last]];
+        rows_of[s] = counts[start[s]];
+        exact[s] = 0;
+        for (int j = start[s]; j < end[s]; ++j)
+            exact[s] += counts[j];
+    }
+    const auto find = [&](int s) {
+        while (merged_into[s] != s)
+            s = merged_into[s] = merged_into[merged_into[s]];
+        return s;
+    };
+    std::vector<int> last_owner(n, -1);  // the live supernode whose last column is j
+    for (int s = 0; s < fundamental; ++s) {
+        for (;;) {
+            if (start[s] == 0)
+                break;
+            const int c = last_owner[start[s] - 1];
+            if (c < 0 || find(c) != c || super_parent[c] < 0 || find(super_parent[c]) != s)
+                break;
+            const long long ns = (end[s] - start[s]) + (end[c] - start[c]);
+            const long long m = (end[c] - start[c]) + rows_of[s];
+            const long long stored = ns * m - ns * (ns - 1) / 2;
+            const double zeros = static_cast<double>(stored - exact[s] - exact[c]) / static_cast<double>(stored);
+            const bool accept = ns <= relaxation.small || (ns <= relaxation.medium && zeros < relaxation.medium_zeros) ||
+                                (ns <= relaxation.large && zeros < relaxation.large_zeros) || zeros < relaxation.any_zeros;
+            if (!accept)
+                break;
+            merged_into[c] = s;
+            start[s] = start[c];
+            rows_of[s] = m;
+            exact[s] += exact[c];
+        }
+        last_owner[end[s] - 1] = s;
+    }
+
+    // 3. The surviving supernodes, in column order, and their tree.
+    first_.clear();
+    std::vector<int> final_end;
+    for (int s = 0; s < fundamental; ++s)
+        if (find(s) == s) {
+            first_.push_back(start[s]);
+            final_end.push_back(end[s]);
+        }
+    const int S = static_cast<int>(first_.size());
+    first_.push_back(n);
+    column_to_supernode_.assign(n, 0);
+    for (int s = 0; s < S; ++s)
+        for (int j = first_[s]; j < first_[s + 1]; ++j)
+            column_to_supernode_[j] = s;
+    parent_.assign(S, -1);
+    for (int s = 0; s < S; ++s) {
+        const int p = parent[first_[s + 1] - 1];
+        parent_[s] = p < 0 ? -1 : column_to_supernode_[p];
+    }
+
+    // 4. Row structures: rows(s) = s's columns ∪ (rows below s of C's columns in s) ∪ (rows below s
+    //    of each child's structure). C's lower triangle column j is row j of C_upper: transpose
+    //    the pattern once.
+    std::vector<int> lower_start(n + 1, 0), lower_rows(C_upper.IA[n]);
+    for (int k = 0; k < C_upper.IA[n]; ++k)
+        ++lower_start[C_upper.JA[k] + 1];
+    std::partial_sum(lower_start.begin(), lower_start.end(), lower_start.begin());
+    {
+        std::vector<int> next(lower_start.begin(), lower_start.end() - 1);
+        for (int i = 0; i < n; ++i)
+            for (int k = C_upper.IA[i]; k < C_upper.IA[i + 1]; ++k)
+                lower_rows[next[C_upper.JA[k]]++] = i;
+    }
+    std::vector<int> child_head(S, -1), child_next(S, -1);
+    for (int s = S - 1; s >= 0; --s)
+        if (parent_[s] >= 0) {
+            child_next[s] = child_head[parent_[s]];
+            child_head[parent_[s]] = s;
+        }
+    row_start_.assign(S + 1, 0);
+    rows_.clear();
+    std::vector<int> mark(n, -1), below;
+    for (int s = 0; s < S; ++s) {
+        const int f = first_[s], e = first_[s + 1];
+        below.clear();
+        for (int j = f; j < e; ++j)
+            for (int k = lower_start[j]; k < lower_start[j + 1]; ++k) {
+                const int i = lower_rows[k];
+                if (i >= e && mark[i] != s) {
+                    mark[i] = s;
+                    below.push_back(i);
+                }
+            }
+        for (int c = child_head[s]; c >= 0; c = child_next[c]) {
+            const int nc = first_[c + 1] - first_[c];
+            for (long long t = row_start_[c] + nc; t < row_start_[c + 1]; ++t) {
+                const int i = rows_[t];
+                if (i >= e && mark[i] != s) {
+                    mark[i] = s;
+                    below.push_back(i);
+                }
+            }
+        }
+        std::sort(below.begin(), below.end());
+        for (int j = f; j < e; ++j)
+            rows_.push_back(j);
+        rows_.insert(rows_.end(), below.begin(), below.end());
+        row_start_[s + 1] = static_cast<long long>(rows_.size());
+    }
+    value_start_.assign(S + 1, 0);
+    for (int s = 0; s < S; ++s)
+        value_start_[s + 1] = value_start_[s] + static_cast<long long>(rows(s)) * (first_[s + 1] - first_[s]);
+}
+
+void SupernodalCholesky::factorize(const sparse::CscMatrix& C_lower)
+{
+    const int n = n_;
+    if (C_lower.rows != n || C_lower.cols != n)
+        throw Error(str("supernodal factorization: the matrix is ", C_lower.rows, "×", C_lower.cols,
+                        ", the analysis was for ", n, "×", n));
+    factored_ = false;
+    const int S = supernodes();
+    // Sizes of the work areas: the largest update matrix, and the peak of the update stack.
+    long long largest_update = 0, peak_stack = 0;
+    {
+        long long stack = 0;
+        std::vector<long long> pending;
+        for (int s = 0; s < S; ++s) {
+            while (!pending.empty() && pending.back() >= 0 && parent_[pending.back()] == s) {
+                const long long r = rows(pending.back()) - (first_[pending.back() + 1] - first_[pending.back()]);
+                stack -= r * r;
+                pending.pop_back();
+            }
+            const long long r = rows(s) - (first_[s + 1] - first_[s]);
+            largest_update = std::max(largest_update, r * r);
+            if (r > 0) {
+                stack += r * r;
+                peak_stack = std::max(peak_stack, stack);
+                pending.push_back(s);
+            }
+        }
+    }
+    const std::vector<double> tiny = pivot_thresholds(C_lower);
+    values_.assign(static_cast<std::size_t>(stored_entries()), 0.0);
+    std::vector<double> work(static_cast<std::size_t>(largest_update));
+    std::vector<double> stack_values(static_cast<std::size_t>(peak_stack));
+    struct Pending {
+        int supernode;
+        long long offset;
+    };
+    std::vector<Pending> stack;
+    long long stack_top = 0;
+    std::vector<int> position(n, -1), relative;
+
+    for (int s = 0; s < S; ++s) {
+        const int f = first_[s];
+        const int ns = first_[s + 1] - f;
+        const int m = rows(s);
+        const int r = m - ns;
+        const int* const row = rows_.data() + row_start_[s];
+        double* const L = values_.data() + value_start_[s];
+        for (int t = 0; t < m; ++t)
+            position[row[t]] = t;
+
+        // The front: A's columns of s into L (m×ns), zero update area W (r×r, lower triangle).
+        for (int c = 0; c < ns; ++c) {
+            double* const column = L + static_cast<long long>(c) * m;
+            for (int k = C_lower.IA[f + c]; k < C_lower.IA[f + c + 1]; ++k)
+                column[position[C_lower.JA[k]]] += C_lower.A[k];
+        }
+        double* const W = work.data();
+        for (int c = 0; c < r; ++c)
+            std::fill(W + static_cast<long long>(c) * r + c, W + static_cast<long long>(c + 1) * r, 0.0);
+
+        // Extend-add the update matrices of the children (on top of the stack).
+        while (!stack.empty() && parent_[stack.back().supernode] == s) {
+            const Pending child = stack.back();
+            stack.pop_back();
+            const int c = child.supernode;
+            const int nc = first_[c + 1] - first_[c];
+            const int rc = rows(c) - nc;
+            const double* const U = stack_values.data() + child.offset;
+            const int* const child_rows = rows_.data() + row_start_[c] + nc;
+            relative.resize(rc);
+            for (int t = 0; t < rc; ++t)
+                relative[t] = position[child_rows[t]];
+            for (int jj = 0; jj < rc; ++jj) {
+                const int pj = relative[jj];
+                const double* const source = U + static_cast<long long>(jj) * rc;
+                if (pj < ns) {
+                    double* const target = L + static_cast<long long>(pj) * m;
+                    for (int ii = jj; ii < rc; ++ii)
+                        target[relative[ii]] += source[ii];
+                } else {
+                    double* const target = W + static_cast<long long>(pj - ns) * r - ns;
+                    for (int ii = jj; ii < rc; ++ii)
+                        target[relative[ii]] += source[ii];
+                }
+            }
+            stack_top = child.offset;
+        }
+
+        double pivot = 0.0;
+        const int failed = partial_cholesky(L, m, ns, tiny.data() + f, pivot);
+        if (failed >= 0)
+            throw not_positive_definite(perm_[f + failed], pivot, tiny[f + failed]);
+        if (r > 0) {
+            lower_rank_update(r, ns, L + ns, m, W, r);  // W −= L21 L21ᵀ
+            double* const target = stack_values.data() + stack_top;
+            for (int c = 0; c < r; ++c)
+                std::memcpy(target + static_cast<long long>(c) * r + c, W + static_cast<long long>(c) * r + c,
+                            sizeof(double) * (r - c));
+            stack.push_back({s, stack_top});
+            stack_top += static_cast<long long>(r) * r;
+        }
+    }
+    factored_ = true;
+}
+
+void SupernodalCholesky::solve_in_place(Eigen::Ref<Eigen::MatrixXd> X) const
+{
+    if (!factored_)
+        throw Error("supernodal solve: the matrix has not been factored (or its factorization failed)");
+    if (X.rows() != n_)
+        throw Error(str("supernodal solve: the right-hand side has ", X.rows(), " rows, the matrix ", n_));
+    const int S = supernodes();
+    int largest = 0;
+    for (int s = 0; s < S; ++s)
+        largest = std::max(largest, rows(s) - (first_[s + 1] - first_[s]));
+    if (X.cols() == 1) {
+        // One right-hand side: triangular solves and matrix-vector products on plain vectors.
+        Eigen::VectorXd work(largest);
+        double* const x = X.data();
+        for (int s = 0; s < S; ++s) {  // forward: L y = b
+            const int f = first_[s], ns = first_[s + 1] - f, m = rows(s), r = m - ns;
+            const ConstBlock L(values_.data() + value_start_[s], m, ns, Eigen::OuterStride<>(m));
+            Eigen::Map<Eigen::VectorXd> xs(x + f, ns);
+            L.topRows(ns).triangularView<Eigen::Lower>().solveInPlace(xs);
+            if (r > 0) {
+                auto t = work.head(r);
+                t.noalias() = L.bottomRows(r) * xs;
+                const int* const below = rows_.data() + row_start_[s] + ns;
+                for (int i = 0; i < r; ++i)
+                    x[below[i]] -= t[i];
+            }
+        }
+        for (int s = S - 1; s >= 0; --s) {  // backward: Lᵀ x = y
+            const int f = first_[s], ns = first_[s + 1] - f, m = rows(s), r = m - ns;
+            const ConstBlock L(values_.data() + value_start_[s], m, ns, Eigen::OuterStride<>(m));
+            Eigen::Map<Eigen::VectorXd> xs(x + f, ns);
+            if (r > 0) {
+                auto t = work.head(r);
+                const int* const below = rows_.data() + row_start_[s] + ns;
+                for (int i = 0; i < r; ++i)
+                    t[i] = x[below[i]];
+                xs.noalias() -= L.bottomRows(r).transpose() * t;
+            }
+            L.topRows(ns).triangularView<Eigen::Lower>().transpose().solveInPlace(xs);
+        }
+        return;
+    }
+    Eigen::MatrixXd work(largest, X.cols());
+    for (int s = 0; s < S; ++s) {  // forward: L Y = B
+        const int f = first_[s], ns = first_[s + 1] - f, m = rows(s), r = m - ns;
+        const ConstBlock L(values_.data() + value_start_[s], m, ns, Eigen::OuterStride<>(m));
+        auto Xs = X.middleRows(f, ns);
+        L.topRows(ns).triangularView<Eigen::Lower>().solveInPlace(Xs);
+        if (r > 0) {
+            auto T = work.topRows(r);
+            T.noalias() = L.bottomRows(r) * Xs;
+            const int* const below = rows_.data() + row_start_[s] + ns;
+            for (int t = 0; t < r; ++t)
+                X.row(below[t]) -= T.row(t);
+        }
+    }
+    for (int s = S - 1; s >= 0; --s) {  // backward: Lᵀ X = Y
+        const int f = first_[s], ns = first_[s + 1] - f, m = rows(s), r = m - ns;
+        const ConstBlock L(values_.data() + value_start_[s], m, ns, Eigen::OuterStride<>(m));
+        auto Xs = X.middleRows(f, ns);
+        if (r > 0) {
+            auto T = work.topRows(r);
+            const int* const below = rows_.data() + row_start_[s] + ns;
+            for (int t = 0; t < r; ++t)
+                T.row(t) = X.row(below[t]);
+            Xs.noalias() -= L.bottomRows(r).transpose() * T;
+        }
+        L.topRows(ns).triangularView<Eigen::Lower>().transpose().solveInPlace(Xs);
+    }
+}
+
+sparse::CscMatrix SupernodalCholesky::factor() const
+{
+    if (!factored_)
+        throw Error("supernodal factor: the matrix has not been factored");
+    sparse::CscMatrix L;
+    L.rows = L.cols = n_;
+    L.IA.assign(n_ + 1, 0);
+    for (int s = 0; s < supernodes(); ++s) {
+        const int f = first_[s], ns = first_[s + 1] - f, m = rows(s);
+        const double* const block = values_.data() + value_start_[s];
+        const int* const row = rows_.data() + row_start_[s];
+        for (int c = 0; c < ns; ++c) {
+            for (int t = c; t < m; ++t) {
+                const double value = block[static_cast<long long>(c) * m + t];
+                if (value != 0.0) {
+                    L.JA.push_back(row[t]);
+                    L.A.push_back(value);
+                }
+            }
+            L.IA[f + c + 1] = static_cast<int>(L.A.size());
+        }
+    }
+    return L;
+}
+
+}  // namespace fem::direct

@@ -1,0 +1,321 @@
+// Chapter 09: the solvers of the course behind one interface.
+// docs/09_conjugate_gradient.md#one-interface-for-every-solver
+#include "09_conjugate_gradient/linear_solver.hpp"
+
+#include "09_conjugate_gradient/linear_operator.hpp"
+#include "09_conjugate_gradient/preconditioners.hpp"
+
+#include "07_sparse_storage/sparse_formats.hpp"
+#include "08_direct_solvers/sparse_cholesky.hpp"
+#include "common/error.hpp"
+#include "common/timer.hpp"
+
+#include <Eigen/IterativeLinearSolvers>
+#include <Eigen/SparseCholesky>
+#ifdef FEM_HAVE_CHOLMOD
+#include <Eigen/CholmodSupport>
+
+#include <dlfcn.h>
+#endif
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <type_traits>
+
+namespace fem::cg {
+namespace {
+
+using SparseMatrix = Eigen::SparseMatrix<double>;
+
+void check_matrix(const SparseMatrix& A)
+{
+    if (A.rows() == 0 || A.rows() != A.cols())
+        throw Error(str("LinearSolver::prepare: the matrix is ", A.rows(), "×", A.cols(),
+                        "; it must be square and not empty"));
+    double largest = 0.0;
+    for (Eigen::Index j = 0; j < A.outerSize(); ++j)
+        for (SparseMatrix::InnerIterator it(A, j); it; ++it) {
+            if (!std::isfinite(it.value()))
+                throw Error(str("LinearSolver::prepare: A(", it.row(), ", ", it.col(), ") = ", it.value(),
+                                " is not finite"));
+            largest = std::max(largest, std::abs(it.value()));
+        }
+    const SparseMatrix difference = SparseMatrix(A.transpose()) - A;
+    for (Eigen::Index j = 0; j < difference.outerSize(); ++j)
+        for (SparseMatrix::InnerIterator it(difference, j); it; ++it)
+            if (std::abs(it.value()) > symmetry_tolerance * largest)
+                throw Error(str("LinearSolver::prepare: A is not symmetric: A(", it.col(), ", ", it.row(), ") − A(",
+                                it.row(), ", ", it.col(), ") = ", -it.value(), " (allowed: ", symmetry_tolerance,
+                                " × max |A_ij| = ", symmetry_tolerance * largest,
+                                "); the solvers of this interface need a symmetric positive definite A"));
+}
+
+bool same_pattern(const SparseMatrix& a, const SparseMatrix& b)
+{
+    if (a.rows() != b.rows() || a.cols() != b.cols() || a.nonZeros() != b.nonZeros())
+        return false;
+    const auto outer = a.outerSize() + 1;
+    return std::equal(a.outerIndexPtr(), a.outerIndexPtr() + outer, b.outerIndexPtr()) &&
+           std::equal(a.innerIndexPtr(), a.innerIndexPtr() + a.nonZeros(), b.innerIndexPtr());
+}
+
+/// CG iterations that missed the tolerance are an error here: the interface promises a solution.
+void require_converged(const std::string& name, int iterations, double reached, double tolerance, bool converged)
+{
+    if (!converged)
+        throw Error(str(name, ": did not reach the relative residual ", tolerance, " within ", iterations,
+                        " iterations (reached ", reached, "); raise the iteration cap, loosen the tolerance, or "
+                        "use a better preconditioner or a direct solver"));
+}
+
+// --- our solvers -------------------------------------------------------------------------------
+
+class OursCholesky final : public LinearSolver {
+public:
+    OursCholesky() : LinearSolver("ours-cholesky") {}
+    bool is_direct() const override { return true; }
+
+private:
+    void do_prepare(const SparseMatrix& A, bool same) override
+    {
+        if (same && factor_)
+            factor_->factorize(sparse::csc_from_eigen(A));
+        else
+            factor_.emplace(A);
+    }
+    int do_solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) override
+    {
+        x = factor_->solve(b);
+        return 0;
+    }
+    std::optional<direct::SparseCholesky> factor_;
+};
+
+/// ours-cg, ours-pcg-jacobi and ours-pcg-ic0: the operator is A's lower triangle.
+class OursCg final : public LinearSolver {
+public:
+    enum class Kind { plain, jacobi, ic0 };
+    OursCg(std::string name, Kind kind, const SolverOptions& options)
+        : LinearSolver(std::move(name)), kind_(kind)
+    {
+        settings_.relative_tolerance = options.relative_tolerance;
+        settings_.max_iterations = options.max_iterations;
+    }
+    bool is_direct() const override { return false; }
+
+private:
+    void do_prepare(const SparseMatrix& A, bool) override
+    {
+        preconditioner_.reset();
+        const sparse::CsrMatrix csr = sparse::csr_from_eigen(A);
+        operator_.emplace(csr);
+        if (kind_ == Kind::jacobi)
+            preconditioner_ = std::make_unique<JacobiPreconditioner>(diagonal(csr));
+        else if (kind_ == Kind::ic0)
+            preconditioner_ = std::make_unique<IncompleteCholesky>(csr);
+    }
+    int do_solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) override
+    {
+        const CgResult result = preconditioner_
+                                    ? preconditioned_conjugate_gradient(*operator_, *preconditioner_, b, x, settings_)
+                                    : conjugate_gradient(*operator_, b, x, settings_);
+        require_converged(name(), result.iterations, result.residual_history.back(), settings_.relative_tolerance,
+                          result.converged);
+        return result.iterations;
+    }
+    Kind kind_;
+    CgSettings settings_;
+    std::optional<SymmetricCsrOperator> operator_;
+    std::unique_ptr<LinearOperator> preconditioner_;
+};
+
+// --- references --------------------------------------------------------------------------------
+
+/// Eigen::SimplicialLLT, and CHOLMOD's supernodal LLT through Eigen: the same calls.
+template <typename Factorization>
+class EigenDirect final : public LinearSolver {
+public:
+    explicit EigenDirect(std::string name) : LinearSolver(std::move(name))
+    {
+#ifdef FEM_HAVE_CHOLMOD
+        if constexpr (std::is_same_v<Factorization, Eigen::CholmodSupernodalLLT<SparseMatrix>>)
+            factor_.cholmod().print = 0;  // failures become fem::Error, not CHOLMOD's own messages
+#endif
+    }
+    bool is_direct() const override { return true; }
+
+private:
+    void do_prepare(const SparseMatrix& A, bool same) override
+    {
+        if (!same || !analysed_) {
+            factor_.analyzePattern(A);
+            analysed_ = true;
+        }
+        factor_.factorize(A);
+        if (factor_.info() != Eigen::Success)
+            throw Error(str(name(), ": the Cholesky factorization failed: the matrix is not positive definite"));
+    }
+    int do_solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) override
+    {
+        x = factor_.solve(b);
+        if (factor_.info() != Eigen::Success)
+            throw Error(str(name(), ": the triangular solves failed"));
+        return 0;
+    }
+    Factorization factor_;
+    bool analysed_ = false;
+};
+
+class EigenCg final : public LinearSolver {
+public:
+    explicit EigenCg(const SolverOptions& options) : LinearSolver("eigen-cg"), options_(options) {}
+    bool is_direct() const override { return false; }
+
+private:
+    void do_prepare(const SparseMatrix& A, bool) override
+    {
+        cg_.setTolerance(options_.relative_tolerance);
+        if (options_.max_iterations > 0)
+            cg_.setMaxIterations(options_.max_iterations);
+        else
+            cg_.setMaxIterations(iteration_cap_per_unknown * A.rows());
+        cg_.compute(A);
+    }
+    int do_solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) override
+    {
+        x = cg_.solveWithGuess(b, x);
+        require_converged(name(), static_cast<int>(cg_.iterations()), cg_.error(), options_.relative_tolerance,
+                          cg_.info() == Eigen::Success);
+        return static_cast<int>(cg_.iterations());
+    }
+    SolverOptions options_;
+    Eigen::ConjugateGradient<SparseMatrix> cg_;
+};
+
+const std::vector<std::string>& all_names()
+{
+    static const std::vector<std::string> names{"ours-cholesky", "ours-cg",   "ours-pcg-jacobi", "ours-pcg-ic0",
+                                                "eigen-llt",     "eigen-cg",  "cholmod"};
+    return names;
+}
+
+}  // namespace
+
+void LinearSolver::prepare(const Eigen::SparseMatrix<double>& A)
+{
+    check_matrix(A);
+    const bool same = A_.rows() > 0 && same_pattern(A, A_);
+    // The solver keeps its own copy: Eigen's iterative solvers hold a reference to their matrix,
+    // and the residual check needs it too. After a failed prepare the solver is unprepared.
+    A_ = A;
+    A_.makeCompressed();
+    stats_ = SolveStats{};
+    Timer timer;
+    try {
+        do_prepare(A_, same);
+    } catch (...) {
+        A_ = Eigen::SparseMatrix<double>();
+        throw;
+    }
+    stats_.prepare_seconds = timer.seconds();
+}
+
+Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& b)
+{
+    Eigen::VectorXd x;
+    solve(b, x);
+    return x;
+}
+
+void LinearSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x)
+{
+    if (A_.rows() == 0)
+        throw Error(str(name_, ": solve() before prepare(); give the solver its matrix first"));
+    if (b.size() != A_.rows())
+        throw Error(str(name_, ": b has ", b.size(), " entries, the matrix is ", A_.rows(), "×", A_.cols()));
+    if (!b.allFinite())
+        throw Error(str(name_, ": b has a non-finite entry"));
+    if (x.size() != A_.rows() || !x.allFinite())
+        x = Eigen::VectorXd::Zero(A_.rows());
+    Timer timer;
+    stats_.iterations = do_solve(b, x);
+    stats_.solve_seconds = timer.seconds();
+    const double b_norm = b.norm();
+    stats_.relative_residual = b_norm > 0.0 ? (b - A_ * x).norm() / b_norm : x.norm();
+}
+
+std::unique_ptr<LinearSolver> make_solver(std::string_view name, const SolverOptions& options)
+{
+    if (!(options.relative_tolerance > 0.0 && options.relative_tolerance < 1.0))
+        throw Error(str("make_solver: the relative tolerance must lie in (0, 1), got ", options.relative_tolerance));
+    if (options.max_iterations < 0)
+        throw Error(str("make_solver: the iteration cap must be ≥ 0 (0: the default), got ", options.max_iterations));
+    const std::string resolved = name == "default" ? default_solver_name() : std::string(name);
+    if (resolved == "ours-cholesky")
+        return std::make_unique<OursCholesky>();
+    if (resolved == "ours-cg")
+        return std::make_unique<OursCg>(resolved, OursCg::Kind::plain, options);
+    if (resolved == "ours-pcg-jacobi")
+        return std::make_unique<OursCg>(resolved, OursCg::Kind::jacobi, options);
+    if (resolved == "ours-pcg-ic0")
+        return std::make_unique<OursCg>(resolved, OursCg::Kind::ic0, options);
+    if (resolved == "eigen-llt")
+        return std::make_unique<EigenDirect<Eigen::SimplicialLLT<SparseMatrix>>>(resolved);
+    if (resolved == "eigen-cg")
+        return std::make_unique<EigenCg>(options);
+    if (resolved == "cholmod") {
+#ifdef FEM_HAVE_CHOLMOD
+        return std::make_unique<EigenDirect<Eigen::CholmodSupernodalLLT<SparseMatrix>>>(resolved);
+#else
+        throw Error("make_solver: this build has no CHOLMOD (install SuiteSparse, Debian: libsuitesparse-dev, "
+                    "and configure again)");
+#endif
+    }
+    std::string valid = "default";
+    for (const std::string& known : solver_names())
+        valid += ", " + known;
+    throw Error(str("make_solver: unknown solver '", name, "'; this build has: ", valid));
+}
+
+std::vector<std::string> solver_names()
+{
+    std::vector<std::string> names;
+    for (const std::string& name : all_names())
+        if (name != "cholmod" || cholmod_available())
+            names.push_back(name);
+    return names;
+}
+
+std::string default_solver_name()
+{
+    // Measured in ch09_conjugate_gradient (docs/09_conjugate_gradient.md#which-solver-by-default):
+    // the fastest direct solver on one core up to ~10⁴ unknowns, in every build.
+    return "ours-cholesky";
+}
+
+bool cholmod_available()
+{
+#ifdef FEM_HAVE_CHOLMOD
+    return true;
+#else
+    return false;
+#endif
+}
+
+bool set_blas_threads(int threads)
+{
+    if (threads < 1)
+        throw Error(str("set_blas_threads: needs at least 1 thread, got ", threads));
+#ifdef FEM_HAVE_CHOLMOD
+    // OpenBLAS's switch, looked up at run time: another BLAS simply does not have it.
+    using SetThreads = void (*)(int);
+    if (void* symbol = dlsym(RTLD_DEFAULT, "openblas_set_num_threads")) {
+        reinterpret_cast<SetThreads>(symbol)(threads);
+        return true;
+    }
+#endif
+    return false;
+}
+
+}  // namespace fem::cg

@@ -1,0 +1,169 @@
+// Chapter 09: the solver interface. Every solver by name against a dense solve, the default, the
+// errors (unknown name, bad matrices, indefinite A, a missed tolerance), warm starts and
+// refactorisation with the same pattern. docs/09_conjugate_gradient.md#one-interface-for-every-solver
+#include "09_conjugate_gradient/linear_solver.hpp"
+#include "09_conjugate_gradient/model_problems.hpp"
+
+#include "cg_test_support.hpp"
+
+#include "07_sparse_storage/sparse_formats.hpp"
+#include "08_direct_solvers/model_problems.hpp"
+#include "common/error.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+using namespace fem::cg;
+using fem::cg::test::random_vector;
+using fem::cg::test::spd_with_spectrum;
+using Catch::Matchers::Contains;
+
+namespace {
+
+double relative_error(const Eigen::VectorXd& x, const Eigen::VectorXd& reference)
+{
+    return (x - reference).norm() / reference.norm();
+}
+
+bool listed(const std::string& name)
+{
+    const std::vector<std::string> names = solver_names();
+    return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+}  // namespace
+
+TEST_CASE("every solver of the interface solves the elastic box and a Laplacian", "[solvers]")
+{
+    const ElasticBox box = clamped_box(4, fem::elastic::lame_parameters(1e5, 0.45), 1000.0);
+    const Eigen::SparseMatrix<double> laplacian = fem::sparse::to_eigen(fem::direct::laplacian_3d(7));
+    SolverOptions options;
+    options.relative_tolerance = 1e-10;
+    for (const auto& [A, b] : {std::pair{box.K, box.f}, std::pair{laplacian, random_vector(laplacian.rows(), 2u)}}) {
+        const Eigen::VectorXd reference = Eigen::MatrixXd(A).llt().solve(b);
+        for (const std::string& name : solver_names()) {
+            CAPTURE(name);
+            const std::unique_ptr<LinearSolver> solver = make_solver(name, options);
+            CHECK(solver->name() == name);
+            solver->prepare(A);
+            CHECK(solver->size() == A.rows());
+            const Eigen::VectorXd x = solver->solve(b);
+            CHECK(relative_error(x, reference) <= 1e-6);  // κ ≈ 10⁴ times τ
+            const SolveStats& stats = solver->stats();
+            if (solver->is_direct()) {
+                CHECK(stats.iterations == 0);
+                CHECK(stats.relative_residual <= 1e-12);
+            } else {
+                CHECK(stats.iterations > 0);
+                CHECK(stats.relative_residual <= 2e-10);
+            }
+            CHECK(stats.prepare_seconds >= 0.0);
+            CHECK(stats.solve_seconds >= 0.0);
+        }
+    }
+}
+
+TEST_CASE("the solver names, the default and CHOLMOD", "[solvers]")
+{
+    for (const char* name : {"ours-cholesky", "ours-cg", "ours-pcg-jacobi", "ours-pcg-ic0", "eigen-llt", "eigen-cg"})
+        CHECK(listed(name));
+    CHECK(listed("cholmod") == cholmod_available());
+    CHECK(listed(default_solver_name()));
+    CHECK(make_solver()->name() == default_solver_name());
+    CHECK(make_solver("default")->name() == default_solver_name());
+    CHECK_THROWS_WITH(make_solver("superlu"), Contains("unknown solver 'superlu'") && Contains("ours-pcg-ic0"));
+    if (!cholmod_available())
+        CHECK_THROWS_WITH(make_solver("cholmod"), Contains("no CHOLMOD"));
+    SolverOptions bad;
+    bad.relative_tolerance = 2.0;
+    CHECK_THROWS_AS(make_solver("ours-cg", bad), fem::Error);
+}
+
+TEST_CASE("every solver refuses an indefinite matrix with fem::Error", "[solvers]")
+{
+    const Eigen::MatrixXd dense = spd_with_spectrum((Eigen::VectorXd(6) << -1, 1, 2, 3, 4, 5).finished(), 3u);
+    const Eigen::SparseMatrix<double> A = dense.sparseView();
+    const Eigen::VectorXd b = random_vector(6, 4u);
+    for (const std::string& name : solver_names()) {
+        CAPTURE(name);
+        if (name == "eigen-cg")
+            continue;  // Eigen's CG does not check pᵀAp (CG may still succeed on an indefinite A)
+        const std::unique_ptr<LinearSolver> solver = make_solver(name);
+        // A direct solver finds out when it factors, an iterative one when it iterates.
+        CHECK_THROWS_AS(
+            [&] {
+                solver->prepare(A);
+                solver->solve(b);
+            }(),
+            fem::Error);
+    }
+}
+
+TEST_CASE("prepare checks the matrix, solve checks b", "[solvers]")
+{
+    const std::unique_ptr<LinearSolver> solver = make_solver("ours-cg");
+    CHECK_THROWS_WITH(solver->solve(Eigen::VectorXd::Ones(3)), Contains("before prepare"));
+    CHECK_THROWS_WITH(solver->prepare(Eigen::SparseMatrix<double>(3, 4)), Contains("square"));
+    Eigen::MatrixXd unsymmetric = Eigen::MatrixXd::Identity(3, 3);
+    unsymmetric(0, 2) = 0.5;
+    CHECK_THROWS_WITH(solver->prepare(unsymmetric.sparseView()), Contains("not symmetric"));
+    Eigen::MatrixXd not_finite = Eigen::MatrixXd::Identity(3, 3);
+    not_finite(1, 1) = std::nan("");
+    CHECK_THROWS_WITH(solver->prepare(not_finite.sparseView()), Contains("not finite"));
+    solver->prepare(Eigen::MatrixXd::Identity(3, 3).sparseView());
+    CHECK_THROWS_WITH(solver->solve(Eigen::VectorXd::Ones(4)), Contains("b has 4 entries"));
+}
+
+TEST_CASE("an iterative solver that misses its tolerance says so", "[solvers]")
+{
+    SolverOptions options;
+    options.max_iterations = 3;
+    const Eigen::SparseMatrix<double> A = fem::sparse::to_eigen(fem::direct::laplacian_2d(20));
+    for (const char* name : {"ours-cg", "ours-pcg-jacobi", "ours-pcg-ic0", "eigen-cg"}) {
+        CAPTURE(name);
+        const std::unique_ptr<LinearSolver> solver = make_solver(name, options);
+        solver->prepare(A);
+        CHECK_THROWS_WITH(solver->solve(Eigen::VectorXd::Ones(A.rows())), Contains("did not reach"));
+    }
+}
+
+TEST_CASE("a warm start from the last solution costs an iterative solver nothing", "[solvers]")
+{
+    const Eigen::SparseMatrix<double> A = fem::sparse::to_eigen(fem::direct::laplacian_2d(30));
+    const Eigen::VectorXd b = random_vector(A.rows(), 6u);
+    for (const char* name : {"ours-cg", "ours-pcg-jacobi", "ours-pcg-ic0", "eigen-cg"}) {
+        CAPTURE(name);
+        const std::unique_ptr<LinearSolver> solver = make_solver(name);
+        solver->prepare(A);
+        Eigen::VectorXd x;
+        solver->solve(b, x);
+        const int cold = solver->stats().iterations;
+        solver->solve(b, x);
+        CHECK(solver->stats().iterations <= 1);  // the true residual may sit a hair above τ
+        // A slightly different right-hand side (the next time step): fewer iterations than cold.
+        solver->solve(b + 1e-3 * random_vector(A.rows(), 7u), x);
+        CHECK(solver->stats().iterations < cold);
+    }
+}
+
+TEST_CASE("prepare again with new values on the same pattern", "[solvers]")
+{
+    const ElasticBox box = clamped_box(3, fem::elastic::lame_parameters(1e5, 0.3), 1000.0);
+    const Eigen::SparseMatrix<double> stiffer = 2.0 * box.K;
+    SolverOptions options;
+    options.relative_tolerance = 1e-12;
+    for (const std::string& name : solver_names()) {
+        CAPTURE(name);
+        const std::unique_ptr<LinearSolver> solver = make_solver(name, options);
+        solver->prepare(box.K);
+        const Eigen::VectorXd x = solver->solve(box.f);
+        solver->prepare(stiffer);  // same pattern: a direct solver reuses its analysis
+        const Eigen::VectorXd half = solver->solve(box.f);
+        CHECK(relative_error(half, 0.5 * x) <= 1e-8);
+        solver->prepare(fem::sparse::to_eigen(fem::direct::laplacian_2d(6)));  // a new pattern and size
+        CHECK(solver->size() == 36);
+        CHECK(solver->solve(Eigen::VectorXd::Ones(36)).allFinite());
+    }
+}
