@@ -79,6 +79,12 @@ Eigen::VectorXd cholesky_solve(const Eigen::MatrixXd& L, const Eigen::VectorXd& 
 /// docs/08_direct_solvers.md#ill-conditioning-the-hilbert-matrix
 Eigen::MatrixXd hilbert_matrix(int n);
 
+/// b = H (1, …, 1)ᵀ for the n×n Hilbert matrix, b_i = Σ_j 1 / (i + j + 1), summed in long double
+/// and rounded once: a right-hand side whose exact solution is x = (1, …, 1) up to b's own
+/// rounding, so the error of a computed x measures the solver alone. fem::Error unless
+/// 1 ≤ n ≤ 1000. docs/08_direct_solvers.md#ill-conditioning-the-hilbert-matrix
+Eigen::VectorXd hilbert_row_sums(int n);
+
 /// The exact 1-norm condition number κ₁(H) = ‖H‖₁ ‖H⁻¹‖₁ of the n×n Hilbert matrix, from the
 /// closed form of its inverse, (H⁻¹)_ij = (−1)^{i+j} (i+j+1) C(n+i, n−j−1) C(n+j, n−i−1) C(i+j, i)²
 /// (0-based), evaluated in long double. fem::Error unless 1 ≤ n ≤ 20.

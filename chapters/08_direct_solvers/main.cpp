@@ -217,13 +217,7 @@ void hilbert_study(const RunContext& run)
     const auto cell = [](double value) { return str(std::scientific, std::setprecision(3), value); };
     for (int n = 2; n <= 14; ++n) {
         const Eigen::MatrixXd H = hilbert_matrix(n);
-        Eigen::VectorXd b(n);
-        for (int i = 0; i < n; ++i) {
-            long double sum = 0.0L;
-            for (int j = 0; j < n; ++j)
-                sum += 1.0L / (i + j + 1);
-            b[i] = static_cast<double>(sum);
-        }
+        const Eigen::VectorXd b = hilbert_row_sums(n);
         const double kappa = hilbert_condition_number(n);
         const Eigen::PartialPivLU<Eigen::MatrixXd> eigen_lu(H);
         const double eigen_error = (eigen_lu.solve(b).array() - 1.0).abs().maxCoeff();
@@ -634,7 +628,8 @@ void goals_table(const RunContext& run, const std::vector<SpeedRecord>& records)
     table.write_csv(run.file("goals_table.csv"));
 
     // Charts over all matrices: factor time against flops (the slope is the rate), solve time
-    // against nnz(L) (a solve reads L twice).
+    // against nnz(L) (a solve reads L twice). One point per matrix, as markers: a line joining
+    // different matrices would suggest a trend between them that is not there.
     fig::LineChart factor{"Numeric factorization: time against flops, all matrices", "flops of the factorization",
                           "factor time [s]", true, true, {}};
     fig::LineChart solve{"Solve (one right-hand side): time against nnz(L), all matrices", "nnz(L)",
@@ -653,7 +648,7 @@ void goals_table(const RunContext& run, const std::vector<SpeedRecord>& records)
     }
     const auto series = [](const std::string& name, std::vector<std::pair<double, double>> points) {
         std::sort(points.begin(), points.end());
-        fig::Series line{name, {}, {}};
+        fig::Series line{name, {}, {}, true};
         for (const auto& [x, y] : points) {
             line.x.push_back(x);
             line.y.push_back(y);

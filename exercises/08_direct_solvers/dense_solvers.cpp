@@ -172,6 +172,20 @@ Eigen::MatrixXd hilbert_matrix(int n)
     return H;
 }
 
+Eigen::VectorXd hilbert_row_sums(int n)
+{
+    if (n < 1 || n > 1000)
+        throw Error(str("hilbert_row_sums: n = ", n, "; allowed 1 ≤ n ≤ 1000"));
+    Eigen::VectorXd b(n);
+    for (int i = 0; i < n; ++i) {
+        long double sum = 0.0L;
+        for (int j = 0; j < n; ++j)
+            sum += 1.0L / (i + j + 1);
+        b[i] = static_cast<double>(sum);
+    }
+    return b;
+}
+
 double hilbert_condition_number(int n)
 {
     if (n < 1 || n > 20)

@@ -258,13 +258,7 @@ TEST_CASE("Hilbert matrices n = 4 … 14: the LU error grows with κ and stays b
     double error_4 = 0.0, error_12 = 0.0;
     for (int n = 4; n <= 14; ++n) {
         const Eigen::MatrixXd H = hilbert_matrix(n);
-        Eigen::VectorXd b(n);
-        for (int i = 0; i < n; ++i) {
-            long double sum = 0.0L;
-            for (int j = 0; j < n; ++j)
-                sum += 1.0L / (i + j + 1);
-            b[i] = static_cast<double>(sum);
-        }
+        const Eigen::VectorXd b = hilbert_row_sums(n);
         const double kappa = hilbert_condition_number(n);
         INFO("n = " << n << ", kappa = " << kappa);
         if (n == 14) {
