@@ -182,7 +182,8 @@ bool render_dataset(const std::filesystem::path& path, vtkDataSet* data, bool ce
     title->SetInput(options.title.c_str());
     title->GetTextProperty()->SetFontSize(22);
     title->GetTextProperty()->SetColor(0.1, 0.1, 0.1);
-    title->SetPosition(20, options.height - 40);
+    title->GetTextProperty()->SetVerticalJustificationToTop();  // a title of several lines grows downwards
+    title->SetPosition(20, options.height - 14);
 
     vtkNew<vtkRenderer> renderer;
     renderer->AddActor(actor);

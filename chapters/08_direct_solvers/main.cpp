@@ -372,7 +372,8 @@ void pattern_figure(const RunContext& run)
     io::ImageGrid image;
     image.dims = {side, side, 1};
     Eigen::MatrixXd value = Eigen::MatrixXd::Constant(Eigen::Index(side) * side, 1, 0.5);  // the gaps
-    std::string title = str("L, ", grid, "x", grid, " grid (teal: A, yellow: fill), nnz(L):");
+    std::string title =
+        str("L of a ", grid, "x", grid, " grid Laplacian (teal: A, yellow: fill), nnz(L) of each order\n");
     for (int panel = 0; panel < 4; ++panel) {
         const SparseCholesky chol(A, {shown[panel], Factorization::up_looking});
         const sparse::CscMatrix L = chol.factor();
@@ -389,8 +390,9 @@ void pattern_figure(const RunContext& run)
         for (int i = 0; i < n; ++i)
             for (int j = 0; j < n; ++j)  // row i at the top of its panel
                 value(x0 + j + Eigen::Index(side) * (side - 1 - (y0 + i)), 0) = cells(i, j);
-        const char* const short_names[] = {"natural", "RCM", "MD", "ND"};
-        title += str(" ", short_names[panel], " ", L.nonzeros(), panel < 3 ? "," : "");
+        const char* const short_names[] = {"natural", "RCM", "minimum degree", "nested dissection"};
+        const char* const prefixes[] = {"top: ", ", ", "; bottom: ", ", "};
+        title += str(prefixes[panel], short_names[panel], " ", L.nonzeros());
     }
     image.point_data = {{"entry", value}};
     io::write_vti(run.file("factor_patterns.vti"), image);
