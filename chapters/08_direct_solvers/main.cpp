@@ -31,6 +31,7 @@
 #include "common/table.hpp"
 #include "common/timer.hpp"
 #include "common/vtk_io.hpp"
+#include "common/random.hpp"
 
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
@@ -48,7 +49,6 @@
 #include <map>
 #include <optional>
 #include <iomanip>
-#include <random>
 
 using namespace fem;
 using namespace fem::direct;
@@ -62,17 +62,6 @@ struct Settings {
 
 const elastic::Lame rubber = elastic::lame_parameters(1e5, 0.45);
 const double eps = std::numeric_limits<double>::epsilon();
-
-Eigen::MatrixXd random_matrix(int rows, int cols, unsigned seed)
-{
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-    Eigen::MatrixXd M(rows, cols);
-    for (int j = 0; j < cols; ++j)
-        for (int i = 0; i < rows; ++i)
-            M(i, j) = uniform(rng);
-    return M;
-}
 
 /// Best of a few calls for short work, one call for long work.
 template <typename Work>
@@ -159,7 +148,7 @@ void dense_study(const RunContext& run)
         const Eigen::MatrixXd A = random_matrix(n, n, 1 + n) + 2.0 * std::sqrt(double(n)) * Eigen::MatrixXd::Identity(n, n);
         const Eigen::MatrixXd B = random_matrix(n, n, 2 + n);
         const Eigen::MatrixXd S = B * B.transpose() / n + Eigen::MatrixXd::Identity(n, n);
-        const Eigen::VectorXd b = random_matrix(n, 1, 3 + n);
+        const Eigen::VectorXd b = random_vector(n, 3 + n);
         const double lu_flops = 2.0 / 3.0 * n * double(n) * n, llt_flops = lu_flops / 2.0;
         const auto add = [&](const std::string& name, double flops, double factor, double solve,
                              const Eigen::MatrixXd& M, const Eigen::VectorXd& x) {
@@ -537,7 +526,7 @@ std::vector<SpeedRecord> speed_study(const RunContext& run, const Settings& sett
             if (family_unknowns(family, size) > settings.max_unknowns)
                 continue;
             const Problem p = make_problem(family, size);
-            const Eigen::VectorXd x_ref = random_matrix(p.A.rows, 1, 7);
+            const Eigen::VectorXd x_ref = random_vector(p.A.rows, 7);
             const Eigen::VectorXd b = p.E * x_ref;
             std::vector<Measured> rows;
             const CholeskyOptions fast{Ordering::nested_dissection, Factorization::supernodal};

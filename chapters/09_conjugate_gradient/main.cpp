@@ -45,6 +45,7 @@
 #include "common/table.hpp"
 #include "common/timer.hpp"
 #include "common/vtk_io.hpp"
+#include "common/random.hpp"
 
 #include <Eigen/IterativeLinearSolvers>
 
@@ -53,7 +54,6 @@
 #include <iostream>
 #include <map>
 #include <memory>
-#include <random>
 #include <sstream>
 #include <tuple>
 
@@ -182,11 +182,7 @@ void conditioning_study(const RunContext& run)
             const EigenOperator A(sparse::to_eigen(dimension == 2 ? direct::laplacian_2d(n) : direct::laplacian_3d(n)));
             // A random right-hand side has every eigenvector in it (b = 1 would miss the modes that
             // are odd about the centre, and run into CG's finite termination on small grids).
-            std::mt19937 rng(5);
-            std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-            Eigen::VectorXd b(A.size());
-            for (Eigen::Index i = 0; i < b.size(); ++i)
-                b[i] = uniform(rng);
+            const Eigen::VectorXd b = random_vector(A.size(), 5);
             CgSettings settings;
             settings.relative_tolerance = tau;
             Eigen::VectorXd x;
@@ -234,11 +230,7 @@ void operator_study(const RunContext& run, const Settings& settings)
             operators.emplace_back("matrix-free 5-point stencil (ch02)",
                                    std::make_unique<FunctionOperator>(stencil_operator(grid)));
         }
-        std::mt19937 rng(1);
-        std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-        Eigen::VectorXd x(p.A.rows());
-        for (Eigen::Index i = 0; i < x.size(); ++i)
-            x[i] = uniform(rng);
+        const Eigen::VectorXd x = random_vector(p.A.rows(), 1);
         Eigen::VectorXd reference;
         operators.front().second->apply(x, reference);
         for (const auto& [name, op] : operators) {
@@ -782,11 +774,7 @@ void error_snapshots(const RunContext& run)
     const Eigen::VectorXd solution = heat::sample(grid, [](double x, double y) { return x * (1 - x) * y * y * (1 - y); });
     Eigen::VectorXd b;
     A.apply(solution, b);
-    std::mt19937 rng(2);
-    std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-    Eigen::VectorXd start = solution;
-    for (Eigen::Index i = 0; i < start.size(); ++i)
-        start[i] += 0.02 * uniform(rng);
+    Eigen::VectorXd start = solution + 0.02 * random_vector(solution.size(), 2);  // CG overwrites it
     const std::vector<int> snapshots{0, 5, 30};
     std::vector<Eigen::VectorXd> errors;
     CgSettings settings;

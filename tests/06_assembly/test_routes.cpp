@@ -7,15 +7,15 @@
 
 #include "common/error.hpp"
 #include "common/mesh.hpp"
+#include "common/random.hpp"
 
 #include <catch2/catch.hpp>
 
 #include <Eigen/Eigenvalues>
 
-#include <random>
-
 using namespace fem::assembly;
 using fem::TetMesh;
+using fem::random_vector;
 using fem::test::dense_assembly;
 using fem::test::distorted_mesh;
 using fem::test::relative_difference;
@@ -25,16 +25,6 @@ namespace {
 
 Eigen::MatrixXd dense(const SparseMatrix& A) { return Eigen::MatrixXd(A); }
 Eigen::MatrixXd dense(const CsrMatrix& A) { return Eigen::MatrixXd(A); }
-
-Eigen::VectorXd random_vector(Eigen::Index size, unsigned seed)
-{
-    std::mt19937 random(seed);
-    std::uniform_real_distribution<double> u(-1.0, 1.0);
-    Eigen::VectorXd x(size);
-    for (Eigen::Index i = 0; i < size; ++i)
-        x[i] = u(random);
-    return x;
-}
 
 // Meshes with each kind of bad index.
 TetMesh with_index(int t, int corner, int value)

@@ -4,28 +4,18 @@
 #include "07_sparse_storage/sparse_products.hpp"
 
 #include "common/error.hpp"
+#include "common/random.hpp"
 
 #include "sparse_test_support.hpp"
 
 #include <catch2/catch.hpp>
 
-#include <random>
-
 using namespace fem::sparse;
 using namespace fem::sparse::test;
 using Catch::Matchers::Contains;
+using fem::random_vector;
 
 namespace {
-
-Eigen::VectorXd random_vector(Eigen::Index n, unsigned seed)
-{
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> value(-1.0, 1.0);
-    Eigen::VectorXd x(n);
-    for (Eigen::Index i = 0; i < n; ++i)
-        x[i] = value(rng);
-    return x;
-}
 
 /// Random test matrices: rectangular, with empty rows and columns and rows of every length from
 /// 0 to beyond 8 (the kernels may unroll), and a few special shapes.

@@ -5,6 +5,7 @@
 #include "07_sparse_storage/sparse_formats.hpp"
 
 #include "common/error.hpp"
+#include "common/random.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/SparseCholesky>
@@ -31,33 +32,10 @@ std::string fem_error_message(Work&& work)
     return "";
 }
 
-/// An n×n matrix with entries uniform in [−1, 1].
-inline Eigen::MatrixXd random_matrix(int n, unsigned seed)
-{
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-    Eigen::MatrixXd A(n, n);
-    for (int j = 0; j < n; ++j)
-        for (int i = 0; i < n; ++i)
-            A(i, j) = uniform(rng);
-    return A;
-}
-
-/// A vector with entries uniform in [−1, 1].
-inline Eigen::VectorXd random_vector(int n, unsigned seed)
-{
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-    Eigen::VectorXd v(n);
-    for (int i = 0; i < n; ++i)
-        v[i] = uniform(rng);
-    return v;
-}
-
 /// A well-conditioned symmetric positive definite matrix B Bᵀ / n + I.
 inline Eigen::MatrixXd random_spd(int n, unsigned seed)
 {
-    const Eigen::MatrixXd B = random_matrix(n, seed);
+    const Eigen::MatrixXd B = random_matrix(n, n, seed);
     return B * B.transpose() / n + Eigen::MatrixXd::Identity(n, n);
 }
 

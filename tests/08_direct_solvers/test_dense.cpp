@@ -14,9 +14,9 @@
 #include <limits>
 
 using namespace fem::direct;
-using fem::direct::test::random_matrix;
+using fem::random_matrix;
 using fem::direct::test::random_spd;
-using fem::direct::test::random_vector;
+using fem::random_vector;
 using Catch::Matchers::Contains;
 using fem::direct::test::fem_error_message;
 
@@ -35,7 +35,7 @@ double relative_residual(const Eigen::MatrixXd& A, const Eigen::VectorXd& x, con
 TEST_CASE("LU: P A = L U reconstructs A, with unit lower L, |multipliers| ≤ 1 and upper U", "[ex08.1]")
 {
     for (int n : {1, 2, 5, 30, 100}) {
-        const Eigen::MatrixXd A = random_matrix(n, 10 + n);
+        const Eigen::MatrixXd A = random_matrix(n, n, 10 + n);
         const LuFactorization F = lu_factor(A);
         REQUIRE(F.size() == n);
         const Eigen::MatrixXd L = F.L(), U = F.U(), P = F.P();
@@ -82,7 +82,7 @@ TEST_CASE("LU: residual below 1e-12 on well-conditioned non-symmetric systems, a
           "[ex08.1][ex08.2][ex08.3]")
 {
     for (int n : {3, 20, 80, 200}) {
-        const Eigen::MatrixXd A = random_matrix(n, 100 + n) + 2.0 * std::sqrt(n) * Eigen::MatrixXd::Identity(n, n);
+        const Eigen::MatrixXd A = random_matrix(n, n, 100 + n) + 2.0 * std::sqrt(n) * Eigen::MatrixXd::Identity(n, n);
         const Eigen::VectorXd x_exact = random_vector(n, 200 + n);
         const Eigen::VectorXd b = A * x_exact;
         const Eigen::VectorXd x = lu_solve(lu_factor(A), b);
@@ -108,7 +108,7 @@ TEST_CASE("LU: a singular matrix is an fem::Error naming the column of the faile
     CHECK_THAT(fem_error_message([&] { (void)lu_factor(rank_two); }),
                Contains("column 2") && Contains("singular"));
 
-    Eigen::MatrixXd zero_column = random_matrix(5, 7);
+    Eigen::MatrixXd zero_column = random_matrix(5, 5, 7);
     zero_column.col(3).setZero();
     CHECK_THAT(fem_error_message([&] { (void)lu_factor(zero_column); }),
                Contains("column 3"));
@@ -135,14 +135,14 @@ TEST_CASE("forward substitution: exact by hand, and as Eigen's triangular solve"
     CHECK(y[1] == 2.0);
 
     const int n = 60;
-    Eigen::MatrixXd M = random_matrix(n, 3);
+    Eigen::MatrixXd M = random_matrix(n, n, 3);
     M.diagonal().array() += 3.0;
     const Eigen::VectorXd b = random_vector(n, 4);
     const Eigen::VectorXd reference = M.triangularView<Eigen::Lower>().solve(b);
     CHECK((forward_substitution(M, b) - reference).norm() <= 1e-13 * reference.norm());  // reads the lower triangle only
     // Diagonal::unit: the stored diagonal is ignored and taken as ones (small multipliers keep the
     // unit triangular matrix well conditioned)
-    Eigen::MatrixXd U = random_matrix(n, 7) / n;
+    Eigen::MatrixXd U = random_matrix(n, n, 7) / n;
     U.diagonal().setConstant(7.0);
     const Eigen::VectorXd unit_reference = U.triangularView<Eigen::UnitLower>().solve(b);
     CHECK((forward_substitution(U, b, Diagonal::unit) - unit_reference).norm() <= 1e-13 * unit_reference.norm());
@@ -168,7 +168,7 @@ TEST_CASE("back substitution: exact by hand, and as Eigen's triangular solve", "
     CHECK(x[0] == 1.0);
 
     const int n = 60;
-    Eigen::MatrixXd M = random_matrix(n, 5);
+    Eigen::MatrixXd M = random_matrix(n, n, 5);
     M.diagonal().array() += 3.0;
     const Eigen::VectorXd y = random_vector(n, 6);
     const Eigen::VectorXd reference = M.triangularView<Eigen::Upper>().solve(y);

@@ -3,6 +3,8 @@
 // matrices with a chosen spectrum (Q Λ Qᵀ with a random orthogonal Q), Kershaw's matrix (SPD, yet
 // its incomplete Cholesky factorization breaks down), and a dense reference solve.
 
+#include "common/random.hpp"
+
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/QR>
@@ -27,17 +29,6 @@ inline Eigen::MatrixXd spd_with_spectrum(const Eigen::VectorXd& eigenvalues, uns
     const Eigen::MatrixXd Q = Eigen::HouseholderQR<Eigen::MatrixXd>(G).householderQ();
     const Eigen::MatrixXd A = Q * eigenvalues.asDiagonal() * Q.transpose();
     return 0.5 * (A + A.transpose());
-}
-
-/// A random vector with entries in [−1, 1].
-inline Eigen::VectorXd random_vector(Eigen::Index n, unsigned seed)
-{
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-    Eigen::VectorXd v(n);
-    for (Eigen::Index i = 0; i < n; ++i)
-        v[i] = uniform(rng);
-    return v;
 }
 
 /// Kershaw's 4×4 matrix (1978): symmetric positive definite, but not an M-matrix (A_03 > 0), and

@@ -26,7 +26,7 @@
 
 using namespace fem::cg;
 using fem::cg::test::dense_solve;
-using fem::cg::test::random_vector;
+using fem::random_vector;
 using fem::cg::test::spd_with_spectrum;
 using Catch::Matchers::Contains;
 

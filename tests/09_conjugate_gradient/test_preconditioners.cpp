@@ -24,7 +24,7 @@
 using namespace fem::cg;
 using fem::cg::test::dense_solve;
 using fem::cg::test::kershaw_matrix;
-using fem::cg::test::random_vector;
+using fem::random_vector;
 using fem::cg::test::spd_with_spectrum;
 using fem::cg::test::tridiagonal_laplacian;
 using fem::sparse::CsrMatrix;

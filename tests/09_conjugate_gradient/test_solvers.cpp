@@ -16,7 +16,7 @@
 #include <cmath>
 
 using namespace fem::cg;
-using fem::cg::test::random_vector;
+using fem::random_vector;
 using fem::cg::test::spd_with_spectrum;
 using Catch::Matchers::Contains;
 
