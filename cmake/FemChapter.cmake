@@ -18,6 +18,17 @@ set(FEM_ALL_CHAPTERS "" CACHE INTERNAL "registered chapters")
 add_custom_target(fem_tests)
 add_custom_target(fem_chapter_libs)
 
+# fem_discover_tests(target label): one ctest entry per Catch2 test case of target, named
+# "<label>: <test case>" and labelled <label>. Each entry runs with --warn NoTests, so an entry that
+# matches no test case fails instead of passing quietly (a test name ctest cannot carry, e.g. one
+# with a ';', which CMake splits into two lists items, would otherwise count as passed while
+# nothing ran). tools/check_layout.py also rejects such names in the sources.
+function(fem_discover_tests target label)
+  # One label only: catch_discover_tests splits a list of labels into separate properties.
+  catch_discover_tests(${target} TEST_PREFIX "${label}: " EXTRA_ARGS --warn NoTests
+                       PROPERTIES LABELS "${label}")
+endfunction()
+
 function(fem_add_chapter number name)
   cmake_parse_arguments(PARSE_ARGV 2 CH "" "" "DEPENDS")
   set(id ${number}_${name})
@@ -100,8 +111,7 @@ function(fem_add_chapter number name)
     add_executable(${test_exe} ${test_sources})
     target_link_libraries(${test_exe} PRIVATE ${lib} fem_test_main fem_flags)
     target_compile_definitions(${test_exe} PRIVATE FEM_TEST_OUTPUT_DIR="${CMAKE_BINARY_DIR}/test_output/${id}")
-    # One label only: catch_discover_tests splits a list of labels into separate properties.
-    catch_discover_tests(${test_exe} TEST_PREFIX "ch${number}: " PROPERTIES LABELS "ch${number}")
+    fem_discover_tests(${test_exe} "ch${number}")
     add_dependencies(fem_tests ${test_exe})
 
     add_test(NAME ch${number}_quick_run

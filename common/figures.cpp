@@ -196,7 +196,12 @@ bool render_dataset(const std::filesystem::path& path, vtkDataSet* data, bool ce
                         -options.view_direction[2]);
     camera->SetFocalPoint(0.0, 0.0, 0.0);
     camera->SetViewUp(options.view_up.data());
-    renderer->ResetCamera();
+    if (options.frame_bounds) {
+        std::array<double, 6> bounds = *options.frame_bounds;
+        renderer->ResetCamera(bounds.data());
+    } else {
+        renderer->ResetCamera();
+    }
     camera->Zoom(1.1);
 
     vtkNew<vtkRenderWindow> window;

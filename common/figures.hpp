@@ -9,6 +9,7 @@
 
 #include "common/vtk_io.hpp"
 
+#include <array>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -57,6 +58,9 @@ struct RenderOptions {
     std::array<double, 3> view_direction{0.0, 0.0, -1.0};  ///< camera looks along this direction
     std::array<double, 3> view_up{0.0, 1.0, 0.0};
     bool show_edges = false;
+    /// The box (xmin, xmax, ymin, ymax, zmin, zmax) the camera frames; default: the mesh's own
+    /// bounds. The frames of a motion share one box so that the camera stands still.
+    std::optional<std::array<double, 6>> frame_bounds;
     int width = 900;
     int height = 700;
 };

@@ -158,6 +158,41 @@ const Field& MeshData::field(const std::string& name) const
     throw Error(str("the mesh has no field named '", name, "'"));
 }
 
+MatrixX3d vertex_rows(const Eigen::VectorXd& q)
+{
+    if (q.size() % 3 != 0)
+        throw Error(str("a vertex-major vector needs 3 entries per vertex, got ", q.size(), " entries"));
+    return Eigen::Map<const MatrixX3d>(q.data(), q.size() / 3, 3);
+}
+
+MeshData displaced_mesh(const MatrixX3d& rest, const MatrixXiR& cells, const MatrixX3d& displacement)
+{
+    if (displacement.rows() != rest.rows())
+        throw Error(str("displacement has ", displacement.rows(), " rows, expected one per point: ", rest.rows()));
+    MeshData mesh;
+    mesh.points = rest;
+    mesh.cells = cells;
+    mesh.point_data.push_back({displacement_field, displacement});
+    return mesh;
+}
+
+MeshData warped(const MeshData& mesh, double scale)
+{
+    if (!std::isfinite(scale))
+        throw Error(str("warp scale must be finite, got ", scale));
+    for (const Field& u : mesh.point_data) {
+        if (u.name != displacement_field)
+            continue;
+        if (u.values.cols() != 3 || u.values.rows() != mesh.points.rows())
+            throw Error(str("point field '", displacement_field, "' must have 3 components and one row per point (",
+                            mesh.points.rows(), "), got ", u.values.rows(), "x", u.values.cols()));
+        MeshData deformed = mesh;
+        deformed.points += scale * u.values;
+        return deformed;
+    }
+    throw Error(str("the mesh has no point field '", displacement_field, "' to warp by"));
+}
+
 void validate(const MeshData& mesh)
 {
     for (Eigen::Index i = 0; i < mesh.points.rows(); ++i)

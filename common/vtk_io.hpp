@@ -43,6 +43,31 @@ struct ImageGrid {
     std::vector<Field> point_data;
 };
 
+// --- A body that moved: the course's one convention ---------------------------------------------
+//
+// Every .vtu/.vtp of a deformed body stores the REST positions X as its points and the point field
+// "displacement" u = x − X (one row per point, 3 columns). ParaView's Warp By Vector on
+// "displacement" (scale factor 1) then draws the deformed body, and any other scale exaggerates or
+// shrinks the motion; points that were already deformed would be moved twice. displaced_mesh()
+// builds such a mesh and warped() gives the deformed one for a picture.
+
+/// The name of the displacement point field of the convention above.
+inline constexpr const char* displacement_field = "displacement";
+
+/// The #V×3 rows of a vertex-major vector q = (x₀, y₀, z₀, x₁, …): row v = (q_3v, q_3v+1, q_3v+2).
+/// fem::Error if q.size() is not a multiple of 3.
+MatrixX3d vertex_rows(const Eigen::VectorXd& q);
+
+/// A mesh in the convention above: points = rest (#V×3), cells as given, and point_data starting
+/// with "displacement" = displacement (#V×3). Add further fields to the result.
+/// fem::Error if displacement is not rest.rows() × 3.
+MeshData displaced_mesh(const MatrixX3d& rest, const MatrixXiR& cells, const MatrixX3d& displacement);
+
+/// A copy of mesh with every point moved to X + scale · u, u its "displacement" field: the
+/// deformed body to render (scale 1: true scale). The copy keeps every field, displacement included.
+/// fem::Error if mesh has no 3-column point field "displacement" or scale is not finite.
+MeshData warped(const MeshData& mesh, double scale = 1.0);
+
 /// Checks counts, indices and finiteness; fem::Error naming the field, row and value otherwise.
 void validate(const MeshData& mesh);
 void validate(const ImageGrid& grid);

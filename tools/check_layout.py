@@ -2,7 +2,8 @@
 """Checks the course layout (a ctest test): every chapter registered in CMakeLists.txt has its
 header(s), main.cpp, solutions, tests, stored quick-run expectations and docs; a chapter includes
 only its own and earlier chapters' headers, each of them listed in its DEPENDS; common/ includes no
-chapter at all."""
+chapter at all; no Catch2 test name contains a character that ctest cannot carry (';' splits a
+CMake list, so the ctest entry would run no test case)."""
 
 import argparse
 import re
@@ -12,6 +13,23 @@ from pathlib import Path
 REGISTER = re.compile(r"^fem_add_chapter\((?P<number>\d\d)\s+(?P<name>\w+)(?:\s+DEPENDS(?P<deps>[\s\d]+))?\)",
                       re.M)
 INCLUDE = re.compile(r'^\s*#\s*include\s+"(?P<chapter>\d\d)_\w+/', re.M)
+# TEST_CASE( followed by one or more adjacent string literals: the test name.
+TEST_NAME = re.compile(r'\bTEST_CASE\(\s*((?:"(?:[^"\\]|\\.)*"\s*)+)')
+STRING_PIECE = re.compile(r'"((?:[^"\\]|\\.)*)"')
+
+
+def test_name_problems(root):
+    """Catch2 test names that ctest cannot carry: a ';' splits the name into two CMake list items."""
+    problems = []
+    for source in sorted((root / "tests").rglob("*.cpp")):
+        text = source.read_text()
+        for m in TEST_NAME.finditer(text):
+            name = "".join(STRING_PIECE.findall(m.group(1)))
+            if ";" in name:
+                line = text[:m.start()].count("\n") + 1
+                problems.append(f"{source.relative_to(root)}:{line}: test name '{name}' contains ';', which "
+                                "CMake splits: its ctest entry would run no test case")
+    return problems
 
 
 def main():
@@ -47,6 +65,7 @@ def main():
     for source in sorted((root / "common").glob("*.?pp")):
         if INCLUDE.search(source.read_text()):
             problems.append(f"{source.relative_to(root)} includes a chapter: common/ holds no chapter's math")
+    problems += test_name_problems(root)
     for problem in problems:
         print(f"FAIL {problem}")
     if not problems:

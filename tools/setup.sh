@@ -9,6 +9,7 @@ packages=(
   libvtk9-dev libx11-dev xvfb xauth       # VTK files and figures; a virtual display
   libsuitesparse-dev libopenblas0-pthread # CHOLMOD, the speed reference of chapters 08-09
   tetgen                                  # tetrahedral meshes from surfaces
+  libspectra-dev                          # sparse eigenvalues (chapter 10: modes)
 )
 
 missing=()

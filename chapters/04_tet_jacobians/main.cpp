@@ -8,8 +8,8 @@
 //   ch04_tet_jacobians --twist 180 --cells 24 --pinch 1.2
 //
 // Writes: tables deformation_table.csv, twist_convergence_table.csv, locate_table.csv;
-// the chart (PNG + CSV) twist_F_error; per field a mesh <field>.vtu (deformed positions, cell
-// data det F, |F - I|, F (row-major), F error) and its picture <field>.png.
+// the chart (PNG + CSV) twist_F_error; per field a mesh <field>.vtu (rest positions with point field
+// displacement, as every deformed body of the course; cell data det F, |F - I|, F (row-major), F error) and its picture <field>.png.
 // docs/04_tet_jacobians.md
 
 #include "04_tet_jacobians/deformation_fields.hpp"
@@ -107,10 +107,7 @@ void field_study(const RunContext& run, const Settings& settings)
         table.add_row({field.name, field.description, det.minCoeff(), det.maxCoeff(), strain.maxCoeff(),
                        error.maxCoeff(), double(inverted)});
 
-        io::MeshData data;
-        data.points = x;
-        data.cells = mesh.T;
-        data.point_data = {{"displacement", x - mesh.V}};
+        io::MeshData data = io::displaced_mesh(mesh.V, mesh.T, x - mesh.V);
         data.cell_data = {{"det F", det}, {"|F - I|", strain}, {"F", F_rows}, {"F error", error}};
         io::write_vtu(run.file(field.name + ".vtu"), data);
         if (run.figures) {
@@ -128,7 +125,7 @@ void field_study(const RunContext& run, const Settings& settings)
             options.view_up = {0.0, 0.0, 1.0};
             options.show_edges = true;
             options.height = 520;
-            fig::render_mesh_png(run.file(field.name + ".png"), data, options);
+            fig::render_mesh_png(run.file(field.name + ".png"), io::warped(data), options);
         }
         if (inverted > 0) {
             TetMesh deformed{x, mesh.T};

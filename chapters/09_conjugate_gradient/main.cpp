@@ -824,16 +824,9 @@ void box_picture(const RunContext& run, const Settings& settings)
     const std::unique_ptr<LinearSolver> solver = make_solver("default");
     solver->prepare(box.K);
     const Eigen::VectorXd u = assembly::expand(box.P, solver->solve(box.f));
-    MatrixX3d displacement(box.mesh.V.rows(), 3);
-    for (Eigen::Index v = 0; v < displacement.rows(); ++v)
-        displacement.row(v) = u.segment<3>(3 * v).transpose();
-    io::MeshData data;
-    data.points = box.mesh.V;
-    data.cells = box.mesh.T;
-    data.point_data = {{"displacement", displacement}};
+    const MatrixX3d displacement = io::vertex_rows(u);
+    const io::MeshData data = io::displaced_mesh(box.mesh.V, box.mesh.T, displacement);
     io::write_vtu(run.file("box_displacement.vtu"), data);
-    io::MeshData deformed = data;
-    deformed.points = box.mesh.V + displacement;
     fig::RenderOptions options;
     options.title = str("clamped box sagging under its weight (true scale, ", solver->name(), "): |u| [m]");
     options.field = "displacement";
@@ -841,7 +834,7 @@ void box_picture(const RunContext& run, const Settings& settings)
     options.view_up = {0.0, 0.0, 1.0};
     options.show_edges = true;
     options.height = 560;
-    fig::render_mesh_png(run.file("box_displacement.png"), deformed, options);
+    fig::render_mesh_png(run.file("box_displacement.png"), io::warped(data), options);
     std::cout << "\nbox_displacement.vtu: " << box.mesh.T.rows() << " tets, " << box.K.rows()
               << " unknowns solved by " << solver->name() << " in " << solver->stats().prepare_seconds +
                                                                        solver->stats().solve_seconds
@@ -875,6 +868,10 @@ int main(int argc, char** argv)
     cli.app.add_option("--youngs", settings.youngs, "Young's modulus of the box [Pa]")->capture_default_str();
     cli.app.add_option("--poisson", settings.poisson, "Poisson's ratio of the box")->capture_default_str();
     cli.app.add_option("--seconds", settings.seconds, "Measuring time per timed run [s]")->capture_default_str();
+    int blas_threads = 1;
+    cli.app.add_option("--blas-threads", blas_threads,
+                       "Threads of CHOLMOD's BLAS (1: one core against our one core)")
+        ->check(CLI::Range(1, 256))->capture_default_str();
     return cli.run(argc, argv, [&](const RunContext& run) {
         for (double tau : settings.tolerances)
             if (!(tau > 0.0 && tau < 1.0))
@@ -889,10 +886,13 @@ int main(int argc, char** argv)
             if (c < 1 || c > 60)
                 throw Error(str("--cells: sizes must lie in [1, 60], got ", c));
         require_positive(settings.seconds, "--seconds");
-        // One core against one core: CHOLMOD's BLAS would otherwise use every core.
-        const bool single = set_blas_threads(1);
+        // One core against one core by default: CHOLMOD's BLAS would otherwise use every core.
+        const bool limited = set_blas_threads(blas_threads);
         std::cout << "CHOLMOD: " << (cholmod_available() ? "available" : "not in this build")
-                  << (single ? ", its BLAS on one thread" : "") << "; default solver: " << default_solver_name()
+                  << (!limited ? std::string()
+                      : blas_threads == 1 ? std::string(", its BLAS on one thread")
+                                          : str(", its BLAS on ", blas_threads, " threads"))
+                  << "; default solver: " << default_solver_name()
                   << "\n\n";
         conditioning_study(run);
         operator_study(run, settings);

@@ -61,7 +61,7 @@ TEST_CASE("deformation gradient: F = A for the affine map x = A X + b", "[ex04.4
     CHECK(F.determinant() == Approx(1.0).epsilon(1e-14));
 }
 
-TEST_CASE("deformation gradient: det F = deformed volume / rest volume; an inverted tet has det F < 0",
+TEST_CASE("deformation gradient: det F = deformed volume / rest volume, and an inverted tet has det F < 0",
           "[ex04.4]")
 {
     const TetVertices X = skew_tet();

@@ -91,7 +91,7 @@ TEST_CASE("D picks the engineering strain out of the row-major vec(grad u)", "[e
     }
 }
 
-TEST_CASE("C: sigma = C eps reproduces lambda tr(eps) I + 2 mu eps; pure shear gives sigma_xy = 2 mu eps_xy",
+TEST_CASE("C: sigma = C eps reproduces lambda tr(eps) I + 2 mu eps, and pure shear gives sigma_xy = 2 mu eps_xy",
           "[ex05.6]")
 {
     const Matrix6d C = elasticity_matrix(rubber);

@@ -30,7 +30,7 @@ Eigen::Matrix3d rotation(double angle) { return Eigen::AngleAxisd(angle, axis).t
 
 }  // namespace
 
-TEST_CASE("small strain: the symmetric part of grad u; zero for a translation, exact for a stretch",
+TEST_CASE("small strain: the symmetric part of grad u, and zero for a translation, exact for a stretch",
           "[ex05.4]")
 {
     std::mt19937 random(1);

@@ -217,7 +217,7 @@ TEST_CASE("sparse Cholesky: bad input is an fem::Error", "[cholesky]")
     CHECK_THROWS_AS(chol.solve(b), fem::Error);
 }
 
-TEST_CASE("supernodes: fundamental ones follow the column counts; relaxed ones store few zeros", "[supernodal]")
+TEST_CASE("supernodes: fundamental ones follow the column counts, and relaxed ones store few zeros", "[supernodal]")
 {
     const sparse::CscMatrix A = laplacian_3d(10);
     const SparseCholesky chol(A, {Ordering::nested_dissection, Factorization::supernodal});

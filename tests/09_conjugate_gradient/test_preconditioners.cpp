@@ -177,7 +177,7 @@ TEST_CASE("IC(0) with a shift factors A + α diag(A)", "[ex09.3]")
     CHECK((dense_of(ic.L) - L).norm() <= 1e-13 * L.norm());
 }
 
-TEST_CASE("IC(0) breaks down on Kershaw's matrix; the diagonal shift repairs it", "[ex09.3]")
+TEST_CASE("IC(0) breaks down on Kershaw's matrix, and the diagonal shift repairs it", "[ex09.3]")
 {
     const Eigen::MatrixXd A = kershaw_matrix();
     REQUIRE(Eigen::LLT<Eigen::MatrixXd>(A).info() == Eigen::Success);  // SPD all the same

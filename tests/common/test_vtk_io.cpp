@@ -130,3 +130,30 @@ TEST_CASE("a .vti grid is validated and written", "[common][vtk]")
     grid.spacing[1] = 0.0;
     CHECK_THROWS_AS(fem::io::write_vti(dir / "bad.vti", grid), fem::Error);
 }
+
+TEST_CASE("displaced meshes: rest points plus a displacement field, warped once to the deformed body",
+          "[common][vtk]")
+{
+    const auto dir = fem::test::fresh_output_dir("displaced");
+    const auto rest = two_tets();
+    Eigen::VectorXd q(15);
+    for (int i = 0; i < 15; ++i)
+        q[i] = 0.1 * i - 0.4;
+    const fem::MatrixX3d u = fem::io::vertex_rows(q);
+    REQUIRE(u.rows() == 5);
+    CHECK(u(1, 0) == q[3]);
+    CHECK(u(4, 2) == q[14]);
+
+    fem::io::write_vtu(dir / "moved.vtu", fem::io::displaced_mesh(rest.points, rest.cells, u));
+    const auto back = fem::io::read_vtu(dir / "moved.vtu");
+    CHECK(back.points == rest.points);  // the file holds the rest shape ...
+    CHECK(back.field("displacement").values == Eigen::MatrixXd(u));  // ... and u beside it
+    const auto deformed = fem::io::warped(back);
+    CHECK(deformed.points == fem::MatrixX3d(rest.points + u));
+    CHECK(fem::io::warped(back, 10.0).points == fem::MatrixX3d(rest.points + 10.0 * u));
+
+    CHECK_THROWS_WITH(fem::io::warped(rest), Contains("no point field 'displacement'"));
+    CHECK_THROWS_WITH(fem::io::vertex_rows(Eigen::VectorXd::Zero(7)), Contains("3 entries per vertex"));
+    CHECK_THROWS_WITH(fem::io::displaced_mesh(rest.points, rest.cells, u.topRows(4)), Contains("one per point"));
+    CHECK_THROWS_WITH(fem::io::warped(back, std::nan("")), Contains("finite"));
+}

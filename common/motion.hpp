@@ -1,0 +1,44 @@
+#pragma once
+// The output of a moving body: a .pvd time series of .vtu frames (rest positions plus the
+// "displacement" field, the course's convention, see vtk_io.hpp) and PNG frames rendered with one
+// camera and one colour range for the whole motion, so that the pictures can be flipped through or
+// made into a video. No chapter math: the chapters fill the frames' fields.
+
+#include "common/figures.hpp"
+#include "common/vtk_io.hpp"
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace fem::io {
+
+/// Records the frames of one body's motion.
+class MotionRecorder {
+public:
+    /// pvd_path: the series, e.g. out/10_linear_dynamics/beam.pvd (frames in beam/beam_NNNN.vtu).
+    /// png_every: keep every k-th frame (k ≥ 1) for the PNG frames, 0 for none.
+    MotionRecorder(std::filesystem::path pvd_path, int png_every = 0);
+
+    /// Writes the frame (points: rest positions; point field "displacement" required) to the series;
+    /// keeps it for the PNGs when it is one of every png_every. fem::Error for a frame without a
+    /// 3-column point field "displacement" or a field the writer refuses (non-finite values).
+    void add(double time, const MeshData& frame);
+
+    std::size_t frames() const { return series_.frames(); }
+
+    /// Renders the kept frames, warped by their displacement (true scale), to <stem>_0000.png, …:
+    /// one camera framing the union of the deformed bodies' bounds, and one colour range for
+    /// options.field over all kept frames (unless options.range is set). The title gets ", t = …
+    /// s" appended. Returns the number of PNGs written (0 without a display, see figures.hpp).
+    /// fem::Error if the field is missing from a frame.
+    int render_png_frames(const std::filesystem::path& stem, const fig::RenderOptions& options) const;
+
+private:
+    PvdSeries series_;
+    int png_every_;
+    std::size_t added_ = 0;
+    std::vector<std::pair<double, MeshData>> kept_;  // warped frames for the PNGs
+};
+
+}  // namespace fem::io
