@@ -1,0 +1,221 @@
+#pragma once
+// Chapter 10: a scene, the body it builds, and the force model the body moves under.
+// docs/10_linear_dynamics.md
+//
+// The lecture's dynamic equation, written in the displacement u = x − x₀ (3n entries, vertex-major
+// like every global vector of the course):
+//     M ü + D u̇ + K u = f_ext,      D = α M + β K (Rayleigh),      f_ext = the gravity load.
+// Pinned vertices keep u = 0; their dofs are removed from the unknowns (FreeDofs, chapter 06's P).
+//
+// The pieces chapters 11–13 reuse (docs/10_linear_dynamics.md#the-pieces-of-a-simulation):
+//   Scene       plain data: mesh, material, pinned vertices, gravity, damping, mass model, Δt and
+//               duration; validate() checks all of it once;
+//   ForceModel  the elastic energy U(u), the internal forces f(u) = −∂U/∂u and the tangent
+//               stiffness K(u) = ∂²U/∂u²; LinearElasticity is this chapter's (K constant), chapter 11
+//               adds the corotational one, chapter 12 the hyperelastic ones;
+//   Body        what a scene assembles once: M, f_ext, the free dofs, and its force model.
+// The integrators and the time loop that move a Body are in time_integration.hpp.
+
+#include "05_strain_stress/strain_stress.hpp"
+#include "06_assembly/assembly.hpp"
+
+#include "common/mesh.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace fem::dynamics {
+
+using SparseMatrix = Eigen::SparseMatrix<double>;
+
+/// An isotropic elastic material with a density. Defaults: rubber.
+struct Material {
+    double youngs_modulus = 1e5;  ///< Y [Pa], finite and > 0
+    double poisson_ratio = 0.45;  ///< ν, in (−1, 0.5)
+    double density = 1000.0;      ///< ρ [kg/m³], finite and > 0
+};
+
+/// Which mass matrix the body uses (chapter 06): the lumped diagonal m_v = Σ ¼ ρ V_t (default:
+/// cheap, and the explicit step needs no solve) or the consistent ρ ∫ Φᵀ Φ dV.
+enum class MassModel { lumped, consistent };
+
+/// Rayleigh damping D = α M + β K: α [1/s] damps slow motion, β [s] fast motion. For a mode of
+/// angular frequency ω the damping ratio is ξ = α/(2ω) + β ω/2. Both in [0, 0.02], the lecture's
+/// range (chapter 06's rayleigh_damping checks it).
+struct Damping {
+    double alpha = 0.0;
+    double beta = 0.0;
+};
+
+/// A simulation scene: plain data, checked once by validate(). docs/10_linear_dynamics.md#scenes
+struct Scene {
+    TetMesh mesh;                                ///< rest positions x₀ = mesh.V and tets mesh.T
+    Material material;
+    std::vector<int> pinned;                     ///< vertices held at their rest position
+    Eigen::Vector3d gravity{0.0, 0.0, -9.81};    ///< g [m/s²]; the load is f_v = m_v g
+    Damping damping;
+    MassModel mass = MassModel::lumped;
+    double time_step = 1.0 / 60.0;               ///< Δt [s], finite and > 0
+    double duration = 1.0;                       ///< [s], a whole number of steps (see step_count)
+};
+
+/// fem::Error, naming the field and what is allowed, unless: the mesh is valid (indices, no
+/// zero-volume or inverted tet: fem::validate with Inverted::reject), Y > 0, −1 < ν < 0.5, ρ > 0,
+/// g finite, 0 ≤ α, β ≤ 0.02, Δt > 0, duration ≥ 0 and a whole number of steps, and every pinned
+/// vertex lies in [0, #V) and is listed once. Nothing pinned is allowed (the body falls freely).
+/// docs/10_linear_dynamics.md#scenes
+void validate(const Scene& scene);
+
+/// The number of steps that cover `duration`: duration / Δt when that is a whole number to within
+/// 1e-9 relative (1.0 / (1/60) = 60), fem::Error otherwise (e.g. 1.05 s at Δt = 0.1 s: "10.5
+/// steps"), never a silently shortened or lengthened run. fem::Error for Δt ≤ 0 or duration < 0.
+int step_count(double duration, double time_step);
+
+// --- Force models ----------------------------------------------------------------------------
+
+/// The elastic response of a body: energy, forces and stiffness at a displacement u (3n).
+/// Chapters 11 and 12 add their models; the integrators only see this interface.
+/// docs/10_linear_dynamics.md#force-models
+class ForceModel {
+public:
+    virtual ~ForceModel() = default;
+
+    /// A short name for tables, e.g. "linear".
+    virtual std::string name() const = 0;
+
+    /// The elastic energy U(u) [J]; writes the internal forces f(u) = −∂U/∂u (3n) into forces
+    /// (resized). One call per step: the time loop keeps both for the next step and the energies.
+    virtual double evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& forces) = 0;
+
+    /// The tangent stiffness K(u) = ∂²U/∂u² = −∂f/∂u (3n×3n, both triangles stored).
+    virtual const SparseMatrix& stiffness(const Eigen::VectorXd& u) = 0;
+
+    /// True when K does not depend on u (linear elasticity): an implicit step then factors its
+    /// matrix once for the whole run.
+    virtual bool constant_stiffness() const = 0;
+
+    /// The von Mises stress of every tet at u (#T entries) [Pa], for the frames.
+    virtual Eigen::VectorXd von_mises_stress(const Eigen::VectorXd& u) const = 0;
+};
+
+/// Linear elasticity (chapters 05–06): U(u) = ½ uᵀ K u, f(u) = −K u, K assembled once from the rest
+/// shape. evaluate() costs one sparse product. docs/10_linear_dynamics.md#force-models
+class LinearElasticity final : public ForceModel {
+public:
+    /// K = assembly::stiffness_matrix(mesh, Lamé(Y, ν)). fem::Error as that function.
+    LinearElasticity(const TetMesh& mesh, const Material& material);
+
+    std::string name() const override { return "linear"; }
+    double evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& forces) override;
+    const SparseMatrix& stiffness(const Eigen::VectorXd&) override { return K_; }
+    bool constant_stiffness() const override { return true; }
+    /// σ = C B_e u_e per tet (chapter 05), then von Mises.
+    Eigen::VectorXd von_mises_stress(const Eigen::VectorXd& u) const override;
+
+    const SparseMatrix& K() const { return K_; }
+
+private:
+    TetMesh mesh_;
+    elastic::Lame lame_;
+    SparseMatrix K_;
+};
+
+// --- Free dofs -------------------------------------------------------------------------------
+
+/// The free degrees of freedom: every dof 3v + c whose vertex v is not pinned, ascending. The
+/// reduced unknowns are u_f = Pᵀ u and u = P u_f with P = assembly::free_selection_matrix; gather and
+/// scatter do the same by index, without a product. docs/10_linear_dynamics.md#pinned-vertices
+class FreeDofs {
+public:
+    /// fem::Error for a pinned index outside [0, vertex_count) or listed twice.
+    FreeDofs(int vertex_count, const std::vector<int>& pinned_vertices);
+
+    Eigen::Index size() const { return static_cast<Eigen::Index>(free_.size()); }  ///< 3n − 3·#pinned
+    Eigen::Index full_size() const { return full_size_; }                          ///< 3n
+    const std::vector<int>& indices() const { return free_; }
+    /// P (3n × size()), chapter 06's selection matrix.
+    const SparseMatrix& P() const { return P_; }
+    /// The diagonal projection of the kept-dofs route: 1 on free dofs, 0 on pinned ones (3n).
+    const Eigen::VectorXd& free_mask() const { return mask_; }
+
+    /// u_f = Pᵀ u (size()). fem::Error if u has not full_size() entries.
+    Eigen::VectorXd gather(const Eigen::VectorXd& full) const;
+    /// u(free dofs) = u_f, other entries untouched. fem::Error on sizes.
+    void scatter(const Eigen::VectorXd& free, Eigen::VectorXd& full) const;
+    /// A_ff = Pᵀ A P (size() × size()).
+    SparseMatrix reduce(const SparseMatrix& A) const;
+    /// The kept-dofs alternative: P̂ A P̂ + (I − P̂) with P̂ = diag(free_mask()) (3n×3n): the rows and
+    /// columns of pinned dofs replaced by those of the identity. Solving it with a right-hand side
+    /// that is zero on the pinned dofs gives the same free values as A_ff and zeros elsewhere.
+    SparseMatrix project(const SparseMatrix& A) const;
+
+private:
+    Eigen::Index full_size_ = 0;
+    std::vector<int> free_;
+    SparseMatrix P_;
+    Eigen::VectorXd mask_;
+};
+
+// --- The body --------------------------------------------------------------------------------
+
+/// What a scene assembles once: the mass matrix, the gravity load, the free dofs and the force
+/// model. Integrators read it; nothing in it changes during a run.
+class Body {
+public:
+    /// validate(scene), then M (lumped or consistent, chapter 06), f_ext = gravity_load and the
+    /// free dofs. model: the force model (default: LinearElasticity of the scene's mesh and material).
+    explicit Body(const Scene& scene, std::unique_ptr<ForceModel> model = nullptr);
+
+    const Scene& scene() const { return scene_; }
+    const TetMesh& mesh() const { return scene_.mesh; }
+    ForceModel& model() { return *model_; }
+    const ForceModel& model() const { return *model_; }
+    const FreeDofs& dofs() const { return dofs_; }
+
+    /// M (3n×3n): diagonal for the lumped model.
+    const SparseMatrix& mass_matrix() const { return M_; }
+    /// The lumped masses repeated per dof (3n): m_v at 3v, 3v+1, 3v+2 (also for consistent M,
+    /// whose rows sum to them).
+    const Eigen::VectorXd& dof_masses() const { return dof_masses_; }
+    /// f_ext (3n): m_v g per vertex (pinned vertices included; their dofs never move, so their
+    /// entries do no work).
+    const Eigen::VectorXd& external_forces() const { return f_ext_; }
+
+    /// x = x₀ + u as #V×3 rows.
+    MatrixX3d positions(const Eigen::VectorXd& u) const;
+
+private:
+    Scene scene_;
+    std::unique_ptr<ForceModel> model_;
+    FreeDofs dofs_;
+    SparseMatrix M_;
+    Eigen::VectorXd dof_masses_;
+    Eigen::VectorXd f_ext_;
+};
+
+/// The energies of a state (u, v) of a body [J]:
+///   kinetic T = ½ vᵀ M v,  elastic U(u) (from the force model),  gravitational W = −f_extᵀ u
+///   (the potential of the constant load, zero at rest), total H = T + U + W.
+/// For an undamped body the exact motion keeps H constant. docs/10_linear_dynamics.md#energy
+struct Energies {
+    double kinetic = 0.0;
+    double elastic = 0.0;
+    double gravitational = 0.0;
+    double total() const { return kinetic + elastic + gravitational; }
+    /// T + U + |W|: the size of the energies in play, the scale of the divergence check.
+    double magnitude() const;
+};
+
+/// The kinetic energy ½ vᵀ M v (v: 3n, M: 3n×3n). fem::Error on sizes.
+/// docs/10_linear_dynamics.md#energy
+double kinetic_energy(const SparseMatrix& M, const Eigen::VectorXd& v);
+
+/// The potential of a constant load, W = −f_extᵀ u (both 3n): the work the load did is −W.
+/// docs/10_linear_dynamics.md#energy
+double load_potential(const Eigen::VectorXd& f_ext, const Eigen::VectorXd& u);
+
+}  // namespace fem::dynamics

@@ -1,0 +1,231 @@
+#pragma once
+// Chapter 10: time integrators and the time loop. docs/10_linear_dynamics.md
+//
+// The lecture's "best practice" step is backward Euler on the first-order system (u, v):
+//     [M + Δt D + Δt² K] v⁺ = M v − Δt [K u − f_ext],      u⁺ = u + Δt v⁺.
+// It is the θ = 1 member of the θ-method (chapter 02 used the same family for heat):
+//     u⁺ = u + Δt v_θ,   M (v⁺ − v) = Δt [f(u_θ) + f_ext − D v_θ],   w_θ = θ w⁺ + (1 − θ) w,
+// which for the linear forces f(u) = −K u is one linear system for v⁺:
+//     A v⁺ = b,   A = M + θΔt D + θ²Δt² K,
+//                 b = M v + Δt (f(u) + f_ext) − (1 − θ) Δt (D v + θ Δt K v).
+// θ = 1 is backward Euler (first order, damps every mode), θ = ½ the implicit midpoint rule (= the
+// trapezoidal rule = Newmark's average acceleration for a linear body: second order, and it keeps
+// the energy of an undamped body exactly). A is constant for a linear body: ThetaMethod factors it
+// once (chapter 09's make_solver, default solver) and each step is one product and one solve.
+//
+// The same system written for the change of velocity Δv = v⁺ − v,
+//     A Δv = Δt [f(u) + f_ext − D v − θΔt K v],
+// has the same solution in exact arithmetic but no M v on the right: in floating point the lecture's
+// b carries M v, which the solve must cancel again, and the round-off of that cancellation reaches
+// v⁺ amplified by κ(A). ThetaMethod solves for Δv by default and offers the lecture's form to
+// compare (docs/10_linear_dynamics.md#two-forms-of-one-step).
+// For a force model whose K changes (chapter 11) the same step is the linearly implicit (one Newton
+// iteration) step, and A is refactored every step on the same pattern.
+//
+// Beside them, the explicit (symplectic) Euler step v⁺ = v + Δt M⁻¹ [f(u) + f_ext − D v],
+// u⁺ = u + Δt v⁺, stable only for Δt < 2/ω_max (modes.hpp).
+//
+// Simulation owns the loop: time, energies, what damping and the integrator dissipate, divergence
+// detection (an fem::Error naming the step and the energy growth, never a NaN frame) and the
+// observers that write frames.
+
+#include "10_linear_dynamics/body.hpp"
+
+#include "09_conjugate_gradient/linear_solver.hpp"
+
+#include <Eigen/Core>
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace fem::dynamics {
+
+/// Where the body is: time, step, displacement u and velocity v (3n each; zero on pinned dofs),
+/// and the force model's answer at u (kept so that each step evaluates the model once).
+struct State {
+    double time = 0.0;
+    int step = 0;
+    Eigen::VectorXd u;              ///< displacement x − x₀ (3n)
+    Eigen::VectorXd v;              ///< velocity (3n)
+    Eigen::VectorXd forces;         ///< internal forces f(u) = −∂U/∂u (3n)
+    double elastic_energy = 0.0;    ///< U(u)
+};
+
+/// The state (u0, v0) at time 0 (empty vectors: zero), with the force model evaluated at u0.
+/// fem::Error unless u0 and v0 have 3n finite entries and are zero on the pinned dofs.
+State initial_state(Body& body, const Eigen::VectorXd& u0 = {}, const Eigen::VectorXd& v0 = {});
+
+/// T, U and W of a state (see Energies). docs/10_linear_dynamics.md#energy
+Energies energies(const Body& body, const State& state);
+
+// --- The teaching pieces of the implicit step (exercises) -------------------------------------
+
+/// The matrix of the θ-step, A = M + θΔt D + θ²Δt² K with D = α M + β K, i.e.
+///   A = (1 + θΔt α) M + (θΔt β + θ²Δt²) K
+/// (M, K: n×n of one shape; the result has K's pattern when M's lies inside it). θ = 1 gives the
+/// lecture's M + Δt D + Δt² K. fem::Error for Δt ≤ 0, θ outside [½, 1] or mismatched sizes.
+/// docs/10_linear_dynamics.md#the-implicit-step
+SparseMatrix step_matrix(const SparseMatrix& M, const SparseMatrix& K, const Damping& damping, double time_step,
+                         double theta = 1.0);
+
+/// The lecture's right-hand side b = M v + Δt (f + f_ext), i.e. M v − Δt [K u − f_ext] with the
+/// internal forces f = −K u (all vectors of M's size). The θ < 1 correction is added by ThetaMethod.
+/// fem::Error for Δt ≤ 0 or mismatched sizes. docs/10_linear_dynamics.md#the-implicit-step
+Eigen::VectorXd step_right_hand_side(const SparseMatrix& M, const Eigen::VectorXd& v, const Eigen::VectorXd& forces,
+                                     const Eigen::VectorXd& external_forces, double time_step);
+
+/// The right-hand side of the velocity-change form, r = Δt [f + f_ext − D v − θΔt K v] with
+/// D v = α M v + β K v (all vectors of M's size; Kv = K v, needed when β ≠ 0 or θ < 1, else may be
+/// empty). A Δv = r gives v⁺ = v + Δv, the same v⁺ as A v⁺ = b with b from step_right_hand_side
+/// and its θ < 1 correction. fem::Error for Δt ≤ 0, θ outside [½, 1] or mismatched sizes.
+/// docs/10_linear_dynamics.md#two-forms-of-one-step
+Eigen::VectorXd velocity_change_right_hand_side(const SparseMatrix& M, const Eigen::VectorXd& v,
+                                                const Eigen::VectorXd& Kv, const Eigen::VectorXd& forces,
+                                                const Eigen::VectorXd& external_forces, const Damping& damping,
+                                                double time_step, double theta = 1.0);
+
+// --- Integrators -------------------------------------------------------------------------------
+
+/// How the pinned dofs are kept out of the implicit solve. docs/10_linear_dynamics.md#pinned-vertices
+enum class PinnedRoute {
+    eliminate,  ///< solve A_ff v_f = b_f on the free dofs only (size 3n − 3·#pinned; the default)
+    keep,       ///< solve P̂ A P̂ + (I − P̂) on all 3n dofs with b zeroed on the pinned ones
+};
+
+/// Which unknown the implicit step solves for (docs/10_linear_dynamics.md#two-forms-of-one-step).
+enum class StepForm {
+    velocity_change,  ///< A Δv = Δt [f + f_ext − D v − θΔt K v] (the default: less cancellation)
+    velocity,         ///< the lecture's A v⁺ = M v + Δt (f + f_ext) − (1 − θ)Δt (D v + θΔt K v)
+};
+
+/// The choices of an implicit step, compared side by side in the chapter's executable.
+struct ImplicitOptions {
+    std::string solver = "default";     ///< a chapter 09 solver name (cg::make_solver)
+    cg::SolverOptions solver_options;   ///< tolerance and cap of an iterative solver
+    bool refactor_every_step = false;   ///< prepare A every step even when it is constant (to
+                                        ///< measure what factoring once saves)
+    PinnedRoute pinned = PinnedRoute::eliminate;
+    StepForm form = StepForm::velocity_change;
+};
+
+/// What one step did, for the loop's bookkeeping.
+struct StepInfo {
+    double damping_work = 0.0;   ///< energy removed by D in this step: Δt v_θᵀ D v_θ ≥ 0 [J]
+    int solver_iterations = 0;   ///< iterations of an iterative solver (0 for a direct one)
+    bool prepared = false;       ///< the step (re)factored its matrix
+};
+
+/// One step from (u, v) to (u⁺, v⁺) for a body. docs/10_linear_dynamics.md#integrators
+class Integrator {
+public:
+    virtual ~Integrator() = default;
+    virtual std::string name() const = 0;
+    /// The order of accuracy in Δt (1 or 2).
+    virtual int order() const = 0;
+    /// Advances state by Δt: u, v, forces, elastic_energy, time and step. fem::Error from the solver
+    /// (a matrix that is not positive definite, an iterative solver that misses its tolerance) or
+    /// for Δt ≤ 0; state is then unchanged.
+    virtual StepInfo step(Body& body, double time_step, State& state) = 0;
+};
+
+/// The θ-method of the header comment, θ ∈ [½, 1]: θ = 1 backward Euler, θ = ½ implicit midpoint.
+/// A = step_matrix(M, K, damping, Δt, θ) is prepared on the first step and again only when Δt or
+/// the stiffness changes (or every step with refactor_every_step). An iterative solver starts from
+/// its previous answer (warm start: the previous Δv, or the previous v in the lecture's form).
+/// docs/10_linear_dynamics.md#the-implicit-step
+class ThetaMethod final : public Integrator {
+public:
+    /// fem::Error for θ outside [½, 1] or an unknown solver name.
+    explicit ThetaMethod(double theta, ImplicitOptions options = {});
+
+    std::string name() const override;
+    int order() const override { return theta_ == 0.5 ? 2 : 1; }
+    StepInfo step(Body& body, double time_step, State& state) override;
+
+    double theta() const { return theta_; }
+    const cg::LinearSolver& solver() const { return *solver_; }
+
+private:
+    double theta_;
+    ImplicitOptions options_;
+    std::unique_ptr<cg::LinearSolver> solver_;
+    double prepared_time_step_ = 0.0;   // Δt of the prepared matrix (0: none yet)
+    const Body* prepared_body_ = nullptr;
+    Eigen::VectorXd rhs_, solution_;    // work vectors (free or full size, by route); solution_
+                                        // keeps the last answer, the next warm start
+};
+
+/// Symplectic (semi-implicit) Euler: v⁺ = v + Δt M⁻¹ [f(u) + f_ext − D v], u⁺ = u + Δt v⁺. Explicit:
+/// with the lumped mass M⁻¹ is a division per dof, with the consistent mass M_ff is factored once.
+/// Stable only for Δt below explicit_stability_limit (modes.hpp). docs/10_linear_dynamics.md#explicit-euler
+class SymplecticEuler final : public Integrator {
+public:
+    std::string name() const override { return "symplectic Euler"; }
+    int order() const override { return 1; }
+    StepInfo step(Body& body, double time_step, State& state) override;
+
+private:
+    std::unique_ptr<cg::LinearSolver> mass_solver_;  // consistent mass only
+    const Body* prepared_body_ = nullptr;
+};
+
+/// The integrator called `name`: "backward-euler", "implicit-midpoint" or "symplectic-euler"
+/// (options: the implicit ones only). fem::Error for another name (the message lists these).
+std::unique_ptr<Integrator> make_integrator(std::string_view name, const ImplicitOptions& options = {});
+
+/// The names make_integrator accepts.
+std::vector<std::string> integrator_names();
+
+// --- The time loop -----------------------------------------------------------------------------
+
+/// One line of a run's history.
+struct StepRecord {
+    int step = 0;
+    double time = 0.0;
+    Energies energies;
+    double damping_dissipated = 0.0;     ///< Σ damping_work so far [J]
+    double integrator_dissipated = 0.0;  ///< H(0) − H(t) − damping_dissipated: what the integrator
+                                         ///< itself removed (> 0) or added (< 0) [J]
+    int solver_iterations = 0;           ///< of this step
+};
+
+/// The divergence rule: a run fails when its total energy H has risen above H(0) by more than this
+/// fraction of the largest energy magnitude T + U + |W| seen so far. A stable integrator on a body
+/// without energy sources never raises H by more than a round-off or O(Δt²) share of it; an
+/// unstable one multiplies H every step and crosses the line within a few steps of becoming visible.
+inline constexpr double divergence_energy_fraction = 0.5;
+
+/// Moves a body in time with one integrator and watches every step. docs/10_linear_dynamics.md#the-time-loop
+class Simulation {
+public:
+    /// Called at step 0 and after every step with the new state and its record.
+    using Observer = std::function<void(const State&, const StepRecord&)>;
+
+    /// fem::Error if Δt ≤ 0 or the state does not fit the body.
+    Simulation(Body& body, Integrator& integrator, State initial, double time_step);
+
+    /// Runs `steps` steps (≥ 0), calling observer (if any) at step 0 of the first run and after every
+    /// step. fem::Error when a step fails or the run diverges: a non-finite u, v or energy, or the
+    /// divergence rule above; the message names the step, the time and the energy growth, and the
+    /// observer never sees that state (no NaN frame is ever written).
+    void run(int steps, const Observer& observer = {});
+
+    const State& state() const { return state_; }
+    const StepRecord& last() const { return last_; }
+    double time_step() const { return time_step_; }
+
+private:
+    Body& body_;
+    Integrator& integrator_;
+    State state_;
+    double time_step_;
+    double initial_total_ = 0.0;
+    double largest_magnitude_ = 0.0;
+    StepRecord last_;
+    bool started_ = false;
+};
+
+}  // namespace fem::dynamics

@@ -1,0 +1,196 @@
+#include "10_linear_dynamics/body.hpp"
+
+#include "04_tet_jacobians/tet_jacobians.hpp"
+
+#include "common/error.hpp"
+#include "common/vtk_io.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace fem::dynamics {
+
+void validate(const Scene& scene)
+{
+    TetMesh mesh = scene.mesh;
+    fem::validate(mesh, "scene mesh", Inverted::reject);
+    const Material& m = scene.material;
+    require_positive(m.youngs_modulus, "Young's modulus Y [Pa]");
+    if (!(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5))
+        throw Error(str("Poisson's ratio must lie in (-1, 0.5) (0.5 is incompressible, which linear tets "
+                        "cannot model), got ", m.poisson_ratio));
+    require_positive(m.density, "density rho [kg/m^3]");
+    for (int c = 0; c < 3; ++c)
+        require_finite(scene.gravity[c], "gravity g [m/s^2]");
+    for (const auto& [value, name] : {std::pair{scene.damping.alpha, "Rayleigh alpha"},
+                                      std::pair{scene.damping.beta, "Rayleigh beta"}})
+        if (!(value >= 0.0 && value <= assembly::max_rayleigh_coefficient))
+            throw Error(str(name, " must lie in [0, ", assembly::max_rayleigh_coefficient,
+                            "] (the lecture's range), got ", value));
+    step_count(scene.duration, scene.time_step);
+    const auto vertices = static_cast<int>(mesh.V.rows());
+    std::vector<int> sorted = scene.pinned;
+    std::sort(sorted.begin(), sorted.end());
+    for (std::size_t i = 0; i < sorted.size(); ++i) {
+        if (sorted[i] < 0 || sorted[i] >= vertices)
+            throw Error(str("pinned vertex ", sorted[i], " is outside the mesh's vertices [0, ", vertices, ")"));
+        if (i > 0 && sorted[i] == sorted[i - 1])
+            throw Error(str("pinned vertex ", sorted[i], " is listed twice"));
+    }
+}
+
+int step_count(double duration, double time_step)
+{
+    require_positive(time_step, "time step dt [s]");
+    if (!(std::isfinite(duration) && duration >= 0.0))
+        throw Error(str("duration must be a finite number >= 0 [s], got ", duration));
+    const double steps = duration / time_step;
+    const double whole = std::round(steps);
+    if (std::abs(steps - whole) > 1e-9 * std::max(1.0, steps))
+        throw Error(str("duration ", duration, " s is not a whole number of steps of dt = ", time_step, " s (",
+                        steps, " steps): choose a duration that is a multiple of dt"));
+    if (whole > 1e9)
+        throw Error(str("duration / dt = ", whole, " steps: more than 1e9 steps is not a run to start"));
+    return static_cast<int>(whole);
+}
+
+// --- LinearElasticity --------------------------------------------------------------------------
+
+LinearElasticity::LinearElasticity(const TetMesh& mesh, const Material& material)
+    : mesh_(mesh), lame_(elastic::lame_parameters(material.youngs_modulus, material.poisson_ratio)),
+      K_(assembly::stiffness_matrix(mesh, lame_))
+{
+}
+
+double LinearElasticity::evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& forces)
+{
+    if (u.size() != K_.rows())
+        throw Error(str("displacement has ", u.size(), " entries, expected 3n = ", K_.rows()));
+    forces.noalias() = -(K_ * u);
+    return -0.5 * u.dot(forces);
+}
+
+Eigen::VectorXd LinearElasticity::von_mises_stress(const Eigen::VectorXd& u) const
+{
+    if (u.size() != K_.rows())
+        throw Error(str("displacement has ", u.size(), " entries, expected 3n = ", K_.rows()));
+    const elastic::Matrix6d C = elastic::elasticity_matrix(lame_);
+    Eigen::VectorXd stress(mesh_.T.rows());
+    for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t) {
+        tet::TetVertices X;
+        Eigen::Matrix<double, 12, 1> u_e;
+        for (int i = 0; i < 4; ++i) {
+            X.row(i) = mesh_.V.row(mesh_.T(t, i));
+            u_e.segment<3>(3 * i) = u.segment<3>(3 * mesh_.T(t, i));
+        }
+        stress[t] = elastic::von_mises(C * (elastic::strain_displacement_matrix(X) * u_e));
+    }
+    return stress;
+}
+
+// --- FreeDofs ----------------------------------------------------------------------------------
+
+FreeDofs::FreeDofs(int vertex_count, const std::vector<int>& pinned_vertices)
+    : full_size_(3 * static_cast<Eigen::Index>(vertex_count)),
+      P_(assembly::free_selection_matrix(vertex_count, pinned_vertices)),
+      mask_(Eigen::VectorXd::Ones(3 * static_cast<Eigen::Index>(vertex_count)))
+{
+    for (int v : pinned_vertices)
+        mask_.segment<3>(3 * v).setZero();
+    free_.reserve(static_cast<std::size_t>(P_.cols()));
+    for (Eigen::Index dof = 0; dof < full_size_; ++dof)
+        if (mask_[dof] != 0.0)
+            free_.push_back(static_cast<int>(dof));
+}
+
+Eigen::VectorXd FreeDofs::gather(const Eigen::VectorXd& full) const
+{
+    if (full.size() != full_size_)
+        throw Error(str("a full vector has 3n = ", full_size_, " entries, got ", full.size()));
+    Eigen::VectorXd free(size());
+    for (Eigen::Index i = 0; i < size(); ++i)
+        free[i] = full[free_[static_cast<std::size_t>(i)]];
+    return free;
+}
+
+void FreeDofs::scatter(const Eigen::VectorXd& free, Eigen::VectorXd& full) const
+{
+    if (free.size() != size() || full.size() != full_size_)
+        throw Error(str("scatter: expected ", size(), " free and ", full_size_, " full entries, got ", free.size(),
+                        " and ", full.size()));
+    for (Eigen::Index i = 0; i < size(); ++i)
+        full[free_[static_cast<std::size_t>(i)]] = free[i];
+}
+
+SparseMatrix FreeDofs::reduce(const SparseMatrix& A) const
+{
+    return assembly::reduce(A, P_);
+}
+
+SparseMatrix FreeDofs::project(const SparseMatrix& A) const
+{
+    if (A.rows() != full_size_ || A.cols() != full_size_)
+        throw Error(str("project: A must be ", full_size_, "x", full_size_, ", got ", A.rows(), "x", A.cols()));
+    SparseMatrix projected = A;
+    for (Eigen::Index col = 0; col < projected.outerSize(); ++col)
+        for (SparseMatrix::InnerIterator it(projected, col); it; ++it) {
+            const bool pinned_row = mask_[it.row()] == 0.0, pinned_col = mask_[it.col()] == 0.0;
+            if (pinned_row || pinned_col)
+                it.valueRef() = it.row() == it.col() ? 1.0 : 0.0;
+        }
+    projected.prune(0.0);  // the zeroed couplings go; the unit diagonal of a pinned dof stays
+    return projected;
+}
+
+// --- Body ------------------------------------------------------------------------------------
+
+namespace {
+
+const Scene& validated(const Scene& scene)
+{
+    validate(scene);
+    return scene;
+}
+
+}  // namespace
+
+Body::Body(const Scene& scene, std::unique_ptr<ForceModel> model)
+    : scene_(validated(scene)),
+      model_(model ? std::move(model) : std::make_unique<LinearElasticity>(scene.mesh, scene.material)),
+      dofs_(static_cast<int>(scene.mesh.V.rows()), scene.pinned)
+{
+    const Material& m = scene.material;
+    M_ = scene.mass == MassModel::lumped ? assembly::lumped_mass_matrix(scene.mesh, m.density)
+                                         : assembly::consistent_mass_matrix(scene.mesh, m.density);
+    const Eigen::VectorXd masses = assembly::vertex_masses(scene.mesh, m.density);
+    dof_masses_.resize(3 * masses.size());
+    for (Eigen::Index v = 0; v < masses.size(); ++v)
+        dof_masses_.segment<3>(3 * v).setConstant(masses[v]);
+    f_ext_ = assembly::gravity_load(scene.mesh, m.density, scene.gravity);
+}
+
+MatrixX3d Body::positions(const Eigen::VectorXd& u) const
+{
+    return scene_.mesh.V + io::vertex_rows(u);
+}
+
+double Energies::magnitude() const
+{
+    return kinetic + elastic + std::abs(gravitational);
+}
+
+double kinetic_energy(const SparseMatrix& M, const Eigen::VectorXd& v)
+{
+    if (M.rows() != v.size() || M.cols() != v.size())
+        throw Error(str("kinetic energy: M is ", M.rows(), "x", M.cols(), " but v has ", v.size(), " entries"));
+    return 0.5 * v.dot(M * v);
+}
+
+double load_potential(const Eigen::VectorXd& f_ext, const Eigen::VectorXd& u)
+{
+    if (f_ext.size() != u.size())
+        throw Error(str("load potential: f_ext has ", f_ext.size(), " entries but u has ", u.size()));
+    return -f_ext.dot(u);
+}
+
+}  // namespace fem::dynamics

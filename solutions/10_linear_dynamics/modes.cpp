@@ -1,0 +1,304 @@
+#include "10_linear_dynamics/modes.hpp"
+
+#include "09_conjugate_gradient/linear_solver.hpp"
+
+#include "common/error.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <Spectra/MatOp/SparseCholesky.h>
+#include <Spectra/MatOp/SparseSymMatProd.h>
+#include <Spectra/SymGEigsShiftSolver.h>
+#include <Spectra/SymGEigsSolver.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace fem::dynamics {
+namespace {
+
+constexpr double pi = 3.14159265358979323846;
+constexpr double lanczos_tolerance = 1e-10;
+
+void require_pair(const SparseMatrix& K, const SparseMatrix& M, int count)
+{
+    if (K.rows() != K.cols() || M.rows() != M.cols() || K.rows() != M.rows())
+        throw Error(str("modes: K (", K.rows(), "x", K.cols(), ") and M (", M.rows(), "x", M.cols(),
+                        ") must be square and of one size"));
+    if (count < 1 || count > K.rows())
+        throw Error(str("modes: the number of modes must lie in [1, n = ", K.rows(), "], got ", count));
+    if (!Eigen::MatrixXd(K).allFinite() && K.rows() <= 4000)  // a dense check is affordable here
+        throw Error("modes: K has a non-finite entry");
+}
+
+void require_oscillator(double omega, double xi, double time_step, double theta)
+{
+    if (!(std::isfinite(omega) && omega >= 0.0))
+        throw Error(str("oscillator: omega must be finite and >= 0 [rad/s], got ", omega));
+    if (!(std::isfinite(xi) && xi >= 0.0))
+        throw Error(str("oscillator: the damping ratio xi must be finite and >= 0, got ", xi));
+    require_positive(time_step, "time step dt [s]");
+    if (!(theta >= 0.5 && theta <= 1.0))
+        throw Error(str("theta must lie in [0.5, 1], got ", theta));
+}
+
+/// Scales every column to φᵀ M φ = 1 and sorts by ω ascending.
+Modes normalized_modes(const Eigen::VectorXd& eigenvalues, const Eigen::MatrixXd& vectors, const SparseMatrix& M)
+{
+    std::vector<Eigen::Index> order(static_cast<std::size_t>(eigenvalues.size()));
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(), [&](Eigen::Index a, Eigen::Index b) { return eigenvalues[a] < eigenvalues[b]; });
+    Modes modes;
+    modes.omega.resize(eigenvalues.size());
+    modes.shapes.resize(vectors.rows(), eigenvalues.size());
+    for (Eigen::Index k = 0; k < eigenvalues.size(); ++k) {
+        const Eigen::Index j = order[static_cast<std::size_t>(k)];
+        modes.omega[k] = std::sqrt(std::max(eigenvalues[j], 0.0));
+        const Eigen::VectorXd phi = vectors.col(j);
+        modes.shapes.col(k) = phi / std::sqrt(phi.dot(M * phi));
+    }
+    return modes;
+}
+
+/// y = (K − σ M)⁻¹ x with chapter 09's default sparse Cholesky: Spectra's shift-invert operation.
+class ShiftInvertOperator {
+public:
+    using Scalar = double;
+
+    ShiftInvertOperator(const SparseMatrix& K, const SparseMatrix& M)
+        : K_(K), M_(M), solver_(cg::make_solver("default"))
+    {
+    }
+    Eigen::Index rows() const { return K_.rows(); }
+    Eigen::Index cols() const { return K_.cols(); }
+    void set_shift(double sigma) { solver_->prepare(K_ - sigma * M_); }
+    void perform_op(const double* x, double* y) const
+    {
+        Eigen::Map<Eigen::VectorXd>(y, rows()) = solver_->solve(Eigen::Map<const Eigen::VectorXd>(x, rows()));
+    }
+
+private:
+    const SparseMatrix& K_;
+    const SparseMatrix& M_;
+    std::unique_ptr<cg::LinearSolver> solver_;
+};
+
+}  // namespace
+
+Modes lowest_modes_dense(const SparseMatrix& K, const SparseMatrix& M, int count)
+{
+    require_pair(K, M, count);
+    const Eigen::MatrixXd Kd(K), Md(M);
+    Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> solver(Kd, Md, Eigen::ComputeEigenvectors | Eigen::Ax_lBx);
+    if (solver.info() != Eigen::Success)
+        throw Error("modes: the dense generalized eigensolver failed: M must be symmetric positive definite");
+    const Eigen::VectorXd lambda = solver.eigenvalues();
+    if (lambda[0] < -1e-9 * std::abs(lambda[lambda.size() - 1]))
+        throw Error(str("modes: K has the negative eigenvalue ", lambda[0], "; a stiffness must be positive semi-definite"));
+    return normalized_modes(lambda.head(count), solver.eigenvectors().leftCols(count), M);
+}
+
+Modes lowest_modes(const SparseMatrix& K, const SparseMatrix& M, int count)
+{
+    require_pair(K, M, count);
+    const Eigen::Index n = K.rows();
+    if (n <= 3 * count + 20)  // too small for Lanczos to have room: the dense solver is exact
+        return lowest_modes_dense(K, M, count);
+    ShiftInvertOperator op(K, M);
+    Spectra::SparseSymMatProd<double> mass(M);
+    const Eigen::Index ncv = std::min<Eigen::Index>(n, std::max(2 * count + 1, 24));
+    Spectra::SymGEigsShiftSolver<ShiftInvertOperator, Spectra::SparseSymMatProd<double>, Spectra::GEigsMode::ShiftInvert>
+        eigs(op, mass, count, ncv, 0.0);
+    eigs.init();
+    eigs.compute(Spectra::SortRule::LargestMagn, 1000, lanczos_tolerance);
+    if (eigs.info() != Spectra::CompInfo::Successful)
+        throw Error(str("modes: shift-invert Lanczos did not converge to ", lanczos_tolerance, " for ", count, " modes"));
+    return normalized_modes(eigs.eigenvalues(), eigs.eigenvectors(), M);
+}
+
+double highest_frequency(const SparseMatrix& K, const SparseMatrix& M)
+{
+    require_pair(K, M, 1);
+    const Eigen::Index n = K.rows();
+    if (n <= 24) {
+        const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> solver(Eigen::MatrixXd(K), Eigen::MatrixXd(M),
+                                                                               Eigen::EigenvaluesOnly | Eigen::Ax_lBx);
+        if (solver.info() != Eigen::Success)
+            throw Error("highest frequency: M must be symmetric positive definite");
+        return std::sqrt(std::max(solver.eigenvalues().maxCoeff(), 0.0));
+    }
+    Spectra::SparseSymMatProd<double> stiffness(K);
+    Spectra::SparseCholesky<double> mass(M);
+    if (mass.info() != Spectra::CompInfo::Successful)
+        throw Error("highest frequency: M must be symmetric positive definite");
+    Spectra::SymGEigsSolver<Spectra::SparseSymMatProd<double>, Spectra::SparseCholesky<double>, Spectra::GEigsMode::Cholesky>
+        eigs(stiffness, mass, 1, std::min<Eigen::Index>(n, 24));
+    eigs.init();
+    eigs.compute(Spectra::SortRule::LargestAlge, 5000, lanczos_tolerance);
+    if (eigs.info() != Spectra::CompInfo::Successful)
+        throw Error(str("highest frequency: Lanczos did not converge to ", lanczos_tolerance));
+    return std::sqrt(std::max(eigs.eigenvalues()[0], 0.0));
+}
+
+PowerIteration power_iteration(const SparseMatrix& K, const Eigen::VectorXd& masses, double tolerance, int max_iterations)
+{
+    if (K.rows() != K.cols() || K.rows() != masses.size() || masses.size() == 0)
+        throw Error(str("power iteration: K (", K.rows(), "x", K.cols(), ") and the masses (", masses.size(),
+                        ") must be of one size n >= 1"));
+    if (!(masses.array() > 0.0).all() || !masses.allFinite())
+        throw Error("power iteration: every lumped mass must be finite and > 0");
+    if (!(tolerance > 0.0 && tolerance < 1.0))
+        throw Error(str("power iteration: the tolerance must lie in (0, 1), got ", tolerance));
+    if (max_iterations < 1)
+        throw Error(str("power iteration: max_iterations must be >= 1, got ", max_iterations));
+    PowerIteration result;
+    Eigen::VectorXd x(masses.size());
+    for (Eigen::Index i = 0; i < x.size(); ++i)
+        x[i] = 1.0 + ((i % 2 == 0) ? 0.5 : -0.5);
+    // BEGIN EXERCISE 10.8 power_iteration #the-explicit-stability-limit
+    // HINT: repeat: y = K x; λ = xᵀy / xᵀMx (the Rayleigh quotient, M = diag(masses));
+    // HINT: converged when |λ − λ_previous| ≤ tolerance · λ; x = M⁻¹ y, normalized (‖x‖ = 1).
+    // HINT: Report ω = √λ, the iterations and whether it converged.
+    x.normalize();
+    double previous = 0.0;
+    for (int k = 1; k <= max_iterations; ++k) {
+        const Eigen::VectorXd y = K * x;
+        const double lambda = x.dot(y) / x.dot(masses.cwiseProduct(x));
+        result.omega = std::sqrt(std::max(lambda, 0.0));
+        result.iterations = k;
+        if (k > 1 && std::abs(lambda - previous) <= tolerance * std::abs(lambda)) {
+            result.converged = true;
+            break;
+        }
+        previous = lambda;
+        x = y.cwiseQuotient(masses);
+        x.normalize();
+    }
+    // END EXERCISE
+    return result;
+}
+
+double damping_ratio(const Damping& damping, double omega)
+{
+    require_positive(omega, "angular frequency omega [rad/s]");
+    return damping.alpha / (2.0 * omega) + damping.beta * omega / 2.0;
+}
+
+double explicit_stability_limit(double omega, double xi)
+{
+    require_positive(omega, "angular frequency omega [rad/s]");
+    if (!(std::isfinite(xi) && xi >= 0.0))
+        throw Error(str("the damping ratio xi must be finite and >= 0, got ", xi));
+    // BEGIN EXERCISE 10.6 explicit_stability_limit #the-explicit-stability-limit
+    // HINT: symplectic Euler on q̈ + 2ξω q̇ + ω² q = 0 is stable while (ωΔt)² + 4ξ(ωΔt) ≤ 4:
+    // HINT: Δt_max = (2/ω)(√(1 + ξ²) − ξ); 2/ω without damping.
+    return 2.0 / omega * (std::sqrt(1.0 + xi * xi) - xi);
+    // END EXERCISE
+}
+
+Eigen::Matrix2d oscillator_step_matrix(double omega, double xi, double time_step, double theta)
+{
+    require_oscillator(omega, xi, time_step, theta);
+    Eigen::Matrix2d G;
+    // BEGIN EXERCISE 10.7 oscillator_step_matrix #one-mode-one-oscillator
+    // HINT: substitute q⁺ = q + Δt(θp⁺ + (1−θ)p) into the p-equation and solve for p⁺:
+    // HINT: a p⁺ = −Δtω² q + (1 − θ(1−θ)ω²Δt² − 2(1−θ)ξωΔt) p with a = 1 + 2θξωΔt + θ²ω²Δt².
+    // HINT: Row 1 of G maps (q, p) to q⁺, row 2 to p⁺.
+    const double h = time_step, w2 = omega * omega;
+    const double a = 1.0 + 2.0 * theta * xi * omega * h + theta * theta * w2 * h * h;
+    const double p_from_q = -h * w2 / a;
+    const double p_from_p = (1.0 - theta * (1.0 - theta) * w2 * h * h - 2.0 * (1.0 - theta) * xi * omega * h) / a;
+    G << 1.0 + theta * h * p_from_q, theta * h * p_from_p + (1.0 - theta) * h,
+         p_from_q, p_from_p;
+    // END EXERCISE
+    return G;
+}
+
+Eigen::Matrix2d symplectic_oscillator_step_matrix(double omega, double xi, double time_step)
+{
+    require_oscillator(omega, xi, time_step, 1.0);
+    const double h = time_step, w2 = omega * omega;
+    const double p_from_q = -h * w2, p_from_p = 1.0 - 2.0 * xi * omega * h;
+    Eigen::Matrix2d G;
+    G << 1.0 + h * p_from_q, h * p_from_p,
+         p_from_q, p_from_p;
+    return G;
+}
+
+Eigen::Vector2d exact_oscillator(double omega, double xi, double q0, double p0, double t)
+{
+    require_positive(omega, "angular frequency omega [rad/s]");
+    if (!(std::isfinite(xi) && xi >= 0.0))
+        throw Error(str("the damping ratio xi must be finite and >= 0, got ", xi));
+    require_finite(t, "time t [s]");
+    if (std::abs(xi - 1.0) < 1e-9) {  // critically damped
+        const double decay = std::exp(-omega * t), c = p0 + omega * q0;
+        return {decay * (q0 + c * t), decay * (p0 - omega * c * t)};
+    }
+    if (xi < 1.0) {
+        const double wd = omega * std::sqrt(1.0 - xi * xi), decay = std::exp(-xi * omega * t);
+        const double c = std::cos(wd * t), s = std::sin(wd * t);
+        return {decay * (q0 * c + (p0 + xi * omega * q0) / wd * s),
+                decay * (p0 * c - (omega * omega * q0 + xi * omega * p0) / wd * s)};
+    }
+    const double root = std::sqrt(xi * xi - 1.0);
+    const double r1 = -omega * (xi - root), r2 = -omega * (xi + root);
+    const double c1 = (p0 - r2 * q0) / (r1 - r2), c2 = q0 - c1;
+    return {c1 * std::exp(r1 * t) + c2 * std::exp(r2 * t), r1 * c1 * std::exp(r1 * t) + r2 * c2 * std::exp(r2 * t)};
+}
+
+ModalSolution::ModalSolution(const SparseMatrix& K, const SparseMatrix& M, const Eigen::VectorXd& f,
+                             const Damping& damping, const Eigen::VectorXd& u0, const Eigen::VectorXd& v0)
+    : modes_(lowest_modes_dense(K, M, static_cast<int>(K.rows())))
+{
+    const Eigen::Index n = K.rows();
+    if (f.size() != n || u0.size() != n || v0.size() != n)
+        throw Error(str("modal solution: f, u0 and v0 need n = ", n, " entries, got ", f.size(), ", ", u0.size(),
+                        " and ", v0.size()));
+    if (!(damping.alpha >= 0.0 && damping.beta >= 0.0))
+        throw Error("modal solution: the Rayleigh coefficients must be >= 0");
+    if (!(modes_.omega[0] > 0.0))
+        throw Error("modal solution: K is singular (a free body has rigid modes): pin vertices");
+    const Eigen::MatrixXd& Phi = modes_.shapes;
+    static_ = Phi * (Phi.transpose() * f).cwiseQuotient(modes_.omega.cwiseAbs2());
+    q0_ = Phi.transpose() * (M * (u0 - static_));
+    p0_ = Phi.transpose() * (M * v0);
+    xi_.resize(n);
+    for (Eigen::Index k = 0; k < n; ++k)
+        xi_[k] = damping_ratio(damping, modes_.omega[k]);
+}
+
+Eigen::Vector2d ModalSolution::coordinate(Eigen::Index k, double t) const
+{
+    return exact_oscillator(modes_.omega[k], xi_[k], q0_[k], p0_[k], t);
+}
+
+Eigen::VectorXd ModalSolution::displacement(double t) const
+{
+    Eigen::VectorXd q(modes_.omega.size());
+    for (Eigen::Index k = 0; k < q.size(); ++k)
+        q[k] = coordinate(k, t)[0];
+    return static_ + modes_.shapes * q;
+}
+
+Eigen::VectorXd ModalSolution::velocity(double t) const
+{
+    Eigen::VectorXd p(modes_.omega.size());
+    for (Eigen::Index k = 0; k < p.size(); ++k)
+        p[k] = coordinate(k, t)[1];
+    return modes_.shapes * p;
+}
+
+double euler_bernoulli_first_frequency(double youngs_modulus, double density, double length, double area,
+                                       double second_moment)
+{
+    require_positive(youngs_modulus, "Young's modulus Y [Pa]");
+    require_positive(density, "density rho [kg/m^3]");
+    require_positive(length, "length L [m]");
+    require_positive(area, "cross-section area A [m^2]");
+    require_positive(second_moment, "second moment of area I [m^4]");
+    const double beta1 = 1.8751040687119611;  // first root of cos(b) cosh(b) = -1
+    return beta1 * beta1 / (2.0 * pi) * std::sqrt(youngs_modulus * second_moment / (density * area * std::pow(length, 4)));
+}
+
+}  // namespace fem::dynamics

@@ -1,0 +1,329 @@
+#include "10_linear_dynamics/time_integration.hpp"
+
+#include "common/error.hpp"
+
+#include <cmath>
+
+namespace fem::dynamics {
+namespace {
+
+void require_theta(double theta)
+{
+    if (!(theta >= 0.5 && theta <= 1.0))
+        throw Error(str("theta must lie in [0.5, 1] (0.5: implicit midpoint, 1: backward Euler), got ", theta));
+}
+
+void require_fits(const Body& body, const State& state)
+{
+    const Eigen::Index n = body.dofs().full_size();
+    if (state.u.size() != n || state.v.size() != n || state.forces.size() != n)
+        throw Error(str("the state does not fit the body: u, v and forces need 3n = ", n, " entries, got ",
+                        state.u.size(), ", ", state.v.size(), " and ", state.forces.size()));
+}
+
+/// D x = α M x + β K x; Kx is K x when β ≠ 0 (else unused).
+Eigen::VectorXd damping_times(const Body& body, const Eigen::VectorXd& x, const Eigen::VectorXd& Kx)
+{
+    const Damping& d = body.scene().damping;
+    Eigen::VectorXd Dx = d.alpha * (body.mass_matrix() * x);
+    if (d.beta != 0.0)
+        Dx += d.beta * Kx;
+    return Dx;
+}
+
+}  // namespace
+
+State initial_state(Body& body, const Eigen::VectorXd& u0, const Eigen::VectorXd& v0)
+{
+    const Eigen::Index n = body.dofs().full_size();
+    State state;
+    state.u = u0.size() == 0 ? Eigen::VectorXd::Zero(n) : u0;
+    state.v = v0.size() == 0 ? Eigen::VectorXd::Zero(n) : v0;
+    for (const auto& [x, name] : {std::pair{&state.u, "initial displacement u0"}, std::pair{&state.v, "initial velocity v0"}}) {
+        if (x->size() != n)
+            throw Error(str(name, " has ", x->size(), " entries, expected 3n = ", n));
+        for (Eigen::Index i = 0; i < n; ++i) {
+            if (!std::isfinite((*x)[i]))
+                throw Error(str(name, " has the non-finite value ", (*x)[i], " at dof ", i));
+            if (body.dofs().free_mask()[i] == 0.0 && (*x)[i] != 0.0)
+                throw Error(str(name, " is ", (*x)[i], " at dof ", i, " of pinned vertex ", i / 3,
+                                "; pinned vertices stay at rest"));
+        }
+    }
+    state.elastic_energy = body.model().evaluate(state.u, state.forces);
+    return state;
+}
+
+Energies energies(const Body& body, const State& state)
+{
+    Energies e;
+    // BEGIN EXERCISE 10.4 energies #energy
+    // HINT: kinetic ½ vᵀ M v (kinetic_energy), elastic: the force model's U kept in the state,
+    // HINT: gravitational: the load potential −f_extᵀ u (load_potential).
+    e.kinetic = kinetic_energy(body.mass_matrix(), state.v);
+    e.elastic = state.elastic_energy;
+    e.gravitational = load_potential(body.external_forces(), state.u);
+    // END EXERCISE
+    return e;
+}
+
+SparseMatrix step_matrix(const SparseMatrix& M, const SparseMatrix& K, const Damping& damping, double time_step,
+                         double theta)
+{
+    require_positive(time_step, "time step dt [s]");
+    require_theta(theta);
+    if (M.rows() != K.rows() || M.cols() != K.cols() || M.rows() != M.cols())
+        throw Error(str("step matrix: M (", M.rows(), "x", M.cols(), ") and K (", K.rows(), "x", K.cols(),
+                        ") must be square and of one size"));
+    // BEGIN EXERCISE 10.1 step_matrix #the-implicit-step
+    // HINT: D = α M + β K, so A = M + θΔt D + θ²Δt² K = (1 + θΔt α) M + (θΔt β + θ²Δt²) K:
+    // HINT: one weighted sum of two sparse matrices.
+    const double h = theta * time_step;
+    return (1.0 + h * damping.alpha) * M + (h * damping.beta + h * h) * K;
+    // END EXERCISE
+}
+
+Eigen::VectorXd step_right_hand_side(const SparseMatrix& M, const Eigen::VectorXd& v, const Eigen::VectorXd& forces,
+                                     const Eigen::VectorXd& external_forces, double time_step)
+{
+    require_positive(time_step, "time step dt [s]");
+    if (M.rows() != v.size() || forces.size() != v.size() || external_forces.size() != v.size())
+        throw Error(str("step right-hand side: M is ", M.rows(), "x", M.cols(), ", v, f and f_ext have ", v.size(),
+                        ", ", forces.size(), " and ", external_forces.size(), " entries"));
+    // BEGIN EXERCISE 10.2 step_right_hand_side #the-implicit-step
+    // HINT: b = M v − Δt [K u − f_ext] = M v + Δt (f + f_ext), with the internal forces f = −K u.
+    return M * v + time_step * (forces + external_forces);
+    // END EXERCISE
+}
+
+Eigen::VectorXd velocity_change_right_hand_side(const SparseMatrix& M, const Eigen::VectorXd& v,
+                                                const Eigen::VectorXd& Kv, const Eigen::VectorXd& forces,
+                                                const Eigen::VectorXd& external_forces, const Damping& damping,
+                                                double time_step, double theta)
+{
+    require_positive(time_step, "time step dt [s]");
+    require_theta(theta);
+    if (M.rows() != v.size() || Kv.size() != v.size() || forces.size() != v.size() ||
+        external_forces.size() != v.size())
+        throw Error(str("velocity-change right-hand side: M is ", M.rows(), "x", M.cols(), ", v, K v, f and f_ext have ",
+                        v.size(), ", ", Kv.size(), ", ", forces.size(), " and ", external_forces.size(), " entries"));
+    const Eigen::VectorXd Dv = damping.alpha * (M * v) + damping.beta * Kv;
+    return time_step * (forces + external_forces - Dv - (theta * time_step) * Kv);
+}
+
+// --- ThetaMethod ------------------------------------------------------------------------------
+
+ThetaMethod::ThetaMethod(double theta, ImplicitOptions options)
+    : theta_((require_theta(theta), theta)), options_(std::move(options)),
+      solver_(cg::make_solver(options_.solver, options_.solver_options))
+{
+}
+
+std::string ThetaMethod::name() const
+{
+    if (theta_ == 1.0)
+        return "backward Euler";
+    if (theta_ == 0.5)
+        return "implicit midpoint";
+    return str("theta = ", theta_);
+}
+
+StepInfo ThetaMethod::step(Body& body, double time_step, State& state)
+{
+    require_positive(time_step, "time step dt [s]");
+    require_fits(body, state);
+    ForceModel& model = body.model();
+    const FreeDofs& dofs = body.dofs();
+    const SparseMatrix& M = body.mass_matrix();
+    const bool eliminate = options_.pinned == PinnedRoute::eliminate;
+    const SparseMatrix& K = model.stiffness(state.u);
+    StepInfo info;
+
+    if (solver_->size() == 0 || options_.refactor_every_step || !model.constant_stiffness() ||
+        time_step != prepared_time_step_ || &body != prepared_body_) {
+        const SparseMatrix A = step_matrix(M, K, body.scene().damping, time_step, theta_);
+        solver_->prepare(eliminate ? dofs.reduce(A) : dofs.project(A));
+        prepared_time_step_ = time_step;
+        prepared_body_ = &body;
+        info.prepared = true;
+    }
+
+    Eigen::VectorXd v_next, v_theta, u_next;
+    // BEGIN EXERCISE 10.3 theta_step #the-implicit-step
+    // HINT: velocity_change form: r = velocity_change_right_hand_side(M, v, K v, f, f_ext, D, Δt, θ),
+    // HINT: solve A Δv = r, v⁺ = v + Δv. velocity form: b = step_right_hand_side(M, v, f, f_ext, Δt),
+    // HINT: minus (1 − θ)Δt (D v + θΔt K v) when θ < 1 (damping_times gives D v); solve A v⁺ = b.
+    // HINT: Solve on the free dofs (eliminate: gather, solve, scatter; keep: zero the pinned rows
+    // HINT: of the right-hand side, solve all 3n). Then v_θ = θ v⁺ + (1 − θ) v, u⁺ = u + Δt v_θ.
+    const bool change = options_.form == StepForm::velocity_change;
+    Eigen::VectorXd Kv;
+    if (change || theta_ < 1.0)
+        Kv = K * state.v;
+    Eigen::VectorXd b;
+    if (change) {
+        b = velocity_change_right_hand_side(M, state.v, Kv, state.forces, body.external_forces(),
+                                            body.scene().damping, time_step, theta_);
+    } else {
+        b = step_right_hand_side(M, state.v, state.forces, body.external_forces(), time_step);
+        if (theta_ < 1.0)
+            b -= ((1.0 - theta_) * time_step) * (damping_times(body, state.v, Kv) + (theta_ * time_step) * Kv);
+    }
+    // solution_ still holds the previous answer: the warm start of an iterative solver.
+    v_next = Eigen::VectorXd::Zero(state.v.size());
+    if (eliminate) {
+        rhs_ = dofs.gather(b);
+        if (solution_.size() != rhs_.size())
+            solution_ = change ? Eigen::VectorXd::Zero(rhs_.size()) : dofs.gather(state.v);
+        solver_->solve(rhs_, solution_);
+        dofs.scatter(solution_, v_next);
+    } else {
+        rhs_ = b.cwiseProduct(dofs.free_mask());
+        if (solution_.size() != rhs_.size())
+            solution_ = change ? Eigen::VectorXd::Zero(rhs_.size()) : Eigen::VectorXd(state.v);
+        solver_->solve(rhs_, solution_);
+        v_next = solution_.cwiseProduct(dofs.free_mask());  // exactly zero on the pinned dofs
+    }
+    if (change)
+        v_next += state.v;
+    v_theta = theta_ * v_next + (1.0 - theta_) * state.v;
+    u_next = state.u + time_step * v_theta;
+    // END EXERCISE
+
+    info.solver_iterations = solver_->stats().iterations;
+    const Damping& d = body.scene().damping;
+    if (d.alpha != 0.0 || d.beta != 0.0) {
+        const Eigen::VectorXd Kv = d.beta != 0.0 ? Eigen::VectorXd(K * v_theta) : Eigen::VectorXd();
+        info.damping_work = time_step * v_theta.dot(damping_times(body, v_theta, Kv));
+    }
+    Eigen::VectorXd forces;
+    const double elastic = model.evaluate(u_next, forces);
+    state.u = std::move(u_next);
+    state.v = std::move(v_next);
+    state.forces = std::move(forces);
+    state.elastic_energy = elastic;
+    state.time += time_step;
+    state.step += 1;
+    return info;
+}
+
+// --- SymplecticEuler ----------------------------------------------------------------------------
+
+StepInfo SymplecticEuler::step(Body& body, double time_step, State& state)
+{
+    require_positive(time_step, "time step dt [s]");
+    require_fits(body, state);
+    ForceModel& model = body.model();
+    const FreeDofs& dofs = body.dofs();
+    const Damping& d = body.scene().damping;
+    const bool lumped = body.scene().mass == MassModel::lumped;
+    StepInfo info;
+    if (!lumped && (mass_solver_ == nullptr || prepared_body_ != &body)) {
+        mass_solver_ = cg::make_solver("default");
+        mass_solver_->prepare(dofs.reduce(body.mass_matrix()));
+        prepared_body_ = &body;
+        info.prepared = true;
+    }
+    Eigen::VectorXd Kv;
+    if (d.beta != 0.0)
+        Kv = model.stiffness(state.u) * state.v;
+    const Eigen::VectorXd damping_force = damping_times(body, state.v, Kv);
+
+    Eigen::VectorXd v_next, u_next;
+    // BEGIN EXERCISE 10.5 symplectic_euler_step #explicit-euler
+    // HINT: a = f + f_ext − D v on the free dofs; lumped: M⁻¹ a is a division by dof_masses();
+    // HINT: consistent: solve M_ff x = a_f with mass_solver_. Then v⁺ = v + Δt M⁻¹ a (pinned dofs
+    // HINT: stay 0) and u⁺ = u + Δt v⁺ (the NEW velocity: that is what makes it symplectic).
+    const Eigen::VectorXd net = dofs.gather(state.forces + body.external_forces() - damping_force);
+    Eigen::VectorXd acceleration;
+    if (lumped)
+        acceleration = net.cwiseQuotient(dofs.gather(body.dof_masses()));
+    else
+        acceleration = mass_solver_->solve(net);
+    v_next = state.v;
+    dofs.scatter(dofs.gather(state.v) + time_step * acceleration, v_next);
+    u_next = state.u + time_step * v_next;
+    // END EXERCISE
+
+    info.damping_work = time_step * v_next.dot(damping_force);
+    Eigen::VectorXd forces;
+    const double elastic = model.evaluate(u_next, forces);
+    state.u = std::move(u_next);
+    state.v = std::move(v_next);
+    state.forces = std::move(forces);
+    state.elastic_energy = elastic;
+    state.time += time_step;
+    state.step += 1;
+    return info;
+}
+
+std::unique_ptr<Integrator> make_integrator(std::string_view name, const ImplicitOptions& options)
+{
+    if (name == "backward-euler")
+        return std::make_unique<ThetaMethod>(1.0, options);
+    if (name == "implicit-midpoint")
+        return std::make_unique<ThetaMethod>(0.5, options);
+    if (name == "symplectic-euler")
+        return std::make_unique<SymplecticEuler>();
+    std::string names;
+    for (const std::string& known : integrator_names())
+        names += (names.empty() ? "" : ", ") + known;
+    throw Error(str("unknown integrator '", name, "'; choose one of: ", names));
+}
+
+std::vector<std::string> integrator_names()
+{
+    return {"backward-euler", "implicit-midpoint", "symplectic-euler"};
+}
+
+// --- Simulation ----------------------------------------------------------------------------------
+
+Simulation::Simulation(Body& body, Integrator& integrator, State initial, double time_step)
+    : body_(body), integrator_(integrator), state_(std::move(initial)), time_step_(time_step)
+{
+    require_positive(time_step, "time step dt [s]");
+    require_fits(body, state_);
+}
+
+void Simulation::run(int steps, const Observer& observer)
+{
+    if (steps < 0)
+        throw Error(str("the number of steps must be >= 0, got ", steps));
+    if (!started_) {
+        last_ = StepRecord{state_.step, state_.time, energies(body_, state_), 0.0, 0.0, 0};
+        initial_total_ = last_.energies.total();
+        largest_magnitude_ = last_.energies.magnitude();
+        started_ = true;
+        if (observer)
+            observer(state_, last_);
+    }
+    for (int k = 0; k < steps; ++k) {
+        const StepInfo info = integrator_.step(body_, time_step_, state_);
+        StepRecord record;
+        record.step = state_.step;
+        record.time = state_.time;
+        record.energies = energies(body_, state_);
+        record.solver_iterations = info.solver_iterations;
+        record.damping_dissipated = last_.damping_dissipated + info.damping_work;
+        const double total = record.energies.total();
+        const auto where = [&] {
+            return str("step ", record.step, " (t = ", record.time, " s, dt = ", time_step_, " s, ",
+                       integrator_.name(), ")");
+        };
+        if (!std::isfinite(total) || !state_.u.allFinite() || !state_.v.allFinite())
+            throw Error(str("the run diverged at ", where(), ": the state is no longer finite (energy ", total,
+                            " J); use a smaller dt or an implicit integrator"));
+        largest_magnitude_ = std::max(largest_magnitude_, record.energies.magnitude());
+        const double rise = total - initial_total_;
+        if (rise > divergence_energy_fraction * largest_magnitude_)
+            throw Error(str("the run diverged at ", where(), ": the total energy rose from ", initial_total_,
+                            " J to ", total, " J, by ", rise / std::max(largest_magnitude_, 1e-300),
+                            " of the largest energy in play (the limit is ", divergence_energy_fraction,
+                            "); an explicit step above its stability limit does this: use a smaller dt"));
+        record.integrator_dissipated = initial_total_ - total - record.damping_dissipated;
+        last_ = record;
+        if (observer)
+            observer(state_, last_);
+    }
+}
+
+}  // namespace fem::dynamics
