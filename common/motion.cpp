@@ -17,16 +17,20 @@ MotionRecorder::MotionRecorder(std::filesystem::path pvd_path, int png_every)
 
 void MotionRecorder::add(double time, const MeshData& frame)
 {
-    MeshData deformed = warped(frame);  // checks the displacement field before anything is written
+    warped(frame);  // checks the displacement field before anything is written
     series_.add(time, frame);
     if (png_every_ > 0 && added_ % static_cast<std::size_t>(png_every_) == 0)
-        kept_.emplace_back(time, std::move(deformed));
+        kept_.emplace_back(time, frame);
     ++added_;
 }
 
-int MotionRecorder::render_png_frames(const std::filesystem::path& stem, const fig::RenderOptions& options) const
+int MotionRecorder::render_png_frames(const std::filesystem::path& stem, const fig::RenderOptions& options,
+                                      double warp_scale) const
 {
-    if (kept_.empty() || !fig::display_available())
+    std::vector<std::pair<double, MeshData>> deformed;
+    for (const auto& [time, mesh] : kept_)
+        deformed.emplace_back(time, warped(mesh, warp_scale));
+    if (deformed.empty() || !fig::display_available())
         return 0;
     fig::RenderOptions shared = options;
     std::array<double, 6> box{};
@@ -35,7 +39,7 @@ int MotionRecorder::render_png_frames(const std::filesystem::path& stem, const f
         box[2 * axis + 1] = -std::numeric_limits<double>::infinity();
     }
     double low = std::numeric_limits<double>::infinity(), high = -low;
-    for (const auto& [time, mesh] : kept_) {
+    for (const auto& [time, mesh] : deformed) {
         for (int axis = 0; axis < 3; ++axis) {
             box[2 * axis] = std::min(box[2 * axis], mesh.points.col(axis).minCoeff());
             box[2 * axis + 1] = std::max(box[2 * axis + 1], mesh.points.col(axis).maxCoeff());
@@ -51,13 +55,14 @@ int MotionRecorder::render_png_frames(const std::filesystem::path& stem, const f
     if (!shared.range)
         shared.range = std::make_pair(low, high);
     int written = 0;
-    for (const auto& [time, mesh] : kept_) {
+    const std::string scale = warp_scale == 1.0 ? std::string() : str(" (displacement x ", warp_scale, ")");
+    for (const auto& [time, mesh] : deformed) {
         char suffix[32];
         std::snprintf(suffix, sizeof suffix, "_%04d.png", written);
         std::filesystem::path path = stem;
         path += suffix;
         fig::RenderOptions frame_options = shared;
-        frame_options.title = str(options.title, ", t = ", time, " s");
+        frame_options.title = str(options.title, scale, ", t = ", time, " s");
         written += fig::render_mesh_png(path, mesh, frame_options) ? 1 : 0;
     }
     return written;

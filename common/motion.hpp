@@ -27,18 +27,20 @@ public:
 
     std::size_t frames() const { return series_.frames(); }
 
-    /// Renders the kept frames, warped by their displacement (true scale), to <stem>_0000.png, …:
-    /// one camera framing the union of the deformed bodies' bounds, and one colour range for
-    /// options.field over all kept frames (unless options.range is set). The title gets ", t = …
-    /// s" appended. Returns the number of PNGs written (0 without a display, see figures.hpp).
-    /// fem::Error if the field is missing from a frame.
-    int render_png_frames(const std::filesystem::path& stem, const fig::RenderOptions& options) const;
+    /// Renders the kept frames, warped by warp_scale × their displacement (1: true scale), to
+    /// <stem>_0000.png, …: one camera framing the union of the deformed bodies' bounds, and one
+    /// colour range for options.field over all kept frames (unless options.range is set). The title
+    /// gets ", t = … s" appended (and "displacement × k" when warp_scale ≠ 1). Returns the number of
+    /// PNGs written (0 without a display, see figures.hpp). fem::Error if the field is missing from
+    /// a frame or warp_scale is not finite.
+    int render_png_frames(const std::filesystem::path& stem, const fig::RenderOptions& options,
+                          double warp_scale = 1.0) const;
 
 private:
     PvdSeries series_;
     int png_every_;
     std::size_t added_ = 0;
-    std::vector<std::pair<double, MeshData>> kept_;  // warped frames for the PNGs
+    std::vector<std::pair<double, MeshData>> kept_;  // frames for the PNGs
 };
 
 }  // namespace fem::io

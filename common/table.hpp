@@ -5,7 +5,10 @@
 // depends on the machine (a wall time, a rate, a bandwidth) carries its unit in brackets with a
 // time in it: "time [s]", "rate [1/s]", "bandwidth [GB/s]", or "[measured]" for a machine-dependent
 // ratio ("fraction of triad [measured]"). Those columns are reported but never compared against
-// stored numbers; every other column must reproduce.
+// stored numbers; every other column must reproduce. Round-off is held to a bound, not to its
+// digits: a stored value ≤ 1e-12 passes while it stays ≤ 1e-10, and a column named "… [round-off]"
+// (round-off amplified by a condition number) passes while it grows less than 100× (see
+// tools/csv_compare.py). A parameter with a unit is written "dt (s)", not "dt [s]".
 
 #include <filesystem>
 #include <iosfwd>

@@ -25,7 +25,7 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from csv_compare import as_number, close, is_measured, read_csv  # noqa: E402
+from csv_compare import as_number, close, is_measured, is_roundoff, read_csv  # noqa: E402
 from exercises import all_exercises  # noqa: E402
 
 RUN = re.compile(r"<!-- fem:run (?P<exe>\S+)(?P<args>[^>]*?)\s*-->")
@@ -153,7 +153,8 @@ def check_tables(text, out):
                 if is_measured(column):
                     continue
                 a, b = as_number(want[c]), as_number(got[c])
-                same = close(a, b, RELATIVE_TOLERANCE) if a is not None and b is not None else want[c] == got[c]
+                same = (close(a, b, RELATIVE_TOLERANCE, is_roundoff(column)) if a is not None and b is not None
+                        else want[c] == got[c])
                 if not same:
                     problems.append(f"{name}, row {r + 1}, column '{column}': the docs say {want[c]}, "
                                     f"the executable prints {got[c]}")

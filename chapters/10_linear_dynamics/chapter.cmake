@@ -10,3 +10,9 @@ endif()
 foreach(target IN LISTS fem_ch10_libraries)
   target_link_libraries(${target} PRIVATE Spectra::Spectra)
 endforeach()
+
+# The executable's studies, one file each (studies.hpp); not part of the chapter's library.
+target_sources(${exe} PRIVATE
+  ${FEM_ROOT}/chapters/10_linear_dynamics/study_common.cpp ${FEM_ROOT}/chapters/10_linear_dynamics/study_modes.cpp
+  ${FEM_ROOT}/chapters/10_linear_dynamics/study_accuracy.cpp ${FEM_ROOT}/chapters/10_linear_dynamics/study_cost.cpp
+  ${FEM_ROOT}/chapters/10_linear_dynamics/study_scenes.cpp)

@@ -97,6 +97,8 @@ public:
                   const Eigen::VectorXd& u0, const Eigen::VectorXd& v0);
 
     Eigen::VectorXd displacement(double t) const;  ///< u(t) (n)
+    /// One entry u_dof(t), in O(n) instead of O(n²). fem::Error for a dof outside [0, n).
+    double displacement(double t, Eigen::Index dof) const;
     Eigen::VectorXd velocity(double t) const;      ///< u̇(t) (n)
     const Modes& modes() const { return modes_; }
     const Eigen::VectorXd& static_solution() const { return static_; }

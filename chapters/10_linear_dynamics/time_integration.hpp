@@ -118,7 +118,7 @@ struct StepInfo {
     bool prepared = false;       ///< the step (re)factored its matrix
 };
 
-/// One step from (u, v) to (u⁺, v⁺) for a body. docs/10_linear_dynamics.md#integrators
+/// One step from (u, v) to (u⁺, v⁺) for a body. docs/10_linear_dynamics.md#the-pieces-of-a-simulation
 class Integrator {
 public:
     virtual ~Integrator() = default;

@@ -281,6 +281,16 @@ Eigen::VectorXd ModalSolution::displacement(double t) const
     return static_ + modes_.shapes * q;
 }
 
+double ModalSolution::displacement(double t, Eigen::Index dof) const
+{
+    if (dof < 0 || dof >= static_.size())
+        throw Error(str("modal solution: dof ", dof, " is outside [0, ", static_.size(), ")"));
+    double u = static_[dof];
+    for (Eigen::Index k = 0; k < modes_.omega.size(); ++k)
+        u += modes_.shapes(dof, k) * coordinate(k, t)[0];
+    return u;
+}
+
 Eigen::VectorXd ModalSolution::velocity(double t) const
 {
     Eigen::VectorXd p(modes_.omega.size());

@@ -1,6 +1,6 @@
 // Chapter 10: integrators and the time loop on whole bodies: energy bookkeeping, statics, free
 // fall, pinned dofs two ways, solvers, and the stability hard cases.
-// docs/10_linear_dynamics.md#integrators
+// docs/10_linear_dynamics.md#the-pieces-of-a-simulation
 #include "dynamics_fixtures.hpp"
 
 #include "common/error.hpp"
@@ -179,7 +179,7 @@ TEST_CASE("pinned dofs eliminated or kept with P A P + (I - P): the same traject
     }
 }
 
-TEST_CASE("solvers: factor once = refactor every step; warm-started PCG agrees and needs fewer iterations",
+TEST_CASE("solvers: factor once = refactor every step, and warm-started PCG agrees and needs fewer iterations",
           "[ch10]")
 {
     Scene scene = cantilever_scene(8, 2, true);
@@ -240,7 +240,7 @@ TEST_CASE("symplectic Euler follows its own modal recurrence, with lumped and co
     }
 }
 
-TEST_CASE("stability: explicit Euler blows up at 1.01x its limit and the loop says so; bounded at 0.99x",
+TEST_CASE("stability: explicit Euler blows up at 1.01x its limit and the loop says so, bounded at 0.99x",
           "[ex10.5][ex10.6]")
 {
     const Scene scene = cantilever_scene(6, 2, true);
