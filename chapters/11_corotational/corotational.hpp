@@ -1,0 +1,118 @@
+#pragma once
+// Chapter 11: corotational linear elasticity. docs/11_corotational.md
+//
+// Linear elasticity measures strain with ε = ½(∇u + ∇uᵀ), which is not zero when a body merely
+// rotates: a rotated beam grows and shears (chapter 05's rotation table). The corotational element
+// removes the rotation first. For each tet, find the rotation R_e that best maps its rest edges to
+// its deformed edges, measure the displacement in the element's rotated frame, apply the linear
+// element there and rotate the forces back:
+//     f_e = −R_e K_e (R_eᵀ x_e − X_e),          (x_e, X_e: the 12 deformed and rest coordinates)
+//     U_e = ½ (R_eᵀ x_e − X_e)ᵀ K_e (R_eᵀ x_e − X_e),
+//     K_R = Σ_e E_eᵀ R̂_e K_e R̂_eᵀ E_e,           R̂_e = diag(R_e, R_e, R_e, R_e) (12×12),
+// K_R being the "warped stiffness" (the derivative of R_e is left out, as in the lecture). Rotating
+// a whole body by Q rotates every R_e by Q, so the forces rotate with it and the energy does not
+// change: no ghost growth.
+//
+// The best-fit rotation (the lecture's "Finding Best-Fit Rotation"): with the rest edges
+// P = [X₁ − X₀; X₂ − X₀; X₃ − X₀] and the deformed edges Q (one edge a row, 3×3), S = Pᵀ Q = U Σ Vᵀ
+// and the rotation that takes rest to deformed is R = V Uᵀ. The slide writes U Vᵀ, which is its
+// inverse (its transpose); with it the forces would be rotated the wrong way. If det(V Uᵀ) < 0 (a
+// reflection: the tet is inverted or flat), the sign of V's column of the smallest singular value
+// is flipped, giving the closest proper rotation.
+
+#include "10_linear_dynamics/body.hpp"
+
+#include "04_tet_jacobians/tet_jacobians.hpp"
+#include "05_strain_stress/strain_stress.hpp"
+#include "06_assembly/assembly.hpp"
+
+#include <Eigen/Core>
+
+#include <string>
+#include <vector>
+
+namespace fem::corot {
+
+using Matrix12d = elastic::Matrix12d;
+using Vector12d = Eigen::Matrix<double, 12, 1>;
+
+/// S = Pᵀ Q (3×3) with P and Q the rest and deformed edge matrices of one tet: row i is
+/// X_{i+1} − X₀ and x_{i+1} − x₀ (i = 0, 1, 2), the lecture's. It depends on which corner is X₀.
+/// docs/11_corotational.md#the-best-fit-rotation
+Eigen::Matrix3d edge_covariance(const tet::TetVertices& X, const tet::TetVertices& x);
+
+/// S = Σᵢ (Xᵢ − X̄)(xᵢ − x̄)ᵀ over the four corners about their centroids (3×3): the same
+/// least-squares fit with every corner weighted alike, independent of the corner order.
+/// docs/11_corotational.md#edges-centroid-or-polar-decomposition
+Eigen::Matrix3d centroid_covariance(const tet::TetVertices& X, const tet::TetVertices& x);
+
+/// The proper rotation R (RᵀR = I, det R = +1) that best maps rest edges to deformed edges:
+/// S = U Σ Vᵀ (Eigen's JacobiSVD), R = V Uᵀ, and when det(V Uᵀ) < 0 the column of V belonging to
+/// the smallest singular value changes sign. S = 0 (every edge collapsed) gives R = I. Never NaN for
+/// finite S; fem::Error for a non-finite S. docs/11_corotational.md#the-best-fit-rotation
+Eigen::Matrix3d best_fit_rotation(const Eigen::Matrix3d& S);
+
+/// The rotation of the polar decomposition F = R_p S_p (S_p symmetric positive semi-definite), from
+/// the SVD F = U Σ Vᵀ: R_p = U Vᵀ, with the same reflection fix; the rotation closest to F
+/// (it minimises ‖F − R‖). For a tet, F = Qᵀ P⁻ᵀ; R_p equals the edge fit when PᵀP ∝ I (the corner
+/// tet) and the centroid fit when the corners' covariance is ∝ I (a regular tet), and differs from
+/// both for skewed tets. docs/11_corotational.md#edges-centroid-or-polar-decomposition
+Eigen::Matrix3d polar_rotation(const Eigen::Matrix3d& F);
+
+/// R̂ K_e R̂ᵀ with R̂ = diag(R, R, R, R): every 3×3 block (a, b) becomes R K_ab Rᵀ (12×12).
+/// docs/11_corotational.md#forces-and-warped-stiffness
+Matrix12d rotated_stiffness(const Matrix12d& K_e, const Eigen::Matrix3d& R);
+
+/// The element's displacement in its rotated frame, d = R̂ᵀ x_e − X_e (vertex i's block is
+/// Rᵀ x_i − X_i, 12 entries), less its mean over the four corners: that mean is a translation,
+/// which K_e annihilates in exact arithmetic, and removing it keeps a far-moved element's forces
+/// and energy free of its round-off. Zero for a rigid motion x_i = R X_i + c.
+/// docs/11_corotational.md#forces-and-warped-stiffness
+Vector12d corotated_displacement(const Eigen::Matrix3d& R, const Vector12d& x_e, const Vector12d& X_e);
+
+/// The corotated element force f_e = −R̂ K_e (R̂ᵀ x_e − X_e) (12 entries, vertex-major like x_e
+/// and X_e). docs/11_corotational.md#forces-and-warped-stiffness
+Vector12d corotated_force(const Matrix12d& K_e, const Eigen::Matrix3d& R, const Vector12d& x_e, const Vector12d& X_e);
+
+/// Which rotation an element uses (docs/11_corotational.md#edges-centroid-or-polar-decomposition).
+enum class RotationFit {
+    polar,     ///< polar_rotation of the deformation gradient (the default: order-independent, and
+               ///< it leaves RᵀF symmetric, so the corotated strain holds no rotation)
+    centroid,  ///< best_fit_rotation of centroid_covariance (shape matching)
+    edges,     ///< best_fit_rotation of edge_covariance (the lecture's; depends on the corner order)
+};
+
+/// Corotational linear elasticity as a chapter 10 force model: per step, one rotation per tet,
+/// the corotated forces and energy, and the warped stiffness K_R scattered into chapter 06's fixed
+/// CSR pattern (route c: no new pattern, no triplets). K changes with u: chapter 10's implicit step
+/// refactors (or re-preconditions) every step. docs/11_corotational.md#the-force-model
+class CorotationalElasticity final : public dynamics::ForceModel {
+public:
+    /// K_e of every tet at rest (chapter 06's element_stiffnesses) and the assembly pattern.
+    /// fem::Error for bad indices, a zero-volume rest tet (naming it) or a bad material.
+    CorotationalElasticity(const TetMesh& mesh, const dynamics::Material& material,
+                           RotationFit fit = RotationFit::polar);
+
+    std::string name() const override { return "corotational"; }
+    /// Rotations at u, then U = Σ U_e and f = Σ E_eᵀ f_e. fem::Error if u has not 3n entries.
+    double evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& forces) override;
+    /// K_R at u (3n×3n, CSC with both triangles), assembled into the pattern.
+    const dynamics::SparseMatrix& stiffness(const Eigen::VectorXd& u) override;
+    bool constant_stiffness() const override { return false; }
+    /// von Mises of C ε_e with the corotated strain ε_e = B_e (R̂ᵀ x_e − X_e) (chapter 05).
+    Eigen::VectorXd von_mises_stress(const Eigen::VectorXd& u) const override;
+
+    /// The rotation of every tet at u (#T), by the chosen fit.
+    std::vector<Eigen::Matrix3d> rotations(const Eigen::VectorXd& u) const;
+
+private:
+    TetMesh mesh_;
+    elastic::Lame lame_;
+    RotationFit fit_;
+    assembly::ElementMatrices K_e_;
+    assembly::AssemblyPattern pattern_;
+    assembly::CsrMatrix K_R_csr_;
+    dynamics::SparseMatrix K_R_;
+};
+
+}  // namespace fem::corot

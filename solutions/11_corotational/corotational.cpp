@@ -1,0 +1,189 @@
+#include "11_corotational/corotational.hpp"
+
+#include "common/error.hpp"
+#include "common/vtk_io.hpp"
+
+#include <Eigen/LU>
+#include <Eigen/SVD>
+
+#include <cmath>
+
+namespace fem::corot {
+namespace {
+
+/// The proper rotation closest to A Bᵀ from the SVD parts: A Bᵀ, or with the column of the smallest
+/// singular value flipped in A when det(A Bᵀ) < 0. JacobiSVD sorts singular values descending, so
+/// that column is the last.
+Eigen::Matrix3d proper(Eigen::Matrix3d A, const Eigen::Matrix3d& B)
+{
+    if ((A * B.transpose()).determinant() < 0.0)
+        A.col(2) = -A.col(2);
+    return A * B.transpose();
+}
+
+/// x_e as 12 vertex-major coordinates of tet t from a #V×3 matrix.
+Vector12d element_vector(const TetMesh& mesh, const MatrixX3d& positions, Eigen::Index t)
+{
+    Vector12d q;
+    for (int i = 0; i < 4; ++i)
+        q.segment<3>(3 * i) = positions.row(mesh.T(t, i)).transpose();
+    return q;
+}
+
+}  // namespace
+
+Eigen::Matrix3d edge_covariance(const tet::TetVertices& X, const tet::TetVertices& x)
+{
+    Eigen::Matrix3d P, Q;
+    for (int i = 0; i < 3; ++i) {
+        P.row(i) = X.row(i + 1) - X.row(0);
+        Q.row(i) = x.row(i + 1) - x.row(0);
+    }
+    return P.transpose() * Q;
+}
+
+Eigen::Matrix3d centroid_covariance(const tet::TetVertices& X, const tet::TetVertices& x)
+{
+    const Eigen::RowVector3d X_mean = X.colwise().mean(), x_mean = x.colwise().mean();
+    return (X.rowwise() - X_mean).transpose() * (x.rowwise() - x_mean);
+}
+
+Eigen::Matrix3d best_fit_rotation(const Eigen::Matrix3d& S)
+{
+    if (!S.allFinite())
+        throw Error("best-fit rotation: the edge covariance S has a non-finite entry");
+    if (S.isZero(0.0))
+        return Eigen::Matrix3d::Identity();
+    const Eigen::JacobiSVD<Eigen::Matrix3d> svd(S, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    // BEGIN EXERCISE 11.1 best_fit_rotation #the-best-fit-rotation
+    // HINT: S = U Σ Vᵀ. The rotation from rest to deformed is R = V Uᵀ (not the slide's U Vᵀ).
+    // HINT: If det(V Uᵀ) < 0, flip the sign of V's last column (the smallest singular value) first.
+    return proper(svd.matrixV(), svd.matrixU());
+    // END EXERCISE
+}
+
+Eigen::Matrix3d polar_rotation(const Eigen::Matrix3d& F)
+{
+    if (!F.allFinite())
+        throw Error("polar rotation: F has a non-finite entry");
+    if (F.isZero(0.0))
+        return Eigen::Matrix3d::Identity();
+    const Eigen::JacobiSVD<Eigen::Matrix3d> svd(F, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    return proper(svd.matrixU(), svd.matrixV());
+}
+
+Matrix12d rotated_stiffness(const Matrix12d& K_e, const Eigen::Matrix3d& R)
+{
+    Matrix12d rotated;
+    // BEGIN EXERCISE 11.2 rotated_stiffness #forces-and-warped-stiffness
+    // HINT: block (a, b) of the result is R K_ab Rᵀ, K_ab the 3×3 block K_e(3a…3a+2, 3b…3b+2).
+    for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 4; ++b)
+            rotated.block<3, 3>(3 * a, 3 * b) = R * K_e.block<3, 3>(3 * a, 3 * b) * R.transpose();
+    // END EXERCISE
+    return rotated;
+}
+
+Vector12d corotated_displacement(const Eigen::Matrix3d& R, const Vector12d& x_e, const Vector12d& X_e)
+{
+    Vector12d d;
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (int i = 0; i < 4; ++i) {
+        d.segment<3>(3 * i) = R.transpose() * x_e.segment<3>(3 * i) - X_e.segment<3>(3 * i);
+        mean += 0.25 * d.segment<3>(3 * i);
+    }
+    for (int i = 0; i < 4; ++i)
+        d.segment<3>(3 * i) -= mean;  // a translation: K_e ignores it, round-off would not
+    return d;
+}
+
+Vector12d corotated_force(const Matrix12d& K_e, const Eigen::Matrix3d& R, const Vector12d& x_e, const Vector12d& X_e)
+{
+    Vector12d force;
+    // BEGIN EXERCISE 11.3 corotated_force #forces-and-warped-stiffness
+    // HINT: d = corotated_displacement(R, x_e, X_e); apply K_e; rotate each 3-block of K_e d back
+    // HINT: with R and negate: f_e = −R̂ K_e (R̂ᵀ x_e − X_e).
+    const Vector12d local_force = K_e * corotated_displacement(R, x_e, X_e);
+    for (int i = 0; i < 4; ++i)
+        force.segment<3>(3 * i) = -(R * local_force.segment<3>(3 * i));
+    // END EXERCISE
+    return force;
+}
+
+// --- CorotationalElasticity ------------------------------------------------------------------------
+
+CorotationalElasticity::CorotationalElasticity(const TetMesh& mesh, const dynamics::Material& material, RotationFit fit)
+    : mesh_(mesh), lame_(elastic::lame_parameters(material.youngs_modulus, material.poisson_ratio)), fit_(fit),
+      K_e_(assembly::element_stiffnesses(mesh, lame_)), pattern_(mesh), K_R_csr_(pattern_.zero_matrix())
+{
+}
+
+std::vector<Eigen::Matrix3d> CorotationalElasticity::rotations(const Eigen::VectorXd& u) const
+{
+    if (u.size() != 3 * mesh_.V.rows())
+        throw Error(str("displacement has ", u.size(), " entries, expected 3n = ", 3 * mesh_.V.rows()));
+    const MatrixX3d x = mesh_.V + io::vertex_rows(u);
+    std::vector<Eigen::Matrix3d> R(static_cast<std::size_t>(mesh_.T.rows()));
+    for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t) {
+        const tet::TetVertices rest = tet::tet_vertices(mesh_, mesh_.V, static_cast<int>(t));
+        const tet::TetVertices now = tet::tet_vertices(mesh_, x, static_cast<int>(t));
+        Eigen::Matrix3d& R_t = R[static_cast<std::size_t>(t)];
+        switch (fit_) {
+        case RotationFit::polar: R_t = polar_rotation(tet::deformation_gradient(rest, now)); break;
+        case RotationFit::centroid: R_t = best_fit_rotation(centroid_covariance(rest, now)); break;
+        case RotationFit::edges: R_t = best_fit_rotation(edge_covariance(rest, now)); break;
+        }
+    }
+    return R;
+}
+
+double CorotationalElasticity::evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& forces)
+{
+    const std::vector<Eigen::Matrix3d> R = rotations(u);
+    const MatrixX3d x = mesh_.V + io::vertex_rows(u);
+    forces = Eigen::VectorXd::Zero(u.size());
+    double energy = 0.0;
+    for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t) {
+        const Matrix12d& K = K_e_[static_cast<std::size_t>(t)];
+        const Vector12d x_e = element_vector(mesh_, x, t), X_e = element_vector(mesh_, mesh_.V, t);
+        const Eigen::Matrix3d& R_t = R[static_cast<std::size_t>(t)];
+        const Vector12d d = corotated_displacement(R_t, x_e, X_e);
+        energy += 0.5 * d.dot(K * d);  // U_e = ½ dᵀ K_e d
+        const Vector12d f_e = corotated_force(K, R_t, x_e, X_e);
+        for (int i = 0; i < 4; ++i)
+            forces.segment<3>(3 * mesh_.T(t, i)) += f_e.segment<3>(3 * i);
+    }
+    return energy;
+}
+
+const dynamics::SparseMatrix& CorotationalElasticity::stiffness(const Eigen::VectorXd& u)
+{
+    const std::vector<Eigen::Matrix3d> R = rotations(u);
+    assembly::ElementMatrices warped(K_e_.size());
+    // BEGIN EXERCISE 11.4 warped_stiffness #forces-and-warped-stiffness
+    // HINT: one rotated_stiffness per tet, then chapter 06's pattern_.assemble into K_R_csr_ (the
+    // HINT: values of the fixed CSR pattern are overwritten; nothing is allocated).
+    for (std::size_t t = 0; t < K_e_.size(); ++t)
+        warped[t] = rotated_stiffness(K_e_[t], R[t]);
+    pattern_.assemble(warped, K_R_csr_);
+    // END EXERCISE
+    K_R_ = assembly::csc_of_symmetric(K_R_csr_);
+    return K_R_;
+}
+
+Eigen::VectorXd CorotationalElasticity::von_mises_stress(const Eigen::VectorXd& u) const
+{
+    const std::vector<Eigen::Matrix3d> R = rotations(u);
+    const MatrixX3d x = mesh_.V + io::vertex_rows(u);
+    const elastic::Matrix6d C = elastic::elasticity_matrix(lame_);
+    Eigen::VectorXd stress(mesh_.T.rows());
+    for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t) {
+        const Vector12d x_e = element_vector(mesh_, x, t), X_e = element_vector(mesh_, mesh_.V, t);
+        const Vector12d d = corotated_displacement(R[static_cast<std::size_t>(t)], x_e, X_e);
+        const tet::TetVertices rest = tet::tet_vertices(mesh_, mesh_.V, static_cast<int>(t));
+        stress[t] = elastic::von_mises(C * (elastic::strain_displacement_matrix(rest) * d));
+    }
+    return stress;
+}
+
+}  // namespace fem::corot

@@ -1,0 +1,350 @@
+// Chapter 11: best-fit rotations, corotated forces and the warped stiffness, against known
+// rotations, rigid motions, rotation covariance and the small-deformation limit.
+// docs/11_corotational.md
+#include "11_corotational/corotational.hpp"
+
+#include "10_linear_dynamics/time_integration.hpp"
+
+#include "common/error.hpp"
+#include "common/mesh.hpp"
+#include "common/random.hpp"
+#include "common/vtk_io.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <Eigen/Geometry>
+#include <Eigen/SVD>
+
+#include <array>
+#include <cmath>
+
+using namespace fem;
+using namespace fem::corot;
+using Catch::Matchers::Contains;
+
+namespace {
+
+const dynamics::Material rubber{1e5, 0.45, 1000.0};
+
+/// A rotation by `angle` about a random axis (seeded).
+Eigen::Matrix3d rotation(double angle, unsigned seed)
+{
+    return Eigen::AngleAxisd(angle, Eigen::Vector3d(fem::random_vector(3, seed)).normalized()).toRotationMatrix();
+}
+
+/// A random positively oriented tet (seeded): the unit corner tet plus jitter.
+tet::TetVertices random_tet(unsigned seed)
+{
+    tet::TetVertices X;
+    X << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
+    X += 0.3 * Eigen::Matrix<double, 4, 3>(fem::random_matrix(4, 3, seed));
+    if (tet::signed_volume(X) < 0.0)
+        X.row(2).swap(X.row(3));
+    return X;
+}
+
+/// Every vertex moved by x = Q X + c.
+MatrixX3d rigidly_moved(const MatrixX3d& V, const Eigen::Matrix3d& Q, const Eigen::Vector3d& c)
+{
+    return (V * Q.transpose()).rowwise() + c.transpose();
+}
+
+Eigen::VectorXd displacement(const MatrixX3d& x, const MatrixX3d& V)
+{
+    const MatrixX3d u = x - V;
+    return Eigen::Map<const Eigen::VectorXd>(u.data(), u.size());
+}
+
+double orthogonality_error(const Eigen::Matrix3d& R)
+{
+    return (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+}
+
+}  // namespace
+
+TEST_CASE("best-fit rotation: R = V U^T recovers known rotations, the slide's U V^T is its inverse", "[ex11.1]")
+{
+    for (unsigned seed = 1; seed <= 40; ++seed) {
+        const double angle = 0.16 * seed;  // up to 6.4 rad: beyond pi
+        const Eigen::Matrix3d Q = rotation(angle, seed);
+        const tet::TetVertices X = random_tet(seed + 100);
+        const Eigen::Vector3d c = Eigen::Vector3d(fem::random_vector(3, seed + 200)) * 5.0;
+        const tet::TetVertices x = (X * Q.transpose()).rowwise() + c.transpose();
+        const Eigen::Matrix3d S = edge_covariance(X, x);
+        const Eigen::Matrix3d R = best_fit_rotation(S);
+        CAPTURE(seed, angle);
+        CHECK((R - Q).cwiseAbs().maxCoeff() <= 1e-12);
+        CHECK(R.determinant() == Approx(1.0).epsilon(1e-13));
+        // The slide's U Vᵀ is the transpose: the inverse rotation.
+        const Eigen::JacobiSVD<Eigen::Matrix3d> svd(S, Eigen::ComputeFullU | Eigen::ComputeFullV);
+        const Eigen::Matrix3d slide = svd.matrixU() * svd.matrixV().transpose();
+        CHECK((slide - Q.transpose()).cwiseAbs().maxCoeff() <= 1e-12);
+    }
+}
+
+TEST_CASE("best-fit rotation: reflections, flat, collapsed and uniformly scaled tets give proper rotations",
+          "[ex11.1]")
+{
+    const tet::TetVertices X = random_tet(7);
+    // Inverted: vertex 3 pushed through the opposite face (a reflection of the edges).
+    tet::TetVertices inverted = X;
+    const Eigen::RowVector3d n = (X.row(1) - X.row(0)).cross(X.row(2) - X.row(0)).normalized();
+    inverted.row(3) -= 2.0 * n.dot(X.row(3) - X.row(0)) * n;
+    // Flat: vertex 3 in the plane of the others (one singular value 0).
+    tet::TetVertices flat = X;
+    flat.row(3) -= n.dot(X.row(3) - X.row(0)) * n;
+    // A mirror image of the whole tet (det of the best orthogonal map is −1).
+    tet::TetVertices mirrored = X;
+    mirrored.col(0) = -mirrored.col(0);
+    for (const auto& [x, name] : {std::pair{inverted, "inverted"}, std::pair{flat, "flat"},
+                                  std::pair{mirrored, "mirrored"}, std::pair{tet::TetVertices(3.0 * X), "scaled"},
+                                  std::pair{tet::TetVertices(tet::TetVertices::Zero()), "collapsed"}}) {
+        const Eigen::Matrix3d R = best_fit_rotation(edge_covariance(X, x));
+        CAPTURE(name);
+        CHECK(R.allFinite());
+        CHECK(orthogonality_error(R) <= 1e-12);
+        CHECK(R.determinant() == Approx(1.0).epsilon(1e-12));
+    }
+    // Uniform scaling has repeated singular values; its rotation is still the identity.
+    CHECK((best_fit_rotation(edge_covariance(X, tet::TetVertices(3.0 * X))) - Eigen::Matrix3d::Identity()).norm() <= 1e-12);
+    CHECK_THROWS_AS(best_fit_rotation(Eigen::Matrix3d::Constant(std::nan(""))), Error);
+}
+
+TEST_CASE("edges, centroid or polar: equal for the tets they were made for, different for skewed ones", "[ch11]")
+{
+    tet::TetVertices corner;  // edges from vertex 0 orthonormal: PᵀP = I
+    corner << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
+    tet::TetVertices regular;  // the corners' covariance ∝ I
+    regular << 1, 1, 1, 1, -1, -1, -1, 1, -1, -1, -1, 1;
+    if (tet::signed_volume(regular) < 0.0)
+        regular.row(2).swap(regular.row(3));
+    tet::TetVertices skewed;
+    skewed << 0, 0, 0, 1, 0, 0, 0.9, 0.1, 0, 0.3, 0.2, 0.05;
+    Eigen::Matrix3d G;  // a shear and a squash, then a rotation
+    G << 1.0, 0.4, 0.0, 0.0, 1.0, 0.0, 0.1, 0.0, 0.9;
+    const Eigen::Matrix3d A = rotation(0.7, 3) * G;
+    const auto fits = [&](const tet::TetVertices& X) {
+        const tet::TetVertices x = X * A.transpose();
+        return std::array<Eigen::Matrix3d, 3>{polar_rotation(tet::deformation_gradient(X, x)),
+                                             best_fit_rotation(centroid_covariance(X, x)),
+                                             best_fit_rotation(edge_covariance(X, x))};
+    };
+    const auto c = fits(corner), r = fits(regular), k = fits(skewed);
+    CHECK((c[0] - c[2]).norm() <= 1e-12);   // corner tet: polar = edges
+    CHECK((r[0] - r[1]).norm() <= 1e-12);   // regular tet: polar = centroid
+    CHECK((k[0] - k[1]).norm() > 1e-3);     // skewed: all three differ
+    CHECK((k[0] - k[2]).norm() > 1e-3);
+    CHECK((k[1] - k[2]).norm() > 1e-3);
+    for (const auto* set : {&c, &r, &k})
+        for (const Eigen::Matrix3d& R : *set)
+            CHECK(orthogonality_error(R) <= 1e-12);
+    // The polar rotation leaves RᵀF symmetric: no rotation is left in the corotated strain.
+    const Eigen::Matrix3d F = tet::deformation_gradient(skewed, skewed * A.transpose());
+    const Eigen::Matrix3d stretch = k[0].transpose() * F;
+    CHECK((stretch - stretch.transpose()).norm() <= 1e-12 * stretch.norm());
+}
+
+TEST_CASE("rotated stiffness: every 3x3 block becomes R K_ab R^T", "[ex11.2]")
+{
+    const Matrix12d K_e = elastic::element_stiffness(random_tet(5), elastic::lame_parameters(1e5, 0.3));
+    const Eigen::Matrix3d R = rotation(2.0, 9);
+    Matrix12d R_hat = Matrix12d::Zero();
+    for (int i = 0; i < 4; ++i)
+        R_hat.block<3, 3>(3 * i, 3 * i) = R;
+    const Matrix12d expected = R_hat * K_e * R_hat.transpose();
+    CHECK((rotated_stiffness(K_e, R) - expected).cwiseAbs().maxCoeff() <= 1e-12 * K_e.cwiseAbs().maxCoeff());
+    CHECK((rotated_stiffness(K_e, Eigen::Matrix3d::Identity()) - K_e).norm() == 0.0);
+}
+
+TEST_CASE("corotated force: -R K_e (R^T x - X), zero for rigid motions, the linear force at R = I", "[ex11.3]")
+{
+    const tet::TetVertices X = random_tet(11);
+    const Matrix12d K_e = elastic::element_stiffness(X, elastic::lame_parameters(1e5, 0.3));
+    Vector12d X_e, x_e;
+    for (int i = 0; i < 4; ++i)
+        X_e.segment<3>(3 * i) = X.row(i).transpose();
+    const Eigen::Matrix3d Q = rotation(2.5, 4);
+    for (int i = 0; i < 4; ++i)
+        x_e.segment<3>(3 * i) = Q * X.row(i).transpose() + Eigen::Vector3d(1, 2, 3);
+    CHECK(corotated_force(K_e, Q, x_e, X_e).norm() <= 1e-10 * K_e.norm());
+    // With R = I it is the linear force −K_e (x_e − X_e).
+    const Vector12d stretched = X_e + 0.01 * Vector12d(fem::random_vector(12, 8));
+    CHECK((corotated_force(K_e, Eigen::Matrix3d::Identity(), stretched, X_e) + K_e * (stretched - X_e)).norm() <=
+          1e-12 * (K_e * (stretched - X_e)).norm());
+    // A rotated deformation gives the rotated force.
+    Vector12d rotated;
+    for (int i = 0; i < 4; ++i)
+        rotated.segment<3>(3 * i) = Q * stretched.segment<3>(3 * i);
+    const Vector12d f = corotated_force(K_e, Q, rotated, X_e), f0 = -(K_e * (stretched - X_e));
+    for (int i = 0; i < 4; ++i)
+        CHECK((f.segment<3>(3 * i) - Q * f0.segment<3>(3 * i)).norm() <= 1e-10 * f0.norm());
+}
+
+TEST_CASE("corotational body: no force under rigid motion, rotation covariance of f and K_R", "[ex11.4]")
+{
+    const TetMesh mesh = box_mesh(3, 2, 2, Eigen::Vector3d(0.3, 0.2, 0.2));
+    CorotationalElasticity corotational(mesh, rubber);
+    dynamics::LinearElasticity linear(mesh, rubber);
+    Eigen::VectorXd stretch(3 * mesh.V.rows()), f_stretch, f;
+    for (Eigen::Index v = 0; v < mesh.V.rows(); ++v)
+        stretch.segment<3>(3 * v) = Eigen::Vector3d(0.01 * mesh.V(v, 0), 0.0, 0.0);  // 1 % stretch
+    linear.evaluate(stretch, f_stretch);
+    const double scale = f_stretch.norm();
+    for (const double angle : {0.5, 2.0, 3.1, 4.5}) {
+        const Eigen::Matrix3d Q = rotation(angle, 21);
+        const Eigen::VectorXd rigid = displacement(rigidly_moved(mesh.V, Q, Eigen::Vector3d(0.3, -1, 2)), mesh.V);
+        const double energy = corotational.evaluate(rigid, f);
+        CAPTURE(angle);
+        CHECK(f.norm() <= 1e-10 * scale);
+        CHECK(std::abs(energy) <= 1e-10 * 0.5 * stretch.dot(-f_stretch));
+        linear.evaluate(rigid, f);
+        CHECK(f.norm() > 10.0 * scale);  // linear elasticity resists a rotation
+    }
+    // f(Q x) = Q f(x) and K_R(Q x) = Q K_R(x) Qᵀ for a deformed state x.
+    const Eigen::VectorXd u = 0.02 * fem::random_vector(3 * mesh.V.rows(), 31);
+    const MatrixX3d x = mesh.V + io::vertex_rows(u);
+    const Eigen::Matrix3d Q = rotation(1.3, 41);
+    const Eigen::VectorXd u_rotated = displacement(rigidly_moved(x, Q, Eigen::Vector3d::Zero()), mesh.V);
+    Eigen::VectorXd f_x, f_Qx;
+    corotational.evaluate(u, f_x);
+    corotational.evaluate(u_rotated, f_Qx);
+    const MatrixX3d rotated_forces = io::vertex_rows(f_x) * Q.transpose();
+    CHECK((io::vertex_rows(f_Qx) - rotated_forces).norm() <= 1e-10 * f_x.norm());
+    const Eigen::MatrixXd K_x(corotational.stiffness(u)), K_Qx(corotational.stiffness(u_rotated));
+    Eigen::MatrixXd Q_hat = Eigen::MatrixXd::Zero(K_x.rows(), K_x.cols());
+    for (Eigen::Index v = 0; v < mesh.V.rows(); ++v)
+        Q_hat.block<3, 3>(3 * v, 3 * v) = Q;
+    CHECK((K_Qx - Q_hat * K_x * Q_hat.transpose()).cwiseAbs().maxCoeff() <= 1e-10 * K_x.cwiseAbs().maxCoeff());
+    // At rest K_R is the linear K, symmetric.
+    const Eigen::MatrixXd K_rest(corotational.stiffness(Eigen::VectorXd::Zero(u.size())));
+    CHECK((K_rest - Eigen::MatrixXd(linear.K())).cwiseAbs().maxCoeff() <= 1e-12 * K_rest.cwiseAbs().maxCoeff());
+    CHECK((K_x - K_x.transpose()).cwiseAbs().maxCoeff() <= 1e-12 * K_x.cwiseAbs().maxCoeff());
+}
+
+TEST_CASE("small deformations: corotational and linear forces differ by O(eps^2)", "[ch11]")
+{
+    const TetMesh mesh = box_mesh(2, 2, 2);
+    CorotationalElasticity corotational(mesh, rubber);
+    dynamics::LinearElasticity linear(mesh, rubber);
+    const Eigen::VectorXd direction = fem::random_vector(3 * mesh.V.rows(), 51);
+    std::vector<double> gaps;
+    for (const double eps : {1e-2, 5e-3, 2.5e-3, 1.25e-3}) {
+        Eigen::VectorXd f_c, f_l;
+        corotational.evaluate(eps * direction, f_c);
+        linear.evaluate(eps * direction, f_l);
+        gaps.push_back((f_c - f_l).norm());
+    }
+    for (std::size_t k = 1; k < gaps.size(); ++k) {
+        const double order = std::log2(gaps[k - 1] / gaps[k]);
+        CAPTURE(k, order);
+        CHECK(order == Approx(2.0).margin(0.1));
+    }
+}
+
+TEST_CASE("vertex order: corners permuted or the mesh renumbered change nothing, except the lecture's edge fit",
+          "[ch11]")
+{
+    const TetMesh mesh = box_mesh(2, 1, 1);
+    const Eigen::VectorXd u = 0.05 * fem::random_vector(3 * mesh.V.rows(), 61);
+    // Even permutations of every tet's corners keep the orientation.
+    TetMesh permuted = mesh;
+    for (Eigen::Index t = 0; t < mesh.T.rows(); ++t)
+        permuted.T.row(t) << mesh.T(t, 1), mesh.T(t, 2), mesh.T(t, 0), mesh.T(t, 3);
+    // The vertices renumbered in reverse.
+    const Eigen::Index n = mesh.V.rows();
+    TetMesh renumbered{mesh.V.colwise().reverse(), mesh.T};
+    for (Eigen::Index t = 0; t < mesh.T.rows(); ++t)
+        for (int i = 0; i < 4; ++i)
+            renumbered.T(t, i) = static_cast<int>(n - 1 - mesh.T(t, i));
+    Eigen::VectorXd u_renumbered(u.size());
+    for (Eigen::Index v = 0; v < n; ++v)
+        u_renumbered.segment<3>(3 * (n - 1 - v)) = u.segment<3>(3 * v);
+
+    for (const RotationFit fit : {RotationFit::polar, RotationFit::centroid, RotationFit::edges}) {
+        CorotationalElasticity reference(mesh, rubber, fit), corners(permuted, rubber, fit),
+            reversed(renumbered, rubber, fit);
+        Eigen::VectorXd f_ref, f_corners, f_reversed;
+        const double energy = reference.evaluate(u, f_ref);
+        const double energy_corners = corners.evaluate(u, f_corners);
+        const double energy_reversed = reversed.evaluate(u_renumbered, f_reversed);
+        double reversed_gap = 0.0;
+        for (Eigen::Index v = 0; v < n; ++v)
+            reversed_gap = std::max(reversed_gap, (f_reversed.segment<3>(3 * (n - 1 - v)) - f_ref.segment<3>(3 * v)).norm());
+        CAPTURE(int(fit));
+        CHECK(energy_reversed == Approx(energy).epsilon(1e-12));  // renumbering never matters
+        CHECK(reversed_gap <= 1e-12 * f_ref.norm());
+        if (fit == RotationFit::edges) {
+            // The slide's fit uses the edges from corner 0: another first corner, another rotation.
+            CHECK(std::abs(energy_corners - energy) > 1e-4 * energy);
+        } else {
+            CHECK(energy_corners == Approx(energy).epsilon(1e-12));
+            CHECK((f_corners - f_ref).norm() <= 1e-12 * f_ref.norm());
+        }
+    }
+}
+
+// A free cube spun at 6 rad/s, no gravity. Linear elasticity swells (a rotation is a strain to
+// it); the corotational body keeps its volume. The linearly implicit step moves every point along
+// its velocity, a tangent to its circle, which stretches the spinning body a little each step; the
+// warped stiffness K_R (no derivative of R) does not see that coming, so both integrators GAIN
+// energy here, backward Euler too, by an amount that shrinks with dt (a discretisation error that
+// a Newton-converged step, chapter 12, removes).
+TEST_CASE("a spinning body: linear elasticity swells, corotational keeps its volume, energy gain shrinks with dt",
+          "[ch11]")
+{
+    dynamics::Scene scene;
+    scene.mesh = box_mesh(2, 2, 2, Eigen::Vector3d(0.1, 0.1, 0.1));
+    scene.material = rubber;
+    scene.gravity.setZero();
+    scene.duration = 0.0;
+    const Eigen::Vector3d centre(0.05, 0.05, 0.05), spin(0.0, 0.0, 6.0);
+    Eigen::VectorXd v0(3 * scene.mesh.V.rows());
+    for (Eigen::Index v = 0; v < scene.mesh.V.rows(); ++v)
+        v0.segment<3>(3 * v) = spin.cross(Eigen::Vector3d(scene.mesh.V.row(v).transpose()) - centre);
+    const double volume = total_volume(scene.mesh), horizon = 0.5;
+    struct Outcome {
+        double growth = 0.0, energy_gain = 0.0;
+    };
+    const auto run = [&](std::unique_ptr<dynamics::ForceModel> model, const std::string& integrator, double dt) {
+        scene.time_step = dt;
+        dynamics::Body body(scene, std::move(model));
+        const auto stepper = dynamics::make_integrator(integrator);
+        dynamics::Simulation simulation(body, *stepper, dynamics::initial_state(body, {}, v0), dt);
+        Outcome outcome;
+        double h0 = 0.0;
+        simulation.run(static_cast<int>(std::lround(horizon / dt)),
+                       [&](const dynamics::State& state, const dynamics::StepRecord& record) {
+                           if (state.step == 0)
+                               h0 = record.energies.total();
+                       });
+        outcome.energy_gain = simulation.last().energies.total() / h0 - 1.0;
+        TetMesh moved{body.positions(simulation.state().u), scene.mesh.T};
+        outcome.growth = total_volume(moved) / volume - 1.0;
+        return outcome;
+    };
+    const Outcome linear = run(std::make_unique<dynamics::LinearElasticity>(scene.mesh, rubber), "implicit-midpoint", 0.01);
+    const Outcome coarse = run(std::make_unique<CorotationalElasticity>(scene.mesh, rubber), "implicit-midpoint", 0.01);
+    const Outcome fine = run(std::make_unique<CorotationalElasticity>(scene.mesh, rubber), "implicit-midpoint", 0.0025);
+    const Outcome backward = run(std::make_unique<CorotationalElasticity>(scene.mesh, rubber), "backward-euler", 0.01);
+    const Outcome backward_fine =
+        run(std::make_unique<CorotationalElasticity>(scene.mesh, rubber), "backward-euler", 0.0025);
+    CAPTURE(linear.growth, coarse.growth, coarse.energy_gain, fine.energy_gain, backward.energy_gain,
+            backward_fine.energy_gain);
+    CHECK(linear.growth > 1.0);                        // three radians: the linear body doubles its volume
+    CHECK(std::abs(coarse.growth) < 0.01);             // the centrifugal stretch only
+    CHECK(std::abs(linear.energy_gain) < 1e-9);        // linear forces: the midpoint rule conserves
+    CHECK(coarse.energy_gain > 0.0);
+    CHECK(fine.energy_gain < coarse.energy_gain / 3.0);  // 4x smaller dt: the gain shrinks
+    CHECK(backward.energy_gain > 0.0);
+    CHECK(backward_fine.energy_gain < backward.energy_gain / 2.0);
+}
+
+TEST_CASE("bad input: a zero-volume rest tet is named", "[ch11]")
+{
+    TetMesh mesh = box_mesh(1, 1, 1);
+    mesh.V.row(mesh.T(2, 3)) = mesh.V.row(mesh.T(2, 0));
+    CHECK_THROWS_AS(CorotationalElasticity(mesh, rubber), Error);
+    CorotationalElasticity good(box_mesh(1, 1, 1), rubber);
+    Eigen::VectorXd f;
+    CHECK_THROWS_WITH(good.evaluate(Eigen::VectorXd::Zero(5), f), Contains("3n"));
+}
