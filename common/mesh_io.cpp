@@ -324,7 +324,11 @@ void check_stl_layout(const fs::path& path)
     }
     std::string_view start(header, static_cast<std::size_t>(std::min<std::uintmax_t>(size, 84)));
     start.remove_prefix(std::min(start.find_first_not_of(" \t\r\n"), start.size()));
-    if (start.substr(0, 5) == "solid")
+    // Many CAD exporters start the 80-byte header of a BINARY file with "solid" too: text has no NUL
+    // bytes, binary facet data (float zeros, small counts) nearly always has some.
+    const bool looks_binary = std::find(header, header + std::min<std::uintmax_t>(size, 84), '\0') !=
+                              header + std::min<std::uintmax_t>(size, 84);
+    if (start.substr(0, 5) == "solid" && !looks_binary)
         return;  // ASCII; vtkSTLReader reports what it cannot parse
     if (size < 84)
         throw Error(str("'", path.string(), "' is not an STL file: ", size,
@@ -333,7 +337,8 @@ void check_stl_layout(const fs::path& path)
     std::memcpy(&count, header + 80, 4);
     throw Error(str("'", path.string(), "' is not a complete binary STL file: its header announces ", count,
                     " facets (84 + 50·", count, " = ", 84 + 50ull * count, " bytes), the file has ", size,
-                    " bytes (truncated?), and it does not start with 'solid' (ASCII)"));
+                    " bytes (truncated?), and it is not ASCII STL (",
+                    looks_binary ? "it holds binary data" : "it does not start with 'solid'", ")"));
 }
 
 TriMesh read_stl(const fs::path& path)
@@ -379,6 +384,10 @@ TriMesh read_stl(const fs::path& path)
 // PLY (hand-written: VTK 9.1's PLY reader aborts the process on a truncated ASCII file)
 
 enum class PlyFormat { ascii, binary_little_endian, binary_big_endian };
+
+/// The longest PLY list the reader accepts (a face with more corners is no surface we can use; a
+/// larger number is a corrupt file, and a cast of it to an integer would overflow).
+constexpr double max_ply_list_length = 1e6;
 
 struct PlyType {
     int bytes = 0;
@@ -581,6 +590,9 @@ TriMesh read_ply(const fs::path& path)
                 throw Error(str(file.place(element.header_line),
                                 ": element face has no list property vertex_indices (or vertex_index)"));
         }
+        if (element.properties.empty() && element.count > 0)
+            throw Error(str(file.place(element.header_line), ": element ", element.name, " has ", element.count,
+                            " entries but no properties; every PLY element needs at least one property"));
         for (long long i = 0; i < element.count; ++i) {
             values.begin(element, i);
             Eigen::Vector3d point = Eigen::Vector3d::Zero();
@@ -595,8 +607,9 @@ TriMesh read_ply(const fs::path& path)
                     continue;
                 }
                 const double count = values.value(property.count_type, str("the length of list ", property.name));
-                if (count < 0)
-                    throw Error(str(values.place(), ": list ", property.name, " has negative length ", count));
+                if (!(count >= 0 && count <= max_ply_list_length))
+                    throw Error(str(values.place(), ": list ", property.name, " has length ", count,
+                                    "; allowed are 0 to ", max_ply_list_length));
                 for (long long k = 0; k < static_cast<long long>(count); ++k) {
                     const double item = values.value(property.type, str("item ", k, " of list ", property.name));
                     if (static_cast<int>(p) == indices) {
@@ -721,6 +734,18 @@ void check_item_number(const TextFile& file, long long number, long long index, 
     }
 }
 
+/// fem::Error unless a header's count could fit in the file: every record takes at least
+/// min_bytes (e.g. "0 0 0 0\n" for a point), so a count above size / min_bytes is a corrupt header,
+/// refused before any memory is reserved for it.
+void require_plausible_count(const fs::path& path, long long count, long long min_bytes, const char* what,
+                             int header_line)
+{
+    const auto size = static_cast<long long>(fs::file_size(path));
+    if (count > size / min_bytes)
+        throw Error(str(path.string(), ", line ", header_line, ": the header announces ", count, " ", what,
+                        ", more than a file of ", size, " bytes can hold (at least ", min_bytes, " bytes each)"));
+}
+
 TetMesh read_tetgen(const TetGenPaths& paths, Inverted inverted)
 {
     TetMesh mesh;
@@ -738,6 +763,7 @@ TetMesh read_tetgen(const TetGenPaths& paths, Inverted inverted)
         if (header[2] < 0 || header[3] < 0 || header[3] > 1)
             node.fail("the number of attributes must be ≥ 0 and the boundary marker flag 0 or 1");
         const std::size_t columns = 4 + static_cast<std::size_t>(header[2] + header[3]);
+        require_plausible_count(paths.node, header[0], 8, "points", header_line);
         mesh.V.resize(header[0], 3);
         for (long long i = 0; i < header[0]; ++i) {
             if (!node.next_line())
@@ -769,6 +795,7 @@ TetMesh read_tetgen(const TetGenPaths& paths, Inverted inverted)
         if (header[2] < 0)
             ele.fail("the number of attributes must be ≥ 0");
         const std::size_t columns = 5 + static_cast<std::size_t>(header[2]);
+        require_plausible_count(paths.ele, header[0], 10, "tetrahedra", header_line);
         mesh.T.resize(header[0], 4);
         long long tet_base = 0;
         for (long long e = 0; e < header[0]; ++e) {

@@ -23,6 +23,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 
@@ -277,16 +278,38 @@ MeshData read_vtu(const std::filesystem::path& path)
     }
     const vtkIdType cell_count = grid->GetNumberOfCells();
     if (cell_count > 0) {
-        const vtkIdType per_cell = grid->GetCell(0)->GetNumberOfPoints();
+        // Cells are checked by their VTK type, never by asking VTK for a cell object: a type VTK does
+        // not know gives no object at all. All cells must be of one of the four kinds the course
+        // writes, and of one kind.
+        const int type = grid->GetCellType(0);
+        vtkIdType per_cell = 0;
+        switch (type) {
+        case VTK_VERTEX: per_cell = 1; break;
+        case VTK_LINE: per_cell = 2; break;
+        case VTK_TRIANGLE: per_cell = 3; break;
+        case VTK_TETRA: per_cell = 4; break;
+        default:
+            throw Error(str("'", path.string(), "': cell 0 has VTK cell type ", type, "; the course reads vertices (",
+                            VTK_VERTEX, "), lines (", VTK_LINE, "), triangles (", VTK_TRIANGLE, ") and tetrahedra (",
+                            VTK_TETRA, ")"));
+        }
         mesh.cells.resize(cell_count, per_cell);
         vtkNew<vtkIdList> ids;
         for (vtkIdType e = 0; e < cell_count; ++e) {
+            if (grid->GetCellType(e) != type)
+                throw Error(str("'", path.string(), "': cell ", e, " has VTK cell type ", grid->GetCellType(e),
+                                ", cell 0 has ", type, "; mixed cell types are not supported"));
             grid->GetCellPoints(e, ids);
             if (ids->GetNumberOfIds() != per_cell)
-                throw Error(str("'", path.string(), "': cell ", e, " has ", ids->GetNumberOfIds(),
-                                " points, cell 0 has ", per_cell, "; mixed cell types are not supported"));
-            for (vtkIdType k = 0; k < per_cell; ++k)
-                mesh.cells(e, k) = static_cast<int>(ids->GetId(k));
+                throw Error(str("'", path.string(), "': cell ", e, " has ", ids->GetNumberOfIds(), " points; its type ",
+                                type, " has ", per_cell));
+            for (vtkIdType k = 0; k < per_cell; ++k) {
+                const vtkIdType id = ids->GetId(k);
+                if (id < 0 || id >= grid->GetNumberOfPoints())
+                    throw Error(str("'", path.string(), "': cell ", e, " refers to point ", id, ", the file has ",
+                                    grid->GetNumberOfPoints(), " points"));
+                mesh.cells(e, k) = static_cast<int>(id);
+            }
         }
     }
     for (int a = 0; a < grid->GetPointData()->GetNumberOfArrays(); ++a)
@@ -408,7 +431,13 @@ std::vector<std::pair<double, std::string>> read_pvd(const std::filesystem::path
     for (std::size_t tag = content.find("<DataSet"); tag != std::string::npos;
          tag = content.find("<DataSet", tag + 1)) {
         const std::size_t end = content.find('>', tag);
-        entries.emplace_back(std::stod(attribute(tag, end, "timestep")), attribute(tag, end, "file"));
+        const std::string time_text = attribute(tag, end, "timestep");
+        char* parsed_end = nullptr;
+        const double time = std::strtod(time_text.c_str(), &parsed_end);
+        if (time_text.empty() || parsed_end != time_text.c_str() + time_text.size() || !std::isfinite(time))
+            throw Error(str("'", path.string(), "': a DataSet has timestep=\"", time_text,
+                            "\"; a timestep must be a finite number"));
+        entries.emplace_back(time, attribute(tag, end, "file"));
     }
     return entries;
 }
