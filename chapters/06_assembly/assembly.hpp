@@ -202,7 +202,9 @@ Eigen::VectorXd expand(const SparseMatrix& P, const Eigen::VectorXd& u_free);
 
 /// Solves A x = b for a symmetric positive definite A by sparse LDLᵀ (Eigen's SimplicialLDLT).
 /// fem::Error when A is not SPD: the factorisation fails, or a pivot d_i ≤ 1e-10 · max d (singular,
-/// e.g. a free-floating K with its 6 rigid modes: pin vertices), or sizes mismatch.
+/// e.g. a free-floating K with its 6 rigid modes: pin vertices), or sizes mismatch; also when A
+/// or b holds a non-finite entry, or A is not symmetric (max |A_ij − A_ji| > 1e-12 max |A_ij|; the
+/// factorization reads one triangle and would answer a non-symmetric A wrongly).
 /// docs/06_assembly.md#pinned-vertices
 Eigen::VectorXd solve_spd(const SparseMatrix& A, const Eigen::VectorXd& b);
 

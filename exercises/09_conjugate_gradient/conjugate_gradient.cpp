@@ -104,6 +104,11 @@ CgResult cg_loop(const LinearOperator& A, const LinearOperator* M_inverse, const
     // The true residual of the returned x (one more product), not the updated one.
     A.apply(x, q);
     result.relative_residual = (b - q).norm() / b_norm;
+    // NaN compares false with everything: a NaN in A or in the preconditioner would otherwise end
+    // the loop at once and come back as a quiet "not converged".
+    if (!std::isfinite(result.relative_residual) || !x.allFinite())
+        throw Error(str(where, ": the residual is not finite after ", result.iterations,
+                        " iterations: A or the preconditioner holds a NaN or an infinity"));
     return result;
 }
 

@@ -6,6 +6,7 @@
 
 #include <Eigen/SparseCholesky>
 
+#include <algorithm>
 #include <cmath>
 
 namespace fem::assembly {
@@ -78,6 +79,25 @@ Eigen::VectorXd solve_spd(const SparseMatrix& A, const Eigen::VectorXd& b)
     if (A.rows() != A.cols() || b.size() != A.rows() || A.rows() == 0)
         throw Error(str("solve_spd: A is ", A.rows(), "×", A.cols(), " and b has ", b.size(),
                         " entries; A must be square, non-empty and match b"));
+    // SimplicialLDLT reads one triangle: a non-symmetric or non-finite A would be answered wrongly.
+    double largest_entry = 0.0, asymmetry = 0.0;
+    for (Eigen::Index col = 0; col < A.outerSize(); ++col)
+        for (SparseMatrix::InnerIterator it(A, col); it; ++it) {
+            if (!std::isfinite(it.value()))
+                throw Error(str("solve_spd: A(", it.row(), ", ", it.col(), ") is ", it.value(),
+                                "; every entry must be finite"));
+            largest_entry = std::max(largest_entry, std::abs(it.value()));
+        }
+    for (Eigen::Index i = 0; i < b.size(); ++i)
+        if (!std::isfinite(b[i]))
+            throw Error(str("solve_spd: b(", i, ") is ", b[i], "; every entry must be finite"));
+    const SparseMatrix difference = A - SparseMatrix(A.transpose());
+    for (Eigen::Index col = 0; col < difference.outerSize(); ++col)
+        for (SparseMatrix::InnerIterator it(difference, col); it; ++it)
+            asymmetry = std::max(asymmetry, std::abs(it.value()));
+    if (asymmetry > 1e-12 * largest_entry)
+        throw Error(str("solve_spd: A is not symmetric: max |A_ij - A_ji| = ", asymmetry, " against max |A_ij| = ",
+                        largest_entry, " (allowed: 1e-12 of it)"));
     Eigen::SimplicialLDLT<SparseMatrix> ldlt(A);
     if (ldlt.info() != Eigen::Success)
         throw Error("solve_spd: the LDLᵀ factorisation failed (a zero pivot): the matrix is singular; "

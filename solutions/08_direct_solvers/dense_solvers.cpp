@@ -30,6 +30,9 @@ void require_size(Eigen::Index expected, const Eigen::VectorXd& b, const char* w
     if (b.size() != expected)
         throw Error(str(what, ": the right-hand side has ", b.size(), " entries, the matrix ", expected,
                         " rows"));
+    for (Eigen::Index i = 0; i < b.size(); ++i)
+        if (!std::isfinite(b[i]))
+            throw Error(str(what, ": entry ", i, " of the right-hand side is ", b[i], "; every entry must be finite"));
 }
 
 void require_nonzero_diagonal(const Eigen::MatrixXd& T, const char* what)
