@@ -109,6 +109,9 @@ struct ImplicitOptions {
                                         ///< measure what factoring once saves)
     PinnedRoute pinned = PinnedRoute::eliminate;
     StepForm form = StepForm::velocity_change;
+    /// When set, the solver is made by this instead of cg::make_solver(solver, solver_options): the
+    /// hook through which a later chapter plugs in its own (chapter 11's frozen-factorization PCG).
+    std::function<std::unique_ptr<cg::LinearSolver>()> make_solver;
 };
 
 /// What one step did, for the loop's bookkeeping.

@@ -125,8 +125,10 @@ Eigen::VectorXd velocity_change_right_hand_side(const SparseMatrix& M, const Eig
 
 ThetaMethod::ThetaMethod(double theta, ImplicitOptions options)
     : theta_((require_theta(theta), theta)), options_(std::move(options)),
-      solver_(cg::make_solver(options_.solver, options_.solver_options))
+      solver_(options_.make_solver ? options_.make_solver() : cg::make_solver(options_.solver, options_.solver_options))
 {
+    if (!solver_)
+        throw Error("ThetaMethod: the solver factory of the options returned no solver");
 }
 
 std::string ThetaMethod::name() const

@@ -184,10 +184,11 @@ TEST_CASE("solvers: factor once = refactor every step, and warm-started PCG agre
 {
     Scene scene = cantilever_scene(8, 2, true);
     Body body(scene);
-    ThetaMethod once(1.0), every(1.0, {"default", {}, true, PinnedRoute::eliminate});
-    fem::cg::SolverOptions tight;
-    tight.relative_tolerance = 1e-12;
-    ThetaMethod pcg(1.0, {"ours-pcg-ic0", tight, false, PinnedRoute::eliminate});
+    ImplicitOptions refactor, pcg_options;
+    refactor.refactor_every_step = true;
+    pcg_options.solver = "ours-pcg-ic0";
+    pcg_options.solver_options.relative_tolerance = 1e-12;
+    ThetaMethod once(1.0), every(1.0, refactor), pcg(1.0, pcg_options);
     Simulation s1(body, once, initial_state(body), scene.time_step);
     Simulation s2(body, every, initial_state(body), scene.time_step);
     Simulation s3(body, pcg, initial_state(body), scene.time_step);
