@@ -2,7 +2,8 @@
 """Keeps docs/NN_name.md from drifting away from the code (a ctest test per chapter).
 
 Checks:
-  1. every exercise of the chapter has a heading "### Exercise NN.k: function_name", every
+  1. every exercise of the chapter has a heading "### Exercise NN.k: function_name" followed by a
+     line "Builds on: NN.k, …." (or "Builds on: nothing.") naming earlier exercises, every
      "exercise NN.k" the text mentions exists, and every exercise's docs section (#anchor) is a
      heading of the page;
   2. every function or type the page names in backticks (snake_case calls like
@@ -26,14 +27,13 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from csv_compare import as_number, close, is_measured, read_csv  # noqa: E402
-from exercises import all_exercises  # noqa: E402
+from exercises import EXERCISE_HEADING, all_exercises, builds_on, exercise_key  # noqa: E402
 
 RUN = re.compile(r"<!-- fem:run (?P<exe>\S+)(?P<args>[^>]*?)\s*-->")
 TABLE = re.compile(r"(<!-- fem:table (?P<csv>\S+) -->\n)(?P<body>.*?)(<!-- /fem:table -->)", re.S)
 FIGURE = re.compile(r"<!-- fem:figure (?P<png>\S+) -->")
 IMAGE = re.compile(r"!\[[^\]]*\]\((?P<path>[^)\s]+)\)")
 HEADING = re.compile(r"^(#{1,6})\s+(?P<text>.+?)\s*$", re.M)
-EXERCISE_HEADING = re.compile(r"^###\s+Exercise\s+(?P<id>\d\d\.\d+):\s+`?(?P<function>\w+)", re.M)
 EXERCISE_MENTION = re.compile(r"[Ee]xercises?\s+(?P<id>\d\d\.\d+)")
 CODE_SPAN = re.compile(r"`([^`\n]+)`")
 CALL = re.compile(r"^(?:fem::(?:\w+::)*)?(?P<name>[a-z]\w*_\w+)\(")
@@ -114,6 +114,19 @@ def check_exercises(text, root, chapter):
     for m in list(EXERCISE_MENTION.finditer(text)) + list(EXERCISE_HEADING.finditer(text)):
         if m["id"] not in exercises:
             problems.append(f"the docs mention exercise {m['id']}, which does not exist")
+    for exercise_id, listed in builds_on(text).items():
+        if listed is None:
+            problems.append(f"the heading of exercise {exercise_id} is not followed by a line "
+                            f"'Builds on: NN.k, NN.k.' or 'Builds on: nothing.'")
+            continue
+        if len(set(listed)) != len(listed):
+            problems.append(f"exercise {exercise_id} builds on {listed}: an exercise is named twice")
+        for other in listed:
+            if other not in exercises:
+                problems.append(f"exercise {exercise_id} builds on exercise {other}, which does not exist")
+            elif exercise_key(other) >= exercise_key(exercise_id):
+                problems.append(f"exercise {exercise_id} builds on exercise {other}, which does not come "
+                                f"before it: an exercise builds on earlier ones only")
     return problems
 
 

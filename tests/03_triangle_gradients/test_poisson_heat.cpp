@@ -118,7 +118,7 @@ TEST_CASE("manufactured Poisson: O(h²) in L2 and O(h) in the gradient on jitter
     CHECK(l2.back() < 1e-3);
 }
 
-TEST_CASE("Poisson refuses what it cannot solve", "[ch03]")
+TEST_CASE("Poisson refuses what it cannot solve", "[ex03.9]")
 {
     const fem::TriMesh sphere = fem::test::bumpy_sphere();
     const SparseMatrix L = fem_laplacian(sphere.V, sphere.F);
@@ -204,7 +204,7 @@ TEST_CASE("implicit heat on a closed surface: heat is conserved, the range shrin
     }
 }
 
-TEST_CASE("implicit heat refuses bad parameters", "[ch03]")
+TEST_CASE("implicit heat refuses bad parameters", "[ex03.10]")
 {
     const fem::TriMesh mesh = fem::square_mesh(4);
     const SparseMatrix L = fem_laplacian(mesh.V, mesh.F);
@@ -246,7 +246,7 @@ TEST_CASE("the 7-point rule integrates polynomials up to degree 5 exactly, not d
     }
 }
 
-TEST_CASE("error norms: zero for an interpolated linear function, the area for a constant 1", "[ch03]")
+TEST_CASE("error norms: zero for an interpolated linear function, the area for a constant 1", "[ex03.3]")
 {
     const fem::TriMesh mesh = fem::square_mesh(5, 0.2, 3);
     const Vector3d g(2.0, -1.0, 0.0);

@@ -10,6 +10,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <utility>
+
 using namespace fem::sparse;
 using namespace fem::sparse::test;
 using Catch::Matchers::Contains;
@@ -40,6 +42,27 @@ CooMatrix split_triplets(const Eigen::MatrixXd& D)
                 if (D(i, j) != 0.0)
                     M.add(i, j, pass == 0 ? 0.25 * D(i, j) : 0.75 * D(i, j));
     return M;
+}
+
+/// The products of the lecture's 4×6 matrix A (lecture_csr()) worked out by hand: A x and wᵀA.
+struct LectureProducts {
+    Eigen::VectorXd x = (Eigen::VectorXd(6) << 1, 2, 3, 4, 5, 6).finished();
+    Eigen::VectorXd Ax = (Eigen::VectorXd(4) << 50, 220, 740, 480).finished();
+    Eigen::VectorXd w = (Eigen::VectorXd(4) << 1, 2, 3, 4).finished();
+    Eigen::VectorXd wA = (Eigen::VectorXd(6) << 10, 80, 150, 260, 210, 320).finished();
+};
+
+/// Shapes of matrices without entries: 0×0, n×0, 0×n and n×m.
+const std::pair<int, int> empty_shapes[] = {{0, 0}, {3, 0}, {0, 4}, {3, 4}};
+
+/// A rows×cols CSR matrix without entries.
+CsrMatrix empty_csr(int rows, int cols)
+{
+    CsrMatrix R;
+    R.rows = rows;
+    R.cols = cols;
+    R.IA.assign(rows + 1, 0);
+    return R;
 }
 
 }  // namespace
@@ -75,27 +98,24 @@ TEST_CASE("COO × vector: duplicates add up, any order, against the dense produc
     CHECK(close_to_product(y, sum, x));
 }
 
-TEST_CASE("the lecture's 4×6 example: A x and xᵀ A from CSR and CSC", "[ex07.2][ex07.3]")
+TEST_CASE("the lecture's 4×6 example, gather: CSR A x and CSC xᵀA", "[ex07.2]")
 {
-    const Eigen::VectorXd x = (Eigen::VectorXd(6) << 1, 2, 3, 4, 5, 6).finished();
-    const Eigen::Vector4d Ax(50, 220, 740, 480);  // worked out by hand from the slide's matrix
-    const Eigen::Vector4d w(1, 2, 3, 4);
-    const Eigen::VectorXd wA = (Eigen::VectorXd(6) << 10, 80, 150, 260, 210, 320).finished();
+    const LectureProducts want;
     Eigen::VectorXd y;
-    SECTION("gather: CSR A x and CSC xᵀA")
-    {
-        csr_times_vector(lecture_csr(), x, y);
-        CHECK(y == Ax);
-        vector_times_csc(w, lecture_csc(), y);
-        CHECK(y == wA);
-    }
-    SECTION("scatter: CSC A x and CSR xᵀA")
-    {
-        csc_times_vector(lecture_csc(), x, y);
-        CHECK(y == Ax);
-        vector_times_csr(w, lecture_csr(), y);
-        CHECK(y == wA);
-    }
+    csr_times_vector(lecture_csr(), want.x, y);
+    CHECK(y == want.Ax);
+    vector_times_csc(want.w, lecture_csc(), y);
+    CHECK(y == want.wA);
+}
+
+TEST_CASE("the lecture's 4×6 example, scatter: CSC A x and CSR xᵀA", "[ex07.3]")
+{
+    const LectureProducts want;
+    Eigen::VectorXd y;
+    csc_times_vector(lecture_csc(), want.x, y);
+    CHECK(y == want.Ax);
+    vector_times_csr(want.w, lecture_csr(), y);
+    CHECK(y == want.wA);
 }
 
 TEST_CASE("gather: CSR A x and CSC xᵀA of random matrices against the dense product", "[ex07.2]")
@@ -130,47 +150,58 @@ TEST_CASE("scatter: CSC A x and CSR xᵀA of random matrices against the dense p
     }
 }
 
-TEST_CASE("the gather and scatter kernels on views of raw arrays", "[ex07.2][ex07.3]")
+TEST_CASE("the gather kernel on views of raw arrays", "[ex07.2]")
 {
-    const CsrMatrix M = lecture_csr();
     const std::vector<double> x{1, 2, 3, 4, 5, 6};
     std::vector<double> y(4, -1.0);
-    gather_product(view(M), x, y);
+    gather_product(view(lecture_csr()), x, y);
     CHECK(y == std::vector<double>{50, 220, 740, 480});
+}
+
+TEST_CASE("the scatter kernel on views of raw arrays", "[ex07.3]")
+{
+    const std::vector<double> x{1, 2, 3, 4, 5, 6};
     std::vector<double> z(4, -1.0);
     scatter_product(view(lecture_csc()), x, z);
     CHECK(z == std::vector<double>{50, 220, 740, 480});
 }
 
-TEST_CASE("products of empty matrices: 0×0, n×0 gives zeros, 0×n gives an empty vector",
-          "[ex07.1][ex07.2][ex07.3]")
+TEST_CASE("COO products of empty matrices: 0×0, n×0 gives zeros, 0×n gives an empty vector", "[ex07.1]")
 {
-    for (auto [rows, cols] : {std::pair{0, 0}, std::pair{3, 0}, std::pair{0, 4}, std::pair{3, 4}}) {
+    for (auto [rows, cols] : empty_shapes) {
         CAPTURE(rows, cols);
-        CsrMatrix R;
-        R.rows = rows;
-        R.cols = cols;
-        R.IA.assign(rows + 1, 0);
+        CooMatrix T;
+        T.rows = rows;
+        T.cols = cols;
+        Eigen::VectorXd y = Eigen::VectorXd::Constant(rows, 7.0);
+        coo_times_vector(T, Eigen::VectorXd::Ones(cols), y);
+        CHECK(y == Eigen::VectorXd::Zero(rows));
+    }
+}
+
+TEST_CASE("gather products of empty matrices: CSR A x", "[ex07.2]")
+{
+    for (auto [rows, cols] : empty_shapes) {
+        CAPTURE(rows, cols);
+        Eigen::VectorXd y = Eigen::VectorXd::Constant(rows, 7.0);
+        csr_times_vector(empty_csr(rows, cols), Eigen::VectorXd::Ones(cols), y);
+        CHECK(y == Eigen::VectorXd::Zero(rows));
+    }
+}
+
+TEST_CASE("scatter products of empty matrices: CSC A x and CSR xᵀA", "[ex07.3]")
+{
+    for (auto [rows, cols] : empty_shapes) {
+        CAPTURE(rows, cols);
         CscMatrix C;
         C.rows = rows;
         C.cols = cols;
         C.IA.assign(cols + 1, 0);
-        CooMatrix T;
-        T.rows = rows;
-        T.cols = cols;
-        const Eigen::VectorXd x = Eigen::VectorXd::Ones(cols);
-        const Eigen::VectorXd zeros = Eigen::VectorXd::Zero(rows);
         Eigen::VectorXd y = Eigen::VectorXd::Constant(rows, 7.0);
-        csr_times_vector(R, x, y);
-        CHECK(y == zeros);
-        y.setConstant(7.0);
-        csc_times_vector(C, x, y);
-        CHECK(y == zeros);
-        y.setConstant(7.0);
-        coo_times_vector(T, x, y);
-        CHECK(y == zeros);
+        csc_times_vector(C, Eigen::VectorXd::Ones(cols), y);
+        CHECK(y == Eigen::VectorXd::Zero(rows));
         Eigen::VectorXd z = Eigen::VectorXd::Constant(cols, 7.0);
-        vector_times_csr(Eigen::VectorXd::Ones(rows), R, z);
+        vector_times_csr(Eigen::VectorXd::Ones(rows), empty_csr(rows, cols), z);
         CHECK(z == Eigen::VectorXd::Zero(cols));
     }
 }
