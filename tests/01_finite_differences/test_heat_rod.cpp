@@ -4,6 +4,7 @@
 #include "01_finite_differences/heat_rod.hpp"
 
 #include "common/error.hpp"
+#include "common/test_support.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -11,6 +12,8 @@
 
 using namespace fem::fd;
 using Catch::Matchers::Contains;
+using fem::test::EntriesNear;
+using fem::test::entries_of;
 
 namespace {
 
@@ -69,7 +72,7 @@ TEST_CASE("one FTCS step applies the second difference inside and the Dirichlet 
     // A linear profile between the end values is the steady state: FTCS leaves it unchanged.
     Eigen::VectorXd linear = Eigen::VectorXd::LinSpaced(5, 2.0, -1.0);
     ftcs_step(rod, 0.5, linear, next);
-    CHECK((next - linear).cwiseAbs().maxCoeff() < 1e-14);
+    CHECK_THAT(entries_of(next), EntriesNear(linear, 1e-14));
 }
 
 TEST_CASE("FTCS matches the decaying sine mode and converges at O(h²) with Δt ∝ h²", "[ex01.6]")

@@ -8,6 +8,7 @@
 #include "common/error.hpp"
 #include "common/mesh.hpp"
 #include "common/random.hpp"
+#include "common/test_support.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -20,6 +21,8 @@ using namespace fem::assembly;
 using fem::TetMesh;
 using fem::test::distorted_mesh;
 using Catch::Matchers::Contains;
+using fem::test::EntriesNear;
+using fem::test::entries_of;
 
 namespace {
 
@@ -73,9 +76,8 @@ TEST_CASE("lumped masses: a quarter of each tet's mass to each corner", "[ex06.6
     const SparseMatrix M = lumped_mass_matrix(mesh, rho);
     REQUIRE(M.rows() == 3 * mesh.V.rows());
     CHECK(M.nonZeros() == M.rows());
-    for (Eigen::Index v = 0; v < mesh.V.rows(); ++v)
-        for (int c = 0; c < 3; ++c)
-            CHECK(M.coeff(3 * v + c, 3 * v + c) == masses[v]);
+    const Eigen::VectorXd diagonal = masses.replicate(1, 3).transpose().reshaped();  // m_v three times
+    CHECK_THAT(entries_of(M), EntriesNear(Eigen::MatrixXd(diagonal.asDiagonal()), 0.0));
 }
 
 TEST_CASE("the element consistent mass is ρ ∫ φ_i φ_j dV by quadrature", "[ex06.7]")
@@ -93,12 +95,11 @@ TEST_CASE("the element consistent mass is ρ ∫ φ_i φ_j dV by quadrature", "[
         integral += volume / 4 * phi * phi.transpose();
     }
     const Matrix12d M = element_consistent_mass(X, rho);
+    Matrix12d expected = Matrix12d::Zero();  // ρ ∫ φ_i φ_j dV · I₃ in block (i, j)
     for (int i = 0; i < 4; ++i)
         for (int j = 0; j < 4; ++j)
-            for (int c = 0; c < 3; ++c)
-                for (int d = 0; d < 3; ++d)
-                    CHECK(M(3 * i + c, 3 * j + d) ==
-                          Approx(c == d ? rho * integral(i, j) : 0.0).epsilon(1e-12).margin(1e-12 * rho * volume));
+            expected.block<3, 3>(3 * i, 3 * j) = rho * integral(i, j) * Eigen::Matrix3d::Identity();
+    CHECK_THAT(entries_of(M), EntriesNear(expected, 1e-12 * rho * volume, 1e-12));
 }
 
 TEST_CASE("consistent mass: total ρ·volume, rows sum to the lumped masses, exact kinetic energy",
@@ -111,9 +112,8 @@ TEST_CASE("consistent mass: total ρ·volume, rows sum to the lumped masses, exa
 
     const Eigen::VectorXd ones = Eigen::VectorXd::Ones(M.rows());
     const Eigen::VectorXd row_sums = M * ones;
-    for (Eigen::Index v = 0; v < mesh.V.rows(); ++v)
-        for (int c = 0; c < 3; ++c)
-            CHECK(row_sums[3 * v + c] == Approx(lumped[v]).epsilon(1e-12));
+    const Eigen::VectorXd lumped_diagonal = lumped.replicate(1, 3).transpose().reshaped();  // m_v three times
+    CHECK_THAT(entries_of(row_sums), EntriesNear(lumped_diagonal, 0.0, 1e-12));
     // A rigid translation along x: kinetic energy ½ (ρ·volume) · 1².
     Eigen::VectorXd along_x = Eigen::VectorXd::Zero(M.rows());
     for (Eigen::Index v = 0; v < mesh.V.rows(); ++v)

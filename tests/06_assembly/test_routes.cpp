@@ -8,6 +8,7 @@
 #include "common/error.hpp"
 #include "common/mesh.hpp"
 #include "common/random.hpp"
+#include "common/test_support.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -20,6 +21,8 @@ using fem::test::dense_assembly;
 using fem::test::distorted_mesh;
 using fem::test::relative_difference;
 using Catch::Matchers::Contains;
+using fem::test::EntriesNear;
+using fem::test::entries_of;
 
 namespace {
 
@@ -51,10 +54,11 @@ TEST_CASE("E_t picks the element's 12 dofs out of q", "[ex06.1]")
         REQUIRE(E.rows() == 12);
         REQUIRE(E.cols() == 3 * mesh.V.rows());
         CHECK(E.nonZeros() == 12);
-        const Eigen::VectorXd q_e = E * q;
+        Eigen::VectorXd expected(12);  // the coordinates of the tet's corners, vertex-major
         for (int i = 0; i < 4; ++i)
-            for (int c = 0; c < 3; ++c)
-                CHECK(q_e[3 * i + c] == q[3 * mesh.T(t, i) + c]);
+            expected.segment<3>(3 * i) = q.segment<3>(3 * mesh.T(t, i));
+        INFO("tet " << t);
+        CHECK_THAT(entries_of(E * q), EntriesNear(expected, 0.0));
         // E_t E_tᵀ = I₁₂: the four corners are different vertices.
         CHECK(dense(SparseMatrix(E * E.transpose())).isIdentity(0.0));
     }
@@ -235,9 +239,12 @@ TEST_CASE("element_stiffnesses are chapter 05's K_e of each tet", "[ch06]")
     const TetMesh mesh = distorted_mesh(2, 1, 1);
     const ElementMatrices K_e = element_stiffnesses(mesh, fem::test::rubber);
     REQUIRE(K_e.size() == static_cast<std::size_t>(mesh.T.rows()));
-    for (int t = 0; t < mesh.T.rows(); ++t)
-        CHECK(K_e[t] == fem::elastic::element_stiffness(fem::tet::tet_vertices(mesh, mesh.V, t),
-                                                        fem::test::rubber));
+    for (int t = 0; t < mesh.T.rows(); ++t) {
+        INFO("tet " << t);
+        CHECK_THAT(entries_of(K_e[t]), EntriesNear(fem::elastic::element_stiffness(
+                                                       fem::tet::tet_vertices(mesh, mesh.V, t), fem::test::rubber),
+                                                   0.0));
+    }
 }
 
 TEST_CASE("every route rejects bad indices and a wrong number of element matrices", "[ex06.4]")

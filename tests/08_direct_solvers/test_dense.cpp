@@ -5,6 +5,7 @@
 #include "direct_test_support.hpp"
 
 #include "common/error.hpp"
+#include "common/test_support.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -19,6 +20,8 @@ using fem::direct::test::random_spd;
 using fem::random_vector;
 using Catch::Matchers::Contains;
 using fem::direct::test::fem_error_message;
+using fem::test::EntriesNear;
+using fem::test::entries_of;
 
 namespace {
 
@@ -48,7 +51,7 @@ TEST_CASE("LU: P A = L U reconstructs A, with unit lower L, |multipliers| ≤ 1 
         REQUIRE(F.size() == n);
         const Eigen::MatrixXd L = F.L(), U = F.U(), P = F.P();
         // backward error of Gaussian elimination with partial pivoting: O(n ε ‖A‖) for a modest growth
-        CHECK((P * A - L * U).cwiseAbs().maxCoeff() <= 10.0 * n * eps * A.cwiseAbs().maxCoeff());
+        CHECK_THAT(entries_of(L * U), EntriesNear(P * A, 10.0 * n * eps * A.cwiseAbs().maxCoeff()));
         CHECK(L.cwiseAbs().maxCoeff() <= 1.0);  // partial pivoting: every multiplier |l_ij| ≤ 1
         CHECK(Eigen::MatrixXd(U.triangularView<Eigen::StrictlyLower>()).isZero(0.0));
         // P is a permutation: every index once
@@ -192,9 +195,9 @@ TEST_CASE("Cholesky: L Lᵀ reconstructs A, L is Eigen's LLT factor, residual be
         const Eigen::MatrixXd L = cholesky_factor(A);
         CHECK(Eigen::MatrixXd(L.triangularView<Eigen::StrictlyUpper>()).isZero(0.0));
         CHECK((L.diagonal().array() > 0.0).all());
-        CHECK((L * L.transpose() - A).cwiseAbs().maxCoeff() <= 10.0 * n * eps * A.cwiseAbs().maxCoeff());
+        CHECK_THAT(entries_of(L * L.transpose()), EntriesNear(A, 10.0 * n * eps * A.cwiseAbs().maxCoeff()));
         const Eigen::MatrixXd L_eigen = A.llt().matrixL();
-        CHECK((L - L_eigen).cwiseAbs().maxCoeff() <= 1e-13 * L_eigen.cwiseAbs().maxCoeff());
+        CHECK_THAT(entries_of(L), EntriesNear(L_eigen, 1e-13 * L_eigen.cwiseAbs().maxCoeff()));
         const Eigen::VectorXd b = random_vector(n, 40 + n);
         const Eigen::VectorXd x = cholesky_solve(L, b);
         CHECK(relative_residual(A, x, b) < 1e-12);
@@ -207,7 +210,7 @@ TEST_CASE("Cholesky: reads only the lower triangle", "[ex08.4]")
     Eigen::MatrixXd A = random_spd(12, 8);
     const Eigen::MatrixXd L = cholesky_factor(A);
     A.triangularView<Eigen::StrictlyUpper>().setConstant(1e6);  // garbage above the diagonal
-    CHECK((cholesky_factor(A) - L).cwiseAbs().maxCoeff() == 0.0);
+    CHECK_THAT(entries_of(cholesky_factor(A)), EntriesNear(L, 0.0));
 }
 
 TEST_CASE("Cholesky: a matrix that is not SPD is an fem::Error naming the column, the pivot and 'not SPD'",

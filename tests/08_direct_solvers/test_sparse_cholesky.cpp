@@ -11,6 +11,7 @@
 
 #include "common/error.hpp"
 #include "common/mesh.hpp"
+#include "common/test_support.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -22,6 +23,8 @@ using namespace fem;
 using namespace fem::direct;
 using namespace fem::direct::test;
 using Catch::Matchers::Contains;
+using fem::test::EntriesNear;
+using fem::test::entries_of;
 
 namespace {
 
@@ -91,7 +94,7 @@ TEST_CASE("up-looking Cholesky: L equals Eigen's factor of the same permuted mat
                 CHECK(L.JA[L.IA[j]] == j);  // the diagonal first
             const Eigen::MatrixXd L_eigen = eigen_factor_natural(eigen_permuted(sparse::to_eigen(m.A), p));
             const Eigen::MatrixXd L_ours = sparse::to_eigen(L);
-            CHECK((L_ours - L_eigen).cwiseAbs().maxCoeff() <= 1e-13 * L_eigen.cwiseAbs().maxCoeff());
+            CHECK_THAT(entries_of(L_ours), EntriesNear(L_eigen, 1e-13 * L_eigen.cwiseAbs().maxCoeff()));
         }
     }
 }
@@ -137,9 +140,9 @@ TEST_CASE("sparse Cholesky: the supernodal and the up-looking factors agree, and
         CHECK(super.supernodes() < up.supernodes());
         CHECK(super.stored_entries() >= super.factor_nonzeros());
         const Eigen::MatrixXd L_up = sparse::to_eigen(up.factor()), L_super = sparse::to_eigen(super.factor());
-        CHECK((L_up - L_super).cwiseAbs().maxCoeff() <= 1e-13 * L_up.cwiseAbs().maxCoeff());
+        CHECK_THAT(entries_of(L_super), EntriesNear(L_up, 1e-13 * L_up.cwiseAbs().maxCoeff()));
         const Eigen::MatrixXd C = eigen_permuted(sparse::to_eigen(m.A), up.permutation());
-        CHECK((L_super * L_super.transpose() - C).cwiseAbs().maxCoeff() <= 1e-13 * C.cwiseAbs().maxCoeff());
+        CHECK_THAT(entries_of(L_super * L_super.transpose()), EntriesNear(C, 1e-13 * C.cwiseAbs().maxCoeff()));
     }
 }
 

@@ -11,6 +11,7 @@
 #include "07_sparse_storage/sparse_formats.hpp"
 #include "08_direct_solvers/model_problems.hpp"
 #include "common/error.hpp"
+#include "common/test_support.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -29,6 +30,8 @@ using fem::cg::test::spd_with_spectrum;
 using fem::cg::test::tridiagonal_laplacian;
 using fem::sparse::CsrMatrix;
 using Catch::Matchers::Contains;
+using fem::test::EntriesNear;
+using fem::test::entries_of;
 
 namespace {
 
@@ -151,14 +154,9 @@ TEST_CASE("IC(0) reproduces A on its pattern and drops the fill elsewhere", "[ex
     const Eigen::MatrixXd L = dense_of(ic.L);
     const Eigen::MatrixXd M = L * L.transpose();
     const Eigen::MatrixXd dense = dense_of(A);
-    double off_pattern = 0.0;
-    for (int i = 0; i < 36; ++i)
-        for (int j = 0; j < 36; ++j) {
-            if (dense(i, j) != 0.0)
-                CHECK(M(i, j) == Approx(dense(i, j)).epsilon(1e-12));
-            else
-                off_pattern = std::max(off_pattern, std::abs(M(i, j)));
-        }
+    const auto on_pattern = (dense.array() != 0.0);
+    CHECK_THAT(entries_of(on_pattern.select(M, 0.0)), EntriesNear(dense, 0.0, 1e-12));
+    const double off_pattern = on_pattern.select(0.0, M).cwiseAbs().maxCoeff();
     CHECK(off_pattern > 1.0);  // the dropped fill: L Lᵀ ≠ A off the pattern
     // The same pattern as A's lower triangle.
     const CsrMatrix lower = fem::sparse::lower_triangle(A);
