@@ -32,6 +32,7 @@
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
 #include <vtkScalarBarActor.h>
+#include <vtkStringArray.h>
 #include <vtkTable.h>
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
@@ -46,8 +47,10 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <limits>
+#include <sstream>
 #include <thread>
 
 namespace fem::fig {
@@ -143,21 +146,86 @@ struct Scale {
     double from(double scaled) const { return log ? std::pow(10.0, scaled) : scaled; }
 };
 
+/// The ticks of a log axis over [low, high] (log10 of the values): 1 … 9 times the powers of ten
+/// over up to one decade, 1, 2 and 5 times them up to 3.5 decades, every power of ten up to 8
+/// decades, every k-th one beyond.
+std::vector<double> log_ticks(double low, double high)
+{
+    std::vector<double> ticks;
+    const double span = high - low;
+    const int step = span <= 8.0 ? 1 : static_cast<int>(std::ceil(span / 8.0));
+    for (int power = static_cast<int>(std::floor(low)); power <= static_cast<int>(std::ceil(high)); ++power) {
+        if (power % step != 0)
+            continue;
+        const std::vector<double> multiples = span <= 1.0   ? std::vector<double>{1, 2, 3, 4, 5, 6, 7, 8, 9}
+                                              : span <= 3.5 ? std::vector<double>{1, 2, 5}
+                                                            : std::vector<double>{1};
+        for (double m : multiples) {
+            const double tick = power + std::log10(m);
+            if (tick >= low - 1e-9 && tick <= high + 1e-9)
+                ticks.push_back(tick);
+        }
+    }
+    return ticks;
+}
+
+/// A tick label as a person writes it: 0.002, 50000, 1e-6, 2e8.
+std::string tick_label(double value)
+{
+    const double magnitude = std::abs(value);
+    if (magnitude >= 1e-4 && magnitude < 1e6) {
+        std::ostringstream out;
+        out << std::setprecision(6) << value;
+        return out.str();
+    }
+    const int exponent = static_cast<int>(std::floor(std::log10(magnitude) + 1e-9));
+    const long mantissa = std::lround(value / std::pow(10.0, exponent));
+    return str(mantissa, "e", exponent);
+}
+
 /// The range [low, high] (in the axis's scale) that shows data from low to high with room around
 /// it: 5% of the span on each side, so that neither a line nor a marker touches the frame. A log
-/// axis spans at least two powers of ten, so that it has at least two labels.
+/// axis grows to the next 1-2-5 values if it would otherwise have fewer than two ticks.
 std::pair<double, double> padded_range(double low, double high, bool log)
 {
     double span = high - low;
     if (!(span > 0.0))  // one value: a window around it
-        span = log ? 1.0 : std::max(std::abs(high), 1.0);
+        span = log ? 0.5 : std::max(std::abs(high), 1.0);
     low -= 0.05 * span;
     high += 0.05 * span;
-    if (log && std::floor(high) - std::ceil(low) < 1.0) {
-        low = std::floor(low);
-        high = std::ceil(high);
+    if (log && log_ticks(low, high).size() < 2) {
+        const auto below = [](double x) {  // the largest 1-2-5 value ≤ 10^x, as log10
+            const double power = std::floor(x);
+            double best = power;
+            for (double m : {2.0, 5.0})
+                if (power + std::log10(m) <= x)
+                    best = power + std::log10(m);
+            return best;
+        };
+        const auto above = [](double x) {  // the smallest 1-2-5 value ≥ 10^x, as log10
+            const double power = std::floor(x);
+            for (double m : {1.0, 2.0, 5.0})
+                if (power + std::log10(m) >= x)
+                    return power + std::log10(m);
+            return power + 1.0;
+        };
+        low = below(low);
+        high = above(high);
     }
     return {low, high};
+}
+
+/// Gives a log axis the ticks of log_ticks, labelled by tick_label (VTK's own choice leaves some
+/// axes with a single label).
+void set_log_ticks(vtkAxis* axis, double low, double high)
+{
+    vtkNew<vtkDoubleArray> positions;
+    vtkNew<vtkStringArray> labels;
+    for (double tick : log_ticks(low, high)) {
+        positions->InsertNextValue(tick);
+        labels->InsertNextValue(tick_label(std::pow(10.0, tick)));
+    }
+    axis->SetCustomTickPositions(positions, labels);
 }
 
 /// A rectangle in pixels (origin bottom left, as VTK's context items use).
@@ -299,6 +367,32 @@ vtkSmartPointer<vtkLookupTable> category_colours(const std::vector<Category>& ca
     return table;
 }
 
+/// The mesh without the cells that have a vertex on the normal's side of the plane (the points and
+/// point fields stay; the cell fields keep the rows of the cells that stay).
+io::MeshData cut_away(const io::MeshData& mesh, const CutPlane& plane)
+{
+    const Eigen::Vector3d point(plane.point.data()), normal(plane.normal.data());
+    const double tolerance = 1e-9 * (mesh.points.colwise().maxCoeff() - mesh.points.colwise().minCoeff()).norm();
+    std::vector<Eigen::Index> kept;
+    for (Eigen::Index c = 0; c < mesh.cells.rows(); ++c) {
+        bool behind = true;
+        for (Eigen::Index k = 0; k < mesh.cells.cols(); ++k)
+            behind = behind && (mesh.points.row(mesh.cells(c, k)).transpose() - point).dot(normal) <= tolerance;
+        if (behind)
+            kept.push_back(c);
+    }
+    io::MeshData out{mesh.points, MatrixXiR(kept.size(), mesh.cells.cols()), mesh.point_data, {}};
+    for (std::size_t i = 0; i < kept.size(); ++i)
+        out.cells.row(static_cast<Eigen::Index>(i)) = mesh.cells.row(kept[i]);
+    for (const io::Field& field : mesh.cell_data) {
+        io::Field rows{field.name, Eigen::MatrixXd(kept.size(), field.values.cols())};
+        for (std::size_t i = 0; i < kept.size(); ++i)
+            rows.values.row(static_cast<Eigen::Index>(i)) = field.values.row(kept[i]);
+        out.cell_data.push_back(rows);
+    }
+    return out;
+}
+
 /// Draws a data set's surface coloured by a field into a PNG. A mesh (lit = true) is lit by a key,
 /// a fill and a back light, with ambient light so that no face is black, and shows its edges if
 /// asked; a flat grid is drawn unlit, in the colour map's own colours.
@@ -360,27 +454,48 @@ bool render_dataset(const std::filesystem::path& path, vtkDataSet* data, bool ce
         look->SetSpecular(0.0);
     }
 
-    // The colour bar (or, for categories, a legend of swatches) on the right; its title is a text
-    // of its own above it, so that a long field name is never cut to the bar's width.
-    vtkNew<vtkScalarBarActor> bar;
-    bar->SetLookupTable(colours);
-    bar->SetNumberOfLabels(5);
-    bar->SetWidth(0.09);
-    bar->SetHeight(0.72);
-    bar->SetPosition(0.88, 0.08);
-    bar->UnconstrainedFontSizeOn();
-    set_font(bar->GetLabelTextProperty(), 15);
-    set_font(bar->GetAnnotationTextProperty(), 15);
-    if (!options.categories.empty()) {
-        bar->SetPosition(0.82, 0.08);
-        bar->SetWidth(0.15);
-        bar->SetTextPositionToPrecedeScalarBar();
+    // A continuous field gets a colour bar on the right, its title a text of its own above it (so
+    // that a long field name is never cut to the bar's width); a categorical one a row of swatches
+    // along the bottom instead.
+    std::vector<vtkSmartPointer<vtkActor2D>> keys;
+    if (options.categories.empty()) {
+        auto bar = vtkSmartPointer<vtkScalarBarActor>::New();
+        bar->SetLookupTable(colours);
+        bar->SetNumberOfLabels(5);
+        bar->SetWidth(0.09);
+        bar->SetHeight(0.72);
+        bar->SetPosition(0.88, 0.08);
+        bar->UnconstrainedFontSizeOn();
+        set_font(bar->GetLabelTextProperty(), 15);
+        keys.push_back(bar);
+        auto bar_title = vtkSmartPointer<vtkTextActor>::New();
+        bar_title->SetInput(options.field.c_str());
+        set_font(bar_title->GetTextProperty(), 17, true);
+        bar_title->GetTextProperty()->SetJustificationToRight();
+        bar_title->SetPosition(options.width - 16, 0.82 * options.height);
+        keys.push_back(bar_title);
+    } else {
+        double x = 20.0;
+        for (const Category& c : options.categories) {
+            // A filled square in the category's colour under an outlined one, then the name.
+            for (const auto& [glyph, rgb] : {std::pair{"\u25A0", c.colour}, std::pair{"\u25A1", std::array{0.3, 0.3, 0.3}}}) {
+                auto swatch = vtkSmartPointer<vtkTextActor>::New();
+                swatch->SetInput(glyph);
+                set_font(swatch->GetTextProperty(), 24);
+                swatch->GetTextProperty()->SetColor(rgb[0], rgb[1], rgb[2]);
+                swatch->SetPosition(x, 14.0);
+                keys.push_back(swatch);
+            }
+            auto name = vtkSmartPointer<vtkTextActor>::New();
+            name->SetInput(c.name.c_str());
+            set_font(name->GetTextProperty(), 17);
+            name->SetPosition(x + 30.0, 18.0);
+            keys.push_back(name);
+            int box[4] = {0, 0, 0, 0};
+            vtkTextRenderer::GetInstance()->GetBoundingBox(name->GetTextProperty(), c.name, box, 72);
+            x += 30.0 + (box[1] - box[0]) + 36.0;
+        }
     }
-    vtkNew<vtkTextActor> bar_title;
-    bar_title->SetInput(options.field.c_str());
-    set_font(bar_title->GetTextProperty(), 17, true);
-    bar_title->GetTextProperty()->SetJustificationToRight();
-    bar_title->SetPosition(options.width - 16, 0.82 * options.height);
 
     vtkNew<vtkTextActor> title;
     title->SetInput(options.title.c_str());
@@ -388,13 +503,19 @@ bool render_dataset(const std::filesystem::path& path, vtkDataSet* data, bool ce
     title->GetTextProperty()->SetVerticalJustificationToTop();  // a title of several lines grows downwards
     title->SetPosition(20, options.height - 14);
 
-    vtkNew<vtkRenderer> renderer;
-    renderer->AddActor(actor);
-    renderer->AddActor2D(bar);
-    renderer->AddActor2D(bar_title);
-    renderer->AddActor2D(title);
+    // Three renderers: a white backdrop, the data (left of the colour bar's strip, so that neither
+    // the bar nor its title ever covers it), and the texts over the whole window.
+    const bool bar_strip = options.categories.empty();
+    vtkNew<vtkRenderer> backdrop, renderer, texts;
+    backdrop->SetBackground(1.0, 1.0, 1.0);
     renderer->SetBackground(1.0, 1.0, 1.0);
-    renderer->SetViewport(0.0, 0.0, 1.0, 1.0);
+    renderer->SetViewport(0.0, 0.0, bar_strip ? 0.84 : 1.0, 1.0);
+    renderer->AddActor(actor);
+    texts->SetLayer(1);
+    texts->InteractiveOff();
+    for (const auto& key : keys)
+        texts->AddActor2D(key);
+    texts->AddActor2D(title);
     vtkCamera* camera = renderer->GetActiveCamera();
     camera->SetPosition(-options.view_direction[0], -options.view_direction[1],
                         -options.view_direction[2]);
@@ -417,7 +538,10 @@ bool render_dataset(const std::filesystem::path& path, vtkDataSet* data, bool ce
     window->SetDisplayId(shared_display());
     window->SetOffScreenRendering(1);
     window->SetSize(options.width, options.height);
+    window->SetNumberOfLayers(2);
+    window->AddRenderer(backdrop);
     window->AddRenderer(renderer);
+    window->AddRenderer(texts);
     window->Render();
     write_png(window, path);
     return true;
@@ -545,6 +669,10 @@ bool save_chart(const LineChart& chart, const std::filesystem::path& stem, bool 
         y_axis->SetBehavior(vtkAxis::FIXED);
         x_axis->SetUnscaledRange(layout.sx.from(layout.x_low), layout.sx.from(layout.x_high));
         y_axis->SetUnscaledRange(layout.sy.from(layout.y_low), layout.sy.from(layout.y_high));
+        if (chart.log_x)
+            set_log_ticks(x_axis, layout.x_low, layout.x_high);
+        if (chart.log_y)
+            set_log_ticks(y_axis, layout.y_low, layout.y_high);
         window->Render();  // lays the chart out: the plot area is known after it
         layout.left = xy->GetPoint1()[0];
         layout.bottom = xy->GetPoint1()[1];
@@ -600,7 +728,7 @@ bool save_chart(const LineChart& chart, const std::filesystem::path& stem, bool 
 bool render_mesh_png(const std::filesystem::path& path, const io::MeshData& mesh,
                      const RenderOptions& options)
 {
-    const auto grid = io::detail::to_vtk(mesh);
+    const auto grid = io::detail::to_vtk(options.cut ? cut_away(mesh, *options.cut) : mesh);
     const bool point_field = grid->GetPointData()->HasArray(options.field.c_str());
     if (!point_field && !grid->GetCellData()->HasArray(options.field.c_str()))
         throw Error(str("cannot render field '", options.field, "': the mesh has no such field"));

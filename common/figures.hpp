@@ -61,6 +61,12 @@ struct Category {
     std::array<double, 3> colour;  ///< RGB in [0, 1]
 };
 
+/// A plane through point with the given normal (need not be unit length).
+struct CutPlane {
+    std::array<double, 3> point;
+    std::array<double, 3> normal;
+};
+
 /// How to colour and frame a rendered mesh or grid.
 struct RenderOptions {
     std::string title;                 ///< drawn at the top of the image
@@ -73,6 +79,9 @@ struct RenderOptions {
     /// A field of a few values drawn as categories (each in its colour, named in a legend of
     /// swatches) instead of on a continuous colour map; a value that is no category is drawn white.
     std::vector<Category> categories;
+    /// A mesh only: leave out every cell with a vertex on the side of this plane its normal points
+    /// to, so that a field inside the body shows on the cut (e.g. the masses of inner vertices).
+    std::optional<CutPlane> cut;
     /// The box (xmin, xmax, ymin, ymax, zmin, zmax) the camera frames; default: the mesh's own
     /// bounds. The frames of a motion share one box so that the camera stands still.
     std::optional<std::array<double, 6>> frame_bounds;

@@ -58,14 +58,15 @@ def slug(heading):
     return text.replace(" ", "-")
 
 
-def format_number(value):
-    """A table cell: integers whole, 4 significant digits otherwise; but a value that has at most 6
-    significant digits in full is printed in full (ν = 0.49999 must not read 0.5)."""
+def format_number(value, measured=False):
+    """A table cell: integers whole, 4 significant digits otherwise; but a value that has 5
+    significant digits in full is printed in full (ν = 0.49999 must not read 0.5). Measured values
+    (times, rates) always get 4 digits: more would be noise."""
     if value == int(value) and abs(value) < 1e6:
         return str(int(value))
     if 1e-2 <= abs(value) < 1e4:
-        exact = f"{value:.6g}"
-        return exact if float(exact) == value else f"{value:.4g}"
+        exact = f"{value:.5g}"
+        return exact if float(exact) == value and not measured else f"{value:.4g}"
     return f"{value:.3e}"
 
 
@@ -74,7 +75,8 @@ def markdown_table(csv_path):
     escape = lambda text: text.replace("|", "\\|")
     lines = ["| " + " | ".join(map(escape, header)) + " |", "|" + "|".join("---:" for _ in header) + "|"]
     for row in rows:
-        cells = [format_number(float(c)) if as_number(c) is not None else escape(c) for c in row]
+        cells = [format_number(float(c), is_measured(column)) if as_number(c) is not None else escape(c)
+                 for c, column in zip(row, header)]
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
 

@@ -318,7 +318,6 @@ void twisted_beam_study(const RunContext& run, const Settings& settings, const L
             options.range = std::make_pair(0.0, top);
             options.view_direction = {-0.45, 0.75, -0.5};
             options.view_up = {0.0, 0.0, 1.0};
-            options.show_edges = true;
             options.height = 520;
             fig::render_mesh_png(run.file(file), io::warped(data), options);
         }
