@@ -3,7 +3,8 @@
 header(s), main.cpp, solutions, tests, stored quick-run expectations and docs; a chapter includes
 only its own and earlier chapters' headers, each of them listed in its DEPENDS; common/ includes no
 chapter at all; no Catch2 test name contains a character that ctest cannot carry (';' splits a
-CMake list, so the ctest entry would run no test case); no test case carries more than one exercise
+CMake list, so the ctest entry would run no test case; a leading '-' makes Catch2 read it as an
+option); no test case carries more than one exercise
 tag [exNN.k] (a test grades one exercise; what else it needs, that exercise's docs list under
 "Builds on", and tools/exercises.py grade checks)."""
 
@@ -33,6 +34,9 @@ def test_case_problems(root):
             if ";" in name:
                 problems.append(f"{where}: test name '{name}' contains ';', which CMake splits: its "
                                 "ctest entry would run no test case")
+            if name.startswith("-"):
+                problems.append(f"{where}: test name '{name}' starts with '-': its ctest entry passes it "
+                                "to Catch2, which reads it as an option")
             tags = EXERCISE_TAG.findall(m["tags"] or "")
             if len(tags) > 1:
                 problems.append(f"{where}: test '{name}' has the exercise tags {''.join(tags)}: tag it "

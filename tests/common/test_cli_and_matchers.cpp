@@ -62,7 +62,7 @@ TEST_CASE("an unknown option is 'error: …' naming it, and exit code 1", "[cli]
     CHECK_THAT(bad_value.err, Contains("error: ") && Contains("--c"));
 }
 
-TEST_CASE("--help lists the options without CLI11's default-value markup, and exits with 0", "[cli]")
+TEST_CASE("the option --help lists the options without CLI11's default-value markup, and exits with 0", "[cli]")
 {
     const CliRun run = run_cli({"--help"});
     CHECK(run.code == 0);
@@ -71,7 +71,7 @@ TEST_CASE("--help lists the options without CLI11's default-value markup, and ex
     CHECK_THAT(run.out, !Contains("{false}"));
 }
 
-TEST_CASE("--no-figures turns the figures off", "[cli]")
+TEST_CASE("the flag --no-figures turns the figures off", "[cli]")
 {
     const std::string out_dir = fem::test::fresh_output_dir("cli").string();
     const CliRun run = run_cli({"--no-figures", "--out", out_dir});
