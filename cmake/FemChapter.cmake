@@ -7,16 +7,21 @@
 #   fem_chNN_reference  what later chapters link: always the reference solution, so a student
 #                       working on chapter 05 keeps chapters 06+ running;
 #   chNN_name           its executable in <build>/bin, from chapters/NN_name/main.cpp;
-#   test_chNN           its Catch2 tests from tests/NN_name/*.cpp (ctest label chNN);
+#   test_chNN           its Catch2 tests from tests/NN_name/*.cpp (ctest label chNN); a target of
+#                       its own: `cmake --build --preset student --target test_chNN`;
 #   chNN_quick_run      ctest: the executable in --quick mode, its files and figures against
 #                       tests/NN_name/expected (label chNN, run);
 #   chNN_docs           ctest: docs/NN_name.md names only functions and exercises that exist and
 #                       quotes the numbers the executable prints (label chNN, docs).
+#   chNN_test_target    ctest: building test_chNN alone builds no later chapter (label chNN, layout),
+#                       the student's one-chapter loop (README, "Student workflow").
 # DEPENDS lists earlier chapters whose headers this chapter includes; a later one is an error.
 
 set(FEM_ALL_CHAPTERS "" CACHE INTERNAL "registered chapters")
 add_custom_target(fem_tests)
 add_custom_target(fem_chapter_libs)
+
+include(${CMAKE_CURRENT_LIST_DIR}/FemExercises.cmake)
 
 # fem_discover_tests(target label): one ctest entry per Catch2 test case of target, named
 # "<label>: <test case>" and labelled <label>. Each entry runs with --warn NoTests, so an entry that
@@ -67,6 +72,7 @@ function(fem_add_chapter number name)
       DEPENDS ${solution_sources} ${FEM_ROOT}/tools/exercises.py
       COMMENT "Generating graded sources of chapter ${id}")
   elseif(from_exercises)
+    message(STATUS "chapter ${number}: from exercises/ (your code; later chapters keep the reference solution)")
     set(sources "")
     foreach(src IN LISTS solution_sources)
       get_filename_component(file_name ${src} NAME)
@@ -124,6 +130,10 @@ function(fem_add_chapter number name)
                      --chapter ${id} --bin ${CMAKE_BINARY_DIR}/bin
                      --out ${CMAKE_BINARY_DIR}/check_docs/${id})
     set_tests_properties(ch${number}_docs PROPERTIES LABELS "ch${number};docs")
+    add_test(NAME ch${number}_test_target
+             COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/check_targets.py --build ${CMAKE_BINARY_DIR}
+                     --chapter ${id})
+    set_tests_properties(ch${number}_test_target PROPERTIES LABELS "ch${number};layout")
   endif()
 
   # A chapter's own additions to the build (e.g. an optional reference library for its

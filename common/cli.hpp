@@ -31,13 +31,15 @@ public:
     CLI::App app;
 
     /// Parses argv, creates the output folder and calls body. Returns the process exit code:
-    /// 0 on success; 1 after printing "error: <message>" for fem::Error, an unfinished exercise
-    /// or any other failure; CLI11's code for a bad command line (after printing why).
+    /// 0 on success (and after --help); 1 after printing "error: <message>" for fem::Error, an
+    /// unfinished exercise, a bad command line (an unknown option, a value that does not parse)
+    /// or any other failure.
     int run(int argc, char** argv, const std::function<void(const RunContext&)>& body);
 
 private:
     RunContext context_;
     std::string out_text_;
+    bool no_figures_ = false;
 };
 
 }  // namespace fem

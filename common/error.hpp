@@ -29,7 +29,9 @@ public:
 /// be rejected with fem::Error must still fail on a stub.
 class NotImplemented : public std::logic_error {
 public:
-    /// exercise_id "05.2", function "strain_displacement_matrix", docs "docs/05_strain_stress.md#..."
+    /// exercise_id "05.2", function "strain_displacement_matrix", docs "docs/05_strain_stress.md#...".
+    /// The message is two lines: "exercise 05.2 (strain_displacement_matrix) is not implemented
+    /// yet; see" and the docs link alone, so that it can be copied whole.
     NotImplemented(std::string_view exercise_id, std::string_view function, std::string_view docs);
 };
 

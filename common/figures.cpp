@@ -19,6 +19,8 @@
 #include <vtkDataSetSurfaceFilter.h>
 #include <vtkDoubleArray.h>
 #include <vtkImageData.h>
+#include <vtkLightKit.h>
+#include <vtkLookupTable.h>
 #include <vtkNew.h>
 #include <vtkPNGWriter.h>
 #include <vtkPen.h>
@@ -30,19 +32,26 @@
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
 #include <vtkScalarBarActor.h>
+#include <vtkStringArray.h>
 #include <vtkTable.h>
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
+#include <vtkTextRenderer.h>
 #include <vtkUnstructuredGrid.h>
+#include <vtkVariant.h>
 #include <vtkWindowToImageFilter.h>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
-#include <thread>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
+#include <limits>
+#include <sstream>
+#include <thread>
 
 namespace fem::fig {
 namespace {
@@ -105,9 +114,227 @@ constexpr std::array<std::array<unsigned char, 3>, 8> line_colours{{
     {31, 119, 180}, {255, 127, 14}, {44, 160, 44}, {214, 39, 40},
     {148, 103, 189}, {140, 86, 75}, {227, 119, 194}, {127, 127, 127}}};
 
+/// Sets a text's font, size and colour. The figures use DejaVu Sans (Debian's fonts-dejavu-core,
+/// which tools/setup.sh installs) when it is there: VTK's built-in Arial draws '|' so thin that
+/// "|u|" reads "l u l", and has no Greek. Without it VTK's own font is used.
+void set_font(vtkTextProperty* text, int size, bool bold = false)
+{
+    static const std::string regular = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
+    static const std::string heavy = "/usr/share/fonts/truetype/dejavu/DejaVuSans-Bold.ttf";
+    static const bool installed = std::filesystem::exists(regular) && std::filesystem::exists(heavy);
+    if (installed) {
+        text->SetFontFamily(VTK_FONT_FILE);
+        text->SetFontFile((bold ? heavy : regular).c_str());
+    }
+    text->SetBold(bold && !installed);  // the bold file is bold already: no synthetic emboldening
+    text->SetItalic(false);
+    text->SetShadow(false);
+    text->SetFontSize(size);
+    text->SetColor(0.1, 0.1, 0.1);
+}
+
 bool plottable(double x, double y, const LineChart& chart)
 {
     return std::isfinite(x) && std::isfinite(y) && (!chart.log_x || x > 0) && (!chart.log_y || y > 0);
+}
+
+/// One axis of a chart: linear or log10. Ranges and layout are computed in the axis's own scale
+/// (log10 of the value on a log axis), where the plot is linear.
+struct Scale {
+    bool log = false;
+    double to(double value) const { return log ? std::log10(value) : value; }
+    double from(double scaled) const { return log ? std::pow(10.0, scaled) : scaled; }
+};
+
+/// The ticks of a log axis over [low, high] (log10 of the values): 1 … 9 times the powers of ten
+/// over up to one decade, 1, 2 and 5 times them up to 3.5 decades, every power of ten up to 8
+/// decades, every k-th one beyond.
+std::vector<double> log_ticks(double low, double high)
+{
+    std::vector<double> ticks;
+    const double span = high - low;
+    const int step = span <= 8.0 ? 1 : static_cast<int>(std::ceil(span / 8.0));
+    for (int power = static_cast<int>(std::floor(low)); power <= static_cast<int>(std::ceil(high)); ++power) {
+        if (power % step != 0)
+            continue;
+        const std::vector<double> multiples = span <= 1.0   ? std::vector<double>{1, 2, 3, 4, 5, 6, 7, 8, 9}
+                                              : span <= 3.5 ? std::vector<double>{1, 2, 5}
+                                                            : std::vector<double>{1};
+        for (double m : multiples) {
+            const double tick = power + std::log10(m);
+            if (tick >= low - 1e-9 && tick <= high + 1e-9)
+                ticks.push_back(tick);
+        }
+    }
+    return ticks;
+}
+
+/// A tick label as a person writes it: 0.002, 50000, 1e-6, 2e8.
+std::string tick_label(double value)
+{
+    const double magnitude = std::abs(value);
+    if (magnitude >= 1e-4 && magnitude < 1e6) {
+        std::ostringstream out;
+        out << std::setprecision(6) << value;
+        return out.str();
+    }
+    const int exponent = static_cast<int>(std::floor(std::log10(magnitude) + 1e-9));
+    const long mantissa = std::lround(value / std::pow(10.0, exponent));
+    return str(mantissa, "e", exponent);
+}
+
+/// The range [low, high] (in the axis's scale) that shows data from low to high with room around
+/// it: 5% of the span on each side, so that neither a line nor a marker touches the frame. A log
+/// axis grows to the next 1-2-5 values if it would otherwise have fewer than two ticks.
+std::pair<double, double> padded_range(double low, double high, bool log)
+{
+    double span = high - low;
+    if (!(span > 0.0))  // one value: a window around it
+        span = log ? 0.5 : std::max(std::abs(high), 1.0);
+    low -= 0.05 * span;
+    high += 0.05 * span;
+    if (log && log_ticks(low, high).size() < 2) {
+        const auto below = [](double x) {  // the largest 1-2-5 value ≤ 10^x, as log10
+            const double power = std::floor(x);
+            double best = power;
+            for (double m : {2.0, 5.0})
+                if (power + std::log10(m) <= x)
+                    best = power + std::log10(m);
+            return best;
+        };
+        const auto above = [](double x) {  // the smallest 1-2-5 value ≥ 10^x, as log10
+            const double power = std::floor(x);
+            for (double m : {1.0, 2.0, 5.0})
+                if (power + std::log10(m) >= x)
+                    return power + std::log10(m);
+            return power + 1.0;
+        };
+        low = below(low);
+        high = above(high);
+    }
+    return {low, high};
+}
+
+/// Gives a log axis the ticks of log_ticks, labelled by tick_label (VTK's own choice leaves some
+/// axes with a single label).
+void set_log_ticks(vtkAxis* axis, double low, double high)
+{
+    vtkNew<vtkDoubleArray> positions;
+    vtkNew<vtkStringArray> labels;
+    for (double tick : log_ticks(low, high)) {
+        positions->InsertNextValue(tick);
+        labels->InsertNextValue(tick_label(std::pow(10.0, tick)));
+    }
+    axis->SetCustomTickPositions(positions, labels);
+}
+
+/// A rectangle in pixels (origin bottom left, as VTK's context items use).
+struct PixelBox {
+    double left, bottom, right, top;
+    bool contains(double x, double y) const { return x >= left && x <= right && y >= bottom && y <= top; }
+};
+
+/// True when the segment from (x0, y0) to (x1, y1) meets the box (Liang–Barsky clipping).
+bool segment_meets(const PixelBox& box, double x0, double y0, double x1, double y1)
+{
+    const double dx = x1 - x0, dy = y1 - y0;
+    const double p[4] = {-dx, dx, -dy, dy};
+    const double q[4] = {x0 - box.left, box.right - x0, y0 - box.bottom, box.top - y0};
+    double enter = 0.0, leave = 1.0;
+    for (int k = 0; k < 4; ++k) {
+        if (p[k] == 0.0) {
+            if (q[k] < 0.0)
+                return false;  // parallel to this edge and outside it
+            continue;
+        }
+        const double t = q[k] / p[k];
+        if (p[k] < 0.0)
+            enter = std::max(enter, t);
+        else
+            leave = std::min(leave, t);
+        if (enter > leave)
+            return false;
+    }
+    return true;
+}
+
+/// The drawn series of a chart in the axes' scales, and how to map them to pixels once the chart is
+/// laid out (its plot area, Point1 to Point2, is known only after a render).
+struct ChartLayout {
+    struct Curve {
+        std::vector<double> x, y;  // in the axes' scales
+        bool markers = false;
+    };
+    std::vector<Curve> curves;
+    Scale sx, sy;
+    double x_low = 0, x_high = 1, y_low = 0, y_high = 1;  // the axis ranges, in the axes' scales
+    double left = 0, bottom = 0, right = 1, top = 1;      // the plot area in pixels
+
+    double pixel_x(double x) const { return left + (x - x_low) / (x_high - x_low) * (right - left); }
+    double pixel_y(double y) const { return bottom + (y - y_low) / (y_high - y_low) * (top - bottom); }
+
+    /// Whether any line or marker of the chart is drawn inside the box.
+    bool covers(const PixelBox& box) const
+    {
+        constexpr double marker_radius = 9.0;  // half a 14-pixel marker, and a little air
+        const PixelBox grown{box.left - marker_radius, box.bottom - marker_radius, box.right + marker_radius,
+                             box.top + marker_radius};
+        for (const Curve& c : curves)
+            for (std::size_t i = 0; i < c.x.size(); ++i) {
+                const double px = pixel_x(c.x[i]), py = pixel_y(c.y[i]);
+                if (c.markers ? grown.contains(px, py) : box.contains(px, py))
+                    return true;
+                if (!c.markers && i > 0 && segment_meets(box, pixel_x(c.x[i - 1]), pixel_y(c.y[i - 1]), px, py))
+                    return true;
+            }
+        return false;
+    }
+
+    /// Where a legend of the given size sits in a corner of the plot area, inset by a margin.
+    PixelBox legend_box(Corner corner, double width, double height) const
+    {
+        constexpr double inset = 8.0;
+        const bool at_left = corner == Corner::top_left || corner == Corner::bottom_left;
+        const bool at_top = corner == Corner::top_left || corner == Corner::top_right;
+        const double x0 = at_left ? left + inset : right - inset - width;
+        const double y0 = at_top ? top - inset - height : bottom + inset;
+        return {x0, y0, x0 + width, y0 + height};
+    }
+
+    /// The data's extent along y, in the axis's scale, over the pixel columns [from, to].
+    std::pair<double, double> y_extent_between(double from, double to) const
+    {
+        double low = std::numeric_limits<double>::infinity(), high = -low;
+        for (const Curve& c : curves)
+            for (std::size_t i = 0; i < c.x.size(); ++i) {
+                const double px = pixel_x(c.x[i]);
+                const bool inside = px >= from && px <= to;
+                const bool crossing = !c.markers && i > 0 &&
+                                      std::min(px, pixel_x(c.x[i - 1])) <= to && std::max(px, pixel_x(c.x[i - 1])) >= from;
+                if (inside || crossing) {
+                    low = std::min({low, c.y[i], crossing ? c.y[i - 1] : c.y[i]});
+                    high = std::max({high, c.y[i], crossing ? c.y[i - 1] : c.y[i]});
+                }
+            }
+        return {low, high};
+    }
+};
+
+/// The pixel size of the legend vtkChartLegend draws for these names (its own formula: the widest
+/// label, the symbol and padding across; a line of "Tgyf" height and padding per entry).
+std::pair<double, double> legend_size(vtkTextProperty* labels, const std::vector<std::string>& names)
+{
+    constexpr int padding = 5, symbol_width = 25, dpi = 72;
+    vtkTextRenderer* renderer = vtkTextRenderer::GetInstance();
+    int box[4] = {0, 0, 0, 0};
+    renderer->GetBoundingBox(labels, "Tgyf", box, dpi);
+    const double line = box[3] - box[2] + 1;
+    double widest = 0.0;
+    for (const std::string& name : names) {
+        renderer->GetBoundingBox(labels, name, box, dpi);
+        widest = std::max(widest, double(box[1] - box[0] + 1));
+    }
+    return {widest + 2 * padding + symbol_width + 4, names.size() * (line + padding) + padding + 4};
 }
 
 /// A perceptually ordered colour map (viridis, sampled at 5 points).
@@ -124,8 +351,52 @@ vtkSmartPointer<vtkColorTransferFunction> viridis(double low, double high)
     return map;
 }
 
-/// Draws a data set's surface coloured by a field into a PNG.
-bool render_dataset(const std::filesystem::path& path, vtkDataSet* data, bool cell_field,
+/// The colours of a categorical field: value k of options.categories in its colour, anything else in
+/// the background colour (white), with the names as the legend's annotations.
+vtkSmartPointer<vtkLookupTable> category_colours(const std::vector<Category>& categories)
+{
+    auto table = vtkSmartPointer<vtkLookupTable>::New();
+    table->IndexedLookupOn();
+    table->SetNumberOfTableValues(static_cast<vtkIdType>(categories.size()));
+    for (std::size_t k = 0; k < categories.size(); ++k) {
+        const Category& c = categories[k];
+        table->SetTableValue(static_cast<vtkIdType>(k), c.colour[0], c.colour[1], c.colour[2], 1.0);
+        table->SetAnnotation(vtkVariant(c.value), c.name);
+    }
+    table->SetNanColor(1.0, 1.0, 1.0, 1.0);
+    return table;
+}
+
+/// The mesh without the cells that have a vertex on the normal's side of the plane (the points and
+/// point fields stay; the cell fields keep the rows of the cells that stay).
+io::MeshData cut_away(const io::MeshData& mesh, const CutPlane& plane)
+{
+    const Eigen::Vector3d point(plane.point.data()), normal(plane.normal.data());
+    const double tolerance = 1e-9 * (mesh.points.colwise().maxCoeff() - mesh.points.colwise().minCoeff()).norm();
+    std::vector<Eigen::Index> kept;
+    for (Eigen::Index c = 0; c < mesh.cells.rows(); ++c) {
+        bool behind = true;
+        for (Eigen::Index k = 0; k < mesh.cells.cols(); ++k)
+            behind = behind && (mesh.points.row(mesh.cells(c, k)).transpose() - point).dot(normal) <= tolerance;
+        if (behind)
+            kept.push_back(c);
+    }
+    io::MeshData out{mesh.points, MatrixXiR(kept.size(), mesh.cells.cols()), mesh.point_data, {}};
+    for (std::size_t i = 0; i < kept.size(); ++i)
+        out.cells.row(static_cast<Eigen::Index>(i)) = mesh.cells.row(kept[i]);
+    for (const io::Field& field : mesh.cell_data) {
+        io::Field rows{field.name, Eigen::MatrixXd(kept.size(), field.values.cols())};
+        for (std::size_t i = 0; i < kept.size(); ++i)
+            rows.values.row(static_cast<Eigen::Index>(i)) = field.values.row(kept[i]);
+        out.cell_data.push_back(rows);
+    }
+    return out;
+}
+
+/// Draws a data set's surface coloured by a field into a PNG. A mesh (lit = true) is lit by a key,
+/// a fill and a back light, with ambient light so that no face is black, and shows its edges if
+/// asked; a flat grid is drawn unlit, in the colour map's own colours.
+bool render_dataset(const std::filesystem::path& path, vtkDataSet* data, bool cell_field, bool lit,
                     const RenderOptions& options)
 {
     vtkNew<vtkDataSetSurfaceFilter> surface;
@@ -147,55 +418,114 @@ bool render_dataset(const std::filesystem::path& path, vtkDataSet* data, bool ce
     else
         mapper->SetScalarModeToUsePointFieldData();
     mapper->SelectColorArray(options.field.c_str());
-    auto colours = viridis(range[0], range[1]);
-    if (component < 0) {
-        colours->SetVectorModeToMagnitude();
+    vtkSmartPointer<vtkScalarsToColors> colours;
+    if (options.categories.empty()) {
+        auto continuous = viridis(range[0], range[1]);
+        if (component < 0) {
+            continuous->SetVectorModeToMagnitude();
+        } else {
+            continuous->SetVectorModeToComponent();
+            continuous->SetVectorComponent(component);
+        }
+        colours = continuous;
+        mapper->SetScalarRange(range);
+        mapper->InterpolateScalarsBeforeMappingOn();  // colours between vertices from the map, not blended
     } else {
-        colours->SetVectorModeToComponent();
-        colours->SetVectorComponent(component);
+        colours = category_colours(options.categories);
     }
     mapper->SetLookupTable(colours);
-    mapper->SetScalarRange(range);
     mapper->ScalarVisibilityOn();
 
     vtkNew<vtkActor> actor;
     actor->SetMapper(mapper);
-    if (options.show_edges) {
-        actor->GetProperty()->EdgeVisibilityOn();
-        actor->GetProperty()->SetEdgeColor(0.15, 0.15, 0.15);
+    vtkProperty* look = actor->GetProperty();
+    if (lit) {
+        look->SetAmbient(0.25);
+        look->SetDiffuse(0.8);
+        look->SetSpecular(0.0);
+        if (options.show_edges) {
+            look->EdgeVisibilityOn();
+            look->SetEdgeColor(0.25, 0.25, 0.25);
+            look->SetLineWidth(1.0);
+        }
+    } else {
+        look->SetAmbient(1.0);
+        look->SetDiffuse(0.0);
+        look->SetSpecular(0.0);
     }
 
-    vtkNew<vtkScalarBarActor> bar;
-    bar->SetLookupTable(colours);
-    bar->SetTitle(options.field.c_str());
-    bar->SetNumberOfLabels(5);
-    bar->SetWidth(0.1);
-    bar->SetHeight(0.7);
-    bar->SetPosition(0.87, 0.15);
-    bar->GetTitleTextProperty()->SetColor(0.1, 0.1, 0.1);
-    bar->GetLabelTextProperty()->SetColor(0.1, 0.1, 0.1);
-    bar->UnconstrainedFontSizeOn();
-    bar->GetTitleTextProperty()->SetFontSize(18);
-    bar->GetLabelTextProperty()->SetFontSize(14);
+    // A continuous field gets a colour bar on the right, its title a text of its own above it (so
+    // that a long field name is never cut to the bar's width); a categorical one a row of swatches
+    // along the bottom instead.
+    std::vector<vtkSmartPointer<vtkActor2D>> keys;
+    if (options.categories.empty()) {
+        auto bar = vtkSmartPointer<vtkScalarBarActor>::New();
+        bar->SetLookupTable(colours);
+        bar->SetNumberOfLabels(5);
+        bar->SetWidth(0.09);
+        bar->SetHeight(0.72);
+        bar->SetPosition(0.88, 0.08);
+        bar->UnconstrainedFontSizeOn();
+        set_font(bar->GetLabelTextProperty(), 15);
+        keys.push_back(bar);
+        auto bar_title = vtkSmartPointer<vtkTextActor>::New();
+        bar_title->SetInput(options.field.c_str());
+        set_font(bar_title->GetTextProperty(), 17, true);
+        bar_title->GetTextProperty()->SetJustificationToRight();
+        bar_title->SetPosition(options.width - 16, 0.82 * options.height);
+        keys.push_back(bar_title);
+    } else {
+        double x = 20.0;
+        for (const Category& c : options.categories) {
+            // A filled square in the category's colour under an outlined one, then the name.
+            for (const auto& [glyph, rgb] : {std::pair{"\u25A0", c.colour}, std::pair{"\u25A1", std::array{0.3, 0.3, 0.3}}}) {
+                auto swatch = vtkSmartPointer<vtkTextActor>::New();
+                swatch->SetInput(glyph);
+                set_font(swatch->GetTextProperty(), 24);
+                swatch->GetTextProperty()->SetColor(rgb[0], rgb[1], rgb[2]);
+                swatch->SetPosition(x, 14.0);
+                keys.push_back(swatch);
+            }
+            auto name = vtkSmartPointer<vtkTextActor>::New();
+            name->SetInput(c.name.c_str());
+            set_font(name->GetTextProperty(), 17);
+            name->SetPosition(x + 30.0, 18.0);
+            keys.push_back(name);
+            int box[4] = {0, 0, 0, 0};
+            vtkTextRenderer::GetInstance()->GetBoundingBox(name->GetTextProperty(), c.name, box, 72);
+            x += 30.0 + (box[1] - box[0]) + 36.0;
+        }
+    }
 
     vtkNew<vtkTextActor> title;
     title->SetInput(options.title.c_str());
-    title->GetTextProperty()->SetFontSize(22);
-    title->GetTextProperty()->SetColor(0.1, 0.1, 0.1);
+    set_font(title->GetTextProperty(), 20);
     title->GetTextProperty()->SetVerticalJustificationToTop();  // a title of several lines grows downwards
     title->SetPosition(20, options.height - 14);
 
-    vtkNew<vtkRenderer> renderer;
-    renderer->AddActor(actor);
-    renderer->AddActor2D(bar);
-    renderer->AddActor2D(title);
+    // Three renderers: a white backdrop, the data (left of the colour bar's strip, so that neither
+    // the bar nor its title ever covers it), and the texts over the whole window.
+    const bool bar_strip = options.categories.empty();
+    vtkNew<vtkRenderer> backdrop, renderer, texts;
+    backdrop->SetBackground(1.0, 1.0, 1.0);
     renderer->SetBackground(1.0, 1.0, 1.0);
-    renderer->SetViewport(0.0, 0.0, 1.0, 1.0);
+    renderer->SetViewport(0.0, 0.0, bar_strip ? 0.84 : 1.0, 1.0);
+    renderer->AddActor(actor);
+    texts->SetLayer(1);
+    texts->InteractiveOff();
+    for (const auto& key : keys)
+        texts->AddActor2D(key);
+    texts->AddActor2D(title);
     vtkCamera* camera = renderer->GetActiveCamera();
     camera->SetPosition(-options.view_direction[0], -options.view_direction[1],
                         -options.view_direction[2]);
     camera->SetFocalPoint(0.0, 0.0, 0.0);
     camera->SetViewUp(options.view_up.data());
+    if (lit) {
+        renderer->RemoveAllLights();
+        vtkNew<vtkLightKit> lights;  // key, fill, back and head lights, attached to the camera
+        lights->AddLightsToRenderer(renderer);
+    }
     if (options.frame_bounds) {
         std::array<double, 6> bounds = *options.frame_bounds;
         renderer->ResetCamera(bounds.data());
@@ -208,7 +538,10 @@ bool render_dataset(const std::filesystem::path& path, vtkDataSet* data, bool ce
     window->SetDisplayId(shared_display());
     window->SetOffScreenRendering(1);
     window->SetSize(options.width, options.height);
+    window->SetNumberOfLayers(2);
+    window->AddRenderer(backdrop);
     window->AddRenderer(renderer);
+    window->AddRenderer(texts);
     window->Render();
     write_png(window, path);
     return true;
@@ -257,13 +590,12 @@ bool save_chart(const LineChart& chart, const std::filesystem::path& stem, bool 
     renderer->AddActor(context);
     vtkNew<vtkChartXY> xy;
     context->GetScene()->AddItem(xy);
+    // The chart's own layout puts the x axis title at the window's bottom edge, where the
+    // descenders of DejaVu Sans are cut: the chart gets the window less a strip at the bottom.
+    xy->SetAutoSize(false);
+    xy->SetSize(vtkRectf(0.0f, 12.0f, float(chart.width), float(chart.height - 12)));
     xy->SetTitle(chart.title);
-    xy->GetTitleProperties()->SetFontSize(18);
-    xy->SetShowLegend(true);
-    const bool left = chart.legend == Corner::top_left || chart.legend == Corner::bottom_left;
-    const bool top = chart.legend == Corner::top_left || chart.legend == Corner::top_right;
-    xy->GetLegend()->SetHorizontalAlignment(left ? vtkChartLegend::LEFT : vtkChartLegend::RIGHT);
-    xy->GetLegend()->SetVerticalAlignment(top ? vtkChartLegend::TOP : vtkChartLegend::BOTTOM);
+    set_font(xy->GetTitleProperties(), 18);
     vtkAxis* x_axis = xy->GetAxis(vtkAxis::BOTTOM);
     vtkAxis* y_axis = xy->GetAxis(vtkAxis::LEFT);
     x_axis->SetTitle(chart.x_label);
@@ -271,10 +603,21 @@ bool save_chart(const LineChart& chart, const std::filesystem::path& stem, bool 
     x_axis->SetLogScale(chart.log_x);
     y_axis->SetLogScale(chart.log_y);
     for (vtkAxis* axis : {x_axis, y_axis}) {
-        axis->GetTitleProperties()->SetFontSize(16);
-        axis->GetLabelProperties()->SetFontSize(13);
+        set_font(axis->GetTitleProperties(), 16, true);
+        set_font(axis->GetLabelProperties(), 13);
     }
+    // The legend is placed by hand (CUSTOM): in the first corner the data leave free (see below).
+    vtkChartLegend* legend = xy->GetLegend();
+    xy->SetShowLegend(true);
+    legend->SetInline(true);
+    legend->SetHorizontalAlignment(vtkChartLegend::CUSTOM);
+    legend->SetVerticalAlignment(vtkChartLegend::CUSTOM);
+    set_font(legend->GetLabelProperties(), 13);
 
+    ChartLayout layout;
+    layout.sx.log = chart.log_x;
+    layout.sy.log = chart.log_y;
+    std::vector<std::string> names;
     std::vector<vtkSmartPointer<vtkTable>> tables;  // the plots keep pointers into these
     for (std::size_t k = 0; k < chart.series.size(); ++k) {
         const Series& s = chart.series[k];
@@ -282,13 +625,18 @@ bool save_chart(const LineChart& chart, const std::filesystem::path& stem, bool 
         vtkNew<vtkDoubleArray> xs, ys;
         xs->SetName(chart.x_label.c_str());
         ys->SetName(s.name.c_str());
+        ChartLayout::Curve curve{{}, {}, s.markers_only};
         for (std::size_t i = 0; i < s.x.size(); ++i)
             if (plottable(s.x[i], s.y[i], chart)) {
                 xs->InsertNextValue(s.x[i]);
                 ys->InsertNextValue(s.y[i]);
+                curve.x.push_back(layout.sx.to(s.x[i]));
+                curve.y.push_back(layout.sy.to(s.y[i]));
             }
-        if (xs->GetNumberOfTuples() == 0)
+        if (curve.x.empty())
             continue;
+        layout.curves.push_back(curve);
+        names.push_back(s.name);
         table->AddColumn(xs);
         table->AddColumn(ys);
         tables.push_back(table);
@@ -303,6 +651,73 @@ bool save_chart(const LineChart& chart, const std::filesystem::path& stem, bool 
             points->SetMarkerSize(14.0);
         }
     }
+
+    // Fixed axis ranges with room around the data (padded_range).
+    if (!layout.curves.empty()) {
+        double x_low = std::numeric_limits<double>::infinity(), x_high = -x_low, y_low = x_low, y_high = -x_low;
+        for (const ChartLayout::Curve& c : layout.curves) {
+            x_low = std::min(x_low, *std::min_element(c.x.begin(), c.x.end()));
+            x_high = std::max(x_high, *std::max_element(c.x.begin(), c.x.end()));
+            y_low = std::min(y_low, *std::min_element(c.y.begin(), c.y.end()));
+            y_high = std::max(y_high, *std::max_element(c.y.begin(), c.y.end()));
+        }
+        std::tie(layout.x_low, layout.x_high) = padded_range(x_low, x_high, chart.log_x);
+        std::tie(layout.y_low, layout.y_high) = padded_range(y_low, y_high, chart.log_y);
+    }
+    const auto apply_ranges = [&] {
+        x_axis->SetBehavior(vtkAxis::FIXED);
+        y_axis->SetBehavior(vtkAxis::FIXED);
+        x_axis->SetUnscaledRange(layout.sx.from(layout.x_low), layout.sx.from(layout.x_high));
+        y_axis->SetUnscaledRange(layout.sy.from(layout.y_low), layout.sy.from(layout.y_high));
+        if (chart.log_x)
+            set_log_ticks(x_axis, layout.x_low, layout.x_high);
+        if (chart.log_y)
+            set_log_ticks(y_axis, layout.y_low, layout.y_high);
+        window->Render();  // lays the chart out: the plot area is known after it
+        layout.left = xy->GetPoint1()[0];
+        layout.bottom = xy->GetPoint1()[1];
+        layout.right = xy->GetPoint2()[0];
+        layout.top = xy->GetPoint2()[1];
+    };
+    apply_ranges();
+
+    // The legend goes to the preferred corner if no line or marker passes there, else to the first
+    // free one of the others; if every corner is taken, the y range grows at the top or the bottom
+    // (whichever needs less) until the legend fits above or below the data.
+    const auto [legend_width, legend_height] = legend_size(legend->GetLabelProperties(), names);
+    std::vector<Corner> corners{chart.legend};
+    for (Corner c : {Corner::top_right, Corner::top_left, Corner::bottom_right, Corner::bottom_left})
+        if (c != chart.legend)
+            corners.push_back(c);
+    const auto free_corner = std::find_if(corners.begin(), corners.end(), [&](Corner c) {
+        return !layout.covers(layout.legend_box(c, legend_width, legend_height));
+    });
+    Corner corner = chart.legend;
+    if (free_corner != corners.end()) {
+        corner = *free_corner;
+    } else if (!layout.curves.empty()) {
+        const double needed = (legend_height + 20.0) / (layout.top - layout.bottom);  // of the plot height
+        double best_growth = std::numeric_limits<double>::infinity(), best_low = layout.y_low, best_high = layout.y_high;
+        for (Corner c : corners) {
+            const PixelBox box = layout.legend_box(c, legend_width, legend_height);
+            const auto [low, high] = layout.y_extent_between(box.left, box.right);
+            const bool at_top = c == Corner::top_left || c == Corner::top_right;
+            const double span = layout.y_high - layout.y_low;
+            // the data under (over) the legend may use 1 − needed of the new height
+            const double new_span = at_top ? (high - layout.y_low) / (1.0 - needed) : (layout.y_high - low) / (1.0 - needed);
+            if (needed < 0.8 && new_span / span < best_growth) {
+                best_growth = new_span / span;
+                corner = c;
+                best_low = at_top ? layout.y_low : layout.y_high - std::max(new_span, span);
+                best_high = at_top ? layout.y_low + std::max(new_span, span) : layout.y_high;
+            }
+        }
+        layout.y_low = best_low;
+        layout.y_high = best_high;
+        apply_ranges();
+    }
+    const PixelBox box = layout.legend_box(corner, legend_width, legend_height);
+    legend->SetPoint(vtkVector2f(float(box.left), float(box.bottom)));
     window->Render();
     std::filesystem::path png_path = stem;
     png_path += ".png";
@@ -313,13 +728,13 @@ bool save_chart(const LineChart& chart, const std::filesystem::path& stem, bool 
 bool render_mesh_png(const std::filesystem::path& path, const io::MeshData& mesh,
                      const RenderOptions& options)
 {
-    const auto grid = io::detail::to_vtk(mesh);
+    const auto grid = io::detail::to_vtk(options.cut ? cut_away(mesh, *options.cut) : mesh);
     const bool point_field = grid->GetPointData()->HasArray(options.field.c_str());
     if (!point_field && !grid->GetCellData()->HasArray(options.field.c_str()))
         throw Error(str("cannot render field '", options.field, "': the mesh has no such field"));
     if (!can_draw(true))
         return false;
-    return render_dataset(path, grid, !point_field, options);
+    return render_dataset(path, grid, !point_field, true, options);
 }
 
 bool render_grid_png(const std::filesystem::path& path, const io::ImageGrid& grid,
@@ -330,7 +745,7 @@ bool render_grid_png(const std::filesystem::path& path, const io::ImageGrid& gri
         throw Error(str("cannot render field '", options.field, "': the grid has no such field"));
     if (!can_draw(true))
         return false;
-    return render_dataset(path, image, false, options);
+    return render_dataset(path, image, false, false, options);
 }
 
 }  // namespace fem::fig

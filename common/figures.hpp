@@ -29,7 +29,7 @@ struct Series {
     bool markers_only = false;  ///< draw the points as markers, not joined by a line (e.g. one point)
 };
 
-/// Where a chart's legend goes: pick the corner the lines leave empty.
+/// A corner of a chart's plot area, where its legend may go.
 enum class Corner { top_left, top_right, bottom_left, bottom_right };
 
 struct LineChart {
@@ -41,13 +41,31 @@ struct LineChart {
     std::vector<Series> series;
     int width = 900;
     int height = 650;
-    Corner legend = Corner::bottom_right;
+    /// The corner the legend goes to if no line or marker passes there; otherwise the first free
+    /// one of top right, top left, bottom right, bottom left; if none is free, the y range grows
+    /// until the legend fits above or below the data. A legend never covers data.
+    Corner legend = Corner::top_right;
 };
 
 /// Writes <stem>.csv (columns: series, x_label, y_label; every point of every series) and, when figures is true
 /// and a display is available, <stem>.png. On a log axis, points with a value ≤ 0 or non-finite
-/// values are left out of the PNG (they stay in the CSV). Returns whether the PNG was written.
+/// values are left out of the PNG (they stay in the CSV). The axes span the data with 5% to spare
+/// on each side (a log axis at least two powers of ten, so that it has two labels), so no line or
+/// marker touches the frame. Returns whether the PNG was written.
 bool save_chart(const LineChart& chart, const std::filesystem::path& stem, bool figures = true);
+
+/// One value of a categorical field, drawn in its own colour and named in the figure's legend.
+struct Category {
+    double value;                  ///< the field's value, e.g. 2
+    std::string name;              ///< e.g. "fill"
+    std::array<double, 3> colour;  ///< RGB in [0, 1]
+};
+
+/// A plane through point with the given normal (need not be unit length).
+struct CutPlane {
+    std::array<double, 3> point;
+    std::array<double, 3> normal;
+};
 
 /// How to colour and frame a rendered mesh or grid.
 struct RenderOptions {
@@ -57,7 +75,13 @@ struct RenderOptions {
     std::optional<std::pair<double, double>> range;  ///< colour range; default: the field's range
     std::array<double, 3> view_direction{0.0, 0.0, -1.0};  ///< camera looks along this direction
     std::array<double, 3> view_up{0.0, 1.0, 0.0};
-    bool show_edges = false;
+    bool show_edges = true;            ///< draw a mesh's edges (grids never show theirs)
+    /// A field of a few values drawn as categories (each in its colour, named in a legend of
+    /// swatches) instead of on a continuous colour map; a value that is no category is drawn white.
+    std::vector<Category> categories;
+    /// A mesh only: leave out every cell with a vertex on the side of this plane its normal points
+    /// to, so that a field inside the body shows on the cut (e.g. the masses of inner vertices).
+    std::optional<CutPlane> cut;
     /// The box (xmin, xmax, ymin, ymax, zmin, zmax) the camera frames; default: the mesh's own
     /// bounds. The frames of a motion share one box so that the camera stands still.
     std::optional<std::array<double, 6>> frame_bounds;
@@ -65,12 +89,14 @@ struct RenderOptions {
     int height = 700;
 };
 
-/// Renders the mesh's surface coloured by options.field, with a scalar bar, to a PNG file.
+/// Renders the mesh's surface coloured by options.field, with a colour bar, to a PNG file: lit by a
+/// light kit (no face goes black), with its edges unless options.show_edges is false.
 /// Returns false (and writes nothing) without a display; fem::Error if the field is missing.
 bool render_mesh_png(const std::filesystem::path& path, const io::MeshData& mesh,
                      const RenderOptions& options);
 
-/// Renders a 2D or 3D regular grid coloured by a point field (a heat map for a 2D grid).
+/// Renders a 2D or 3D regular grid coloured by a point field (a heat map for a 2D grid), unlit, so
+/// that its colours are exactly the colour map's.
 bool render_grid_png(const std::filesystem::path& path, const io::ImageGrid& grid,
                      const RenderOptions& options);
 

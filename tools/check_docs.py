@@ -2,7 +2,8 @@
 """Keeps docs/NN_name.md from drifting away from the code (a ctest test per chapter).
 
 Checks:
-  1. every exercise of the chapter has a heading "### Exercise NN.k: function_name", every
+  1. every exercise of the chapter has a heading "### Exercise NN.k: function_name" followed by a
+     line "Builds on: NN.k, …." (or "Builds on: nothing.") naming earlier exercises, every
      "exercise NN.k" the text mentions exists, and every exercise's docs section (#anchor) is a
      heading of the page;
   2. every function or type the page names in backticks (snake_case calls like
@@ -11,33 +12,42 @@ Checks:
   3. the tables between <!-- fem:table NAME.csv --> and <!-- /fem:table --> hold the numbers the
      executable prints today: the page's <!-- fem:run chNN_name [args] --> line says how to run it;
      measured columns (times, rates) are skipped (see csv_compare.py);
-  4. every image the page shows exists.
+  4. every number a sentence quotes from a table, marked
+         <!-- fem:value NAME.csv KEY=VALUE … "COLUMN" -->6·10⁻³<!-- /fem:value -->
+     (the row whose KEY columns hold those VALUEs, quoted with "" when they contain spaces), is the
+     executable's value rounded to the significant digits the sentence shows (see
+     csv_compare.quoted_number);
+  5. every image the page shows exists.
 
 --update reruns the executable, rewrites the tables and copies the figures named by
-<!-- fem:figure NAME.png --> into docs/figures/NN_name/ (run it under xvfb-run -a).
+<!-- fem:figure NAME.png --> into docs/figures/NN_name/ (run it under xvfb-run -a). It never
+rewrites a quoted number: a sentence around a number that changed needs a person, so --update
+lists those and fails.
 """
 
 import argparse
+import math
 import re
+import shlex
 import shutil
 import subprocess
 import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from csv_compare import as_number, close, is_measured, is_roundoff, read_csv  # noqa: E402
-from exercises import all_exercises  # noqa: E402
+from csv_compare import as_number, close, is_measured, is_roundoff, quoted_number, read_csv, rounded  # noqa: E402
+from exercises import EXERCISE_HEADING, all_exercises, builds_on, exercise_key  # noqa: E402
 
 RUN = re.compile(r"<!-- fem:run (?P<exe>\S+)(?P<args>[^>]*?)\s*-->")
 TABLE = re.compile(r"(<!-- fem:table (?P<csv>\S+) -->\n)(?P<body>.*?)(<!-- /fem:table -->)", re.S)
 FIGURE = re.compile(r"<!-- fem:figure (?P<png>\S+) -->")
 IMAGE = re.compile(r"!\[[^\]]*\]\((?P<path>[^)\s]+)\)")
 HEADING = re.compile(r"^(#{1,6})\s+(?P<text>.+?)\s*$", re.M)
-EXERCISE_HEADING = re.compile(r"^###\s+Exercise\s+(?P<id>\d\d\.\d+):\s+`?(?P<function>\w+)", re.M)
 EXERCISE_MENTION = re.compile(r"[Ee]xercises?\s+(?P<id>\d\d\.\d+)")
 CODE_SPAN = re.compile(r"`([^`\n]+)`")
 CALL = re.compile(r"^(?:fem::(?:\w+::)*)?(?P<name>[a-z]\w*_\w+)\(")
 QUALIFIED = re.compile(r"^fem::(?:\w+::)*(?P<name>\w+)$")
+VALUE = re.compile(r"<!-- fem:value (?P<spec>.*?) -->(?P<text>.*?)<!-- /fem:value -->", re.S)
 RELATIVE_TOLERANCE = 2e-3  # the tables print 4 significant digits
 
 
@@ -48,11 +58,15 @@ def slug(heading):
     return text.replace(" ", "-")
 
 
-def format_number(value):
+def format_number(value, measured=False):
+    """A table cell: integers whole, 4 significant digits otherwise; but a value that has 5
+    significant digits in full is printed in full (ν = 0.49999 must not read 0.5). Measured values
+    (times, rates) always get 4 digits: more would be noise."""
     if value == int(value) and abs(value) < 1e6:
         return str(int(value))
     if 1e-2 <= abs(value) < 1e4:
-        return f"{value:.4g}"
+        exact = f"{value:.5g}"
+        return exact if float(exact) == value and not measured else f"{value:.4g}"
     return f"{value:.3e}"
 
 
@@ -61,7 +75,8 @@ def markdown_table(csv_path):
     escape = lambda text: text.replace("|", "\\|")
     lines = ["| " + " | ".join(map(escape, header)) + " |", "|" + "|".join("---:" for _ in header) + "|"]
     for row in rows:
-        cells = [format_number(float(c)) if as_number(c) is not None else escape(c) for c in row]
+        cells = [format_number(float(c), is_measured(column)) if as_number(c) is not None else escape(c)
+                 for c, column in zip(row, header)]
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
 
@@ -70,6 +85,58 @@ def parse_markdown_table(body):
     lines = [l.strip() for l in body.strip().splitlines() if l.strip().startswith("|")]
     split = lambda l: [c.strip().replace("\\|", "|") for c in re.split(r"(?<!\\)\|", l.strip()[1:-1])]
     return split(lines[0]), [split(l) for l in lines[2:]]
+
+
+def check_quotes(text, out):
+    """Problems with the numbers quoted inline by <!-- fem:value … --> (see the module's docstring)."""
+    problems = []
+    tables = {}
+    for m in VALUE.finditer(text):
+        spec, quoted = m["spec"], m["text"]
+        where = f"fem:value {spec} (quoting '{quoted}')"
+        try:
+            name, *rest = shlex.split(spec)
+        except ValueError as error:
+            problems.append(f"{where}: {error}")
+            continue
+        selectors = [token.split("=", 1) for token in rest if "=" in token]
+        columns = [token for token in rest if "=" not in token]
+        number = quoted_number(quoted)
+        if len(columns) != 1 or not selectors:
+            problems.append(f"{where}: expected NAME.csv KEY=VALUE … \"COLUMN\" (one column, at least one key)")
+            continue
+        if number is None:
+            problems.append(f"{where}: '{quoted}' is not a number the check can read (e.g. 6e-3, 6·10⁻³, 0.27)")
+            continue
+        if not (out / name).is_file():
+            problems.append(f"{where}: the executable wrote no {name}")
+            continue
+        header, rows = tables.setdefault(name, read_csv(out / name))
+        column = columns[0]
+        unknown = [c for c in [column] + [k for k, _ in selectors] if c not in header]
+        if unknown:
+            problems.append(f"{where}: {name} has no column {unknown}; it has {header}")
+            continue
+        if is_measured(column):
+            problems.append(f"{where}: '{column}' is measured (it changes from run to run): quote it in words")
+            continue
+
+        def matches(row, key, want):
+            got = row[header.index(key)]
+            a, b = as_number(want), as_number(got)
+            return a == b if a is not None and b is not None else want == got
+
+        found = [row for row in rows if all(matches(row, k, v) for k, v in selectors)]
+        if len(found) != 1:
+            problems.append(f"{where}: {len(found)} rows of {name} match {dict(selectors)}, expected one")
+            continue
+        cell = found[0][header.index(column)]
+        value, digits = number
+        actual = as_number(cell)
+        if actual is None or not math.isclose(rounded(actual, digits), rounded(value, digits), rel_tol=1e-9):
+            problems.append(f"{where}: the executable prints {cell}, which to {digits} significant "
+                            f"digit(s) is not {quoted}: rewrite the sentence around the new number")
+    return problems
 
 
 def declared_names(root, chapter):
@@ -114,6 +181,19 @@ def check_exercises(text, root, chapter):
     for m in list(EXERCISE_MENTION.finditer(text)) + list(EXERCISE_HEADING.finditer(text)):
         if m["id"] not in exercises:
             problems.append(f"the docs mention exercise {m['id']}, which does not exist")
+    for exercise_id, listed in builds_on(text).items():
+        if listed is None:
+            problems.append(f"the heading of exercise {exercise_id} is not followed by a line "
+                            f"'Builds on: NN.k, NN.k.' or 'Builds on: nothing.'")
+            continue
+        if len(set(listed)) != len(listed):
+            problems.append(f"exercise {exercise_id} builds on {listed}: an exercise is named twice")
+        for other in listed:
+            if other not in exercises:
+                problems.append(f"exercise {exercise_id} builds on exercise {other}, which does not exist")
+            elif exercise_key(other) >= exercise_key(exercise_id):
+                problems.append(f"exercise {exercise_id} builds on exercise {other}, which does not come "
+                                f"before it: an exercise builds on earlier ones only")
     return problems
 
 
@@ -195,17 +275,20 @@ def main():
     for m in IMAGE.finditer(text):
         if not (doc.parent / m["path"]).is_file():
             problems.append(f"the docs show {m['path']}, which does not exist")
-    if TABLE.search(text):
+    if TABLE.search(text) or VALUE.search(text):
         if not (args.bin and args.out):
-            problems.append("--bin and --out are needed to check the tables")
+            problems.append("--bin and --out are needed to check the tables and quoted numbers")
         else:
             out, run_problems = run_executable(text, args.bin, args.out)
             problems += run_problems
             if out and args.update:
                 update(doc, text, out, args.root, args.chapter)
-                return 0
+                stale = check_quotes(text, out)
+                for problem in stale:
+                    print(f"FAIL {problem}")
+                return 1 if stale else 0
             if out:
-                problems += check_tables(text, out)
+                problems += check_tables(text, out) + check_quotes(text, out)
     for problem in problems:
         print(f"FAIL {problem}")
     if not problems:

@@ -3,7 +3,10 @@
 header(s), main.cpp, solutions, tests, stored quick-run expectations and docs; a chapter includes
 only its own and earlier chapters' headers, each of them listed in its DEPENDS; common/ includes no
 chapter at all; no Catch2 test name contains a character that ctest cannot carry (';' splits a
-CMake list, so the ctest entry would run no test case)."""
+CMake list, so the ctest entry would run no test case; a leading '-' makes Catch2 read it as an
+option); no test case carries more than one exercise
+tag [exNN.k] (a test grades one exercise; what else it needs, that exercise's docs list under
+"Builds on", and tools/exercises.py grade checks)."""
 
 import argparse
 import re
@@ -13,22 +16,32 @@ from pathlib import Path
 REGISTER = re.compile(r"^fem_add_chapter\((?P<number>\d\d)\s+(?P<name>\w+)(?:\s+DEPENDS(?P<deps>[\s\d]+))?\)",
                       re.M)
 INCLUDE = re.compile(r'^\s*#\s*include\s+"(?P<chapter>\d\d)_\w+/', re.M)
-# TEST_CASE( followed by one or more adjacent string literals: the test name.
-TEST_NAME = re.compile(r'\bTEST_CASE\(\s*((?:"(?:[^"\\]|\\.)*"\s*)+)')
+# TEST_CASE( followed by one or more adjacent string literals: the test name, then its tags.
+TEST_NAME = re.compile(r'\bTEST_CASE\(\s*((?:"(?:[^"\\]|\\.)*"\s*)+)(?:,\s*"(?P<tags>[^"]*)")?')
+EXERCISE_TAG = re.compile(r"\[ex\d\d\.\d+\]")
 STRING_PIECE = re.compile(r'"((?:[^"\\]|\\.)*)"')
 
 
-def test_name_problems(root):
-    """Catch2 test names that ctest cannot carry: a ';' splits the name into two CMake list items."""
+def test_case_problems(root):
+    """Catch2 test names that ctest cannot carry (a ';' splits the name into two CMake list items)
+    and test cases with more than one exercise tag."""
     problems = []
     for source in sorted((root / "tests").rglob("*.cpp")):
         text = source.read_text()
         for m in TEST_NAME.finditer(text):
             name = "".join(STRING_PIECE.findall(m.group(1)))
+            where = f"{source.relative_to(root)}:{text[:m.start()].count(chr(10)) + 1}"
             if ";" in name:
-                line = text[:m.start()].count("\n") + 1
-                problems.append(f"{source.relative_to(root)}:{line}: test name '{name}' contains ';', which "
-                                "CMake splits: its ctest entry would run no test case")
+                problems.append(f"{where}: test name '{name}' contains ';', which CMake splits: its "
+                                "ctest entry would run no test case")
+            if name.startswith("-"):
+                problems.append(f"{where}: test name '{name}' starts with '-': its ctest entry passes it "
+                                "to Catch2, which reads it as an option")
+            tags = EXERCISE_TAG.findall(m["tags"] or "")
+            if len(tags) > 1:
+                problems.append(f"{where}: test '{name}' has the exercise tags {''.join(tags)}: tag it "
+                                "with the one exercise it grades and list the others under that "
+                                "exercise's 'Builds on' in the docs")
     return problems
 
 
@@ -65,7 +78,7 @@ def main():
     for source in sorted((root / "common").glob("*.?pp")):
         if INCLUDE.search(source.read_text()):
             problems.append(f"{source.relative_to(root)} includes a chapter: common/ holds no chapter's math")
-    problems += test_name_problems(root)
+    problems += test_case_problems(root)
     for problem in problems:
         print(f"FAIL {problem}")
     if not problems:

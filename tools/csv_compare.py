@@ -17,12 +17,20 @@ reproducible and keep the relative tolerance.
 A column whose header ends with "[round-off]" holds round-off amplified by a condition number
 (e.g. "max deviation / max tip [round-off]": 1e-13…1e-10): each new value passes when it is at most
 ROUNDOFF_GROWTH (100) times the stored one, or ≤ ROUNDOFF_BOUND.
+
+A number the docs quote in a sentence (check_docs.py, <!-- fem:value … -->) is read with
+quoted_number and holds when the table's value, rounded to the digits the sentence shows, is it.
 """
 
 import csv
 import math
 import re
 
+# A number as prose writes it: 6e-3, 0.27, −2.2, 50 700 (thin or plain spaces between groups of
+# three), 6·10⁻³, 6 × 10⁻³ or 10⁴.
+PROSE_NUMBER = re.compile(r"(?P<mantissa>[-+]?\d{1,3}(?:[ \u2009\u202f]\d{3})+|[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?)?"
+                          r"(?:\s*[·×]?\s*10(?P<power>[⁻]?[⁰¹²³⁴⁵⁶⁷⁸⁹]+))?")
+SUPERSCRIPTS = str.maketrans("⁰¹²³⁴⁵⁶⁷⁸⁹⁻", "0123456789-")
 MEASURED = re.compile(r"\[(s|ms|us|ns|measured|[^\]]*/\s*(s|ms|us|ns))\]\s*$")
 ROUNDOFF = re.compile(r"\[round-off\]\s*$")
 ROUNDOFF_LEVEL = 1e-12
@@ -62,6 +70,28 @@ def close(expected, actual, rtol, roundoff_column=False):
     if abs(expected) <= ROUNDOFF_LEVEL:
         return abs(actual) <= ROUNDOFF_BOUND
     return abs(actual - expected) <= rtol * max(abs(expected), abs(actual)) + 1e-300
+
+
+def quoted_number(text):
+    """(value, significant digits) of a number as the docs write it, or None if it is not one.
+    The digits are those the text shows: 6·10⁻³ has 1, 0.0595 has 3, 2.20 has 3, 300 has 1."""
+    text = text.strip().replace("−", "-")
+    m = PROSE_NUMBER.fullmatch(text)
+    if not text or not m or not (m["mantissa"] or m["power"]):
+        return None
+    mantissa = re.sub(r"[ \u2009\u202f]", "", m["mantissa"] or "1")
+    value = float(mantissa) * (10.0 ** int(m["power"].translate(SUPERSCRIPTS)) if m["power"] else 1.0)
+    digits = re.sub(r"e.*$", "", mantissa.lstrip("+-")).replace(".", "").lstrip("0")
+    if "." not in mantissa:
+        digits = digits.rstrip("0")
+    return value, max(len(digits), 1)
+
+
+def rounded(value, digits):
+    """value rounded to that many significant digits."""
+    if value == 0 or not math.isfinite(value):
+        return value
+    return round(value, digits - 1 - math.floor(math.log10(abs(value))))
 
 
 def compare_tables(expected_header, expected_rows, actual_header, actual_rows, rtol, name):
@@ -105,6 +135,12 @@ def self_test():
     assert len(compare_tables(header, [["1", "1e-15", "3"]], header, [["2", "4e-10", "9"]], 1e-6, "t")) == 2
     header = ["deviation [round-off]"]
     assert compare_tables(header, [["2e-11"]], header, [["7e-11"]], 1e-6, "t") == []
+    assert quoted_number("6·10⁻³") == (0.006, 1) and quoted_number("6 × 10⁻³") == (0.006, 1)
+    assert quoted_number("10⁴") == (1e4, 1) and quoted_number("2.20") == (2.2, 3)
+    assert quoted_number("50 700") == (50700.0, 3) and quoted_number("300") == (300.0, 1)
+    assert quoted_number("−0.0595") == (-0.0595, 3) and quoted_number("1.2e-03") == (0.0012, 2)
+    assert quoted_number("a few") is None and quoted_number("") is None
+    assert rounded(5.954e-3, 1) == 0.006 and rounded(294.1, 1) == 300.0 and rounded(2.196, 2) == 2.2
     print("csv_compare: rules hold")
 
 

@@ -16,8 +16,18 @@ Commands:
   list      print every exercise: id, function, docs section, file:line
   graded    write one chapter's solutions with each region behind the run-time switch
             fem::exercise_stubbed(id), for the grading build (-DFEM_GRADING=ON)
-  grade     with a grading build, stub one exercise at a time (FEM_STUB_EXERCISE=id), run the
-            tests tagged [exNN.k], print how many fail, and fail if any exercise has none
+  grade     with a grading build, check every exercise's tests against its stubs (see command_grade)
+
+What an exercise builds on is written in its chapter's docs, on the line right under its heading:
+
+    ### Exercise 05.8: element_stiffness
+
+    Builds on: 05.3, 05.6.
+
+("Builds on: nothing." when it needs no other exercise). It lists the exercises whose code the
+tests tagged [ex05.8] run besides 05.8's own: earlier exercises of the same chapter (those the
+check below holds to it) or of an earlier chapter (for the reader; a student's build links the
+reference solution of every other chapter). `grade` proves the list right.
 """
 
 import argparse
@@ -34,6 +44,12 @@ BEGIN = re.compile(r"^(?P<indent>\s*)// BEGIN EXERCISE (?P<id>\d\d\.\d+) (?P<fun
 END = re.compile(r"^\s*// END EXERCISE\s*$")
 HINT = re.compile(r"^\s*// HINT: ?(?P<text>.*)$")
 CHAPTER_DIR = re.compile(r"^(?P<number>\d\d)_\w+$")
+EXERCISE_HEADING = re.compile(r"^###\s+Exercise\s+(?P<id>\d\d\.\d+):\s+`?(?P<function>\w+)", re.M)
+BUILDS_ON = re.compile(r"^Builds on: (?:nothing|(?P<ids>\d\d\.\d+(?:, \d\d\.\d+)*))\.$")
+NOT_IMPLEMENTED = re.compile(r"exercise (?P<id>\d\d\.\d+) \(\w+\) is not implemented yet")
+# Catch2 wraps a message at 80 columns and indents it by 2: a docs link on its own line (see
+# common/error.cpp) stays whole if it is at most this long.
+MAX_LINK_LENGTH = 76
 
 
 class ExerciseError(Exception):
@@ -111,6 +127,48 @@ def all_exercises(root):
     return sorted(found, key=lambda e: (e.chapter, int(e.id.split(".")[1])))
 
 
+def exercise_key(exercise_id):
+    """Sort key of an id: 05.10 comes after 05.9."""
+    chapter, number = exercise_id.split(".")
+    return int(chapter), int(number)
+
+
+def builds_on(text):
+    """{exercise id: the ids on the "Builds on:" line under its heading, or None} of a docs page.
+    None means the first non-blank line under the heading is not a well-formed "Builds on:" line."""
+    lines = text.splitlines()
+    found = {}
+    for index, line in enumerate(lines):
+        heading = EXERCISE_HEADING.match(line)
+        if not heading:
+            continue
+        following = next((l.strip() for l in lines[index + 1:] if l.strip()), "")
+        match = BUILDS_ON.match(following)
+        if match is None:
+            found[heading["id"]] = None
+        else:
+            found[heading["id"]] = match["ids"].split(", ") if match["ids"] else []
+    return found
+
+
+def prerequisites(root, chapter):
+    """{exercise id: the ids it builds on} of one chapter, from its docs (see builds_on)."""
+    doc = Path(root) / "docs" / f"{chapter}.md"
+    return builds_on(doc.read_text()) if doc.is_file() else {}
+
+
+def closure_in_chapter(exercise_id, listed):
+    """Every exercise of exercise_id's chapter it builds on, directly or through another one."""
+    chapter = exercise_id.split(".")[0]
+    found, todo = set(), [exercise_id]
+    while todo:
+        for other in listed.get(todo.pop()) or []:
+            if other.split(".")[0] == chapter and other not in found:
+                found.add(other)
+                todo.append(other)
+    return found
+
+
 def throw_statement(exercise, indent):
     return (f'{indent}throw fem::NotImplemented("{exercise.id}", "{exercise.function}", '
             f'"{exercise.docs}");\n')
@@ -186,6 +244,12 @@ def command_generate(args):
 
 def command_check(args):
     root = Path(args.root)
+    long_links = [e for e in all_exercises(root) if len(e.docs) > MAX_LINK_LENGTH]
+    for e in long_links:
+        print(f"exercise {e.id}: its docs link {e.docs} has {len(e.docs)} characters; Catch2 would "
+              f"break it over two lines: shorten the section's heading to {MAX_LINK_LENGTH} at most")
+    if long_links:
+        return 1
     tree = expected_exercise_tree(root)
     stale = [str(r) for r, content in tree.items()
              if not (root / "exercises" / r).exists() or (root / "exercises" / r).read_text() != content]
@@ -221,21 +285,84 @@ def command_graded(args):
     return 0
 
 
-def run_tagged_tests(binary, tag, stub):
-    """(tests run, tests failed) of the test cases tagged `tag`, with `stub` stubbed ('' for none)."""
-    env = dict(os.environ, FEM_STUB_EXERCISE=stub)
-    result = subprocess.run([str(binary), f"[{tag}]", "--reporter", "xml"], env=env,
+@dataclass
+class TestRun:
+    """The test cases one run of a chapter's test binary ran, from Catch2's XML report."""
+    cases: int = 0
+    failed: list = field(default_factory=list)   # names of the failed test cases
+    failed_untagged: list = field(default_factory=list)  # those of them without an [exNN.k] tag
+    missing: set = field(default_factory=set)    # exercise ids named by NotImplemented in failures
+    crash: str = ""                              # why there is no report, if there is none
+
+
+def run_tests(binary, test_spec, stubbed):
+    """Runs the test cases of binary that match test_spec (e.g. "[ex05.3]") with the exercises in
+    stubbed (a collection of ids) behind their stubs; every test case when test_spec is None."""
+    env = dict(os.environ, FEM_STUB_EXERCISE=",".join(sorted(stubbed, key=exercise_key)))
+    spec = [test_spec] if test_spec else []
+    result = subprocess.run([str(binary), *spec, "--reporter", "xml"], env=env,
                             capture_output=True, text=True, timeout=600)
     try:
         report = ElementTree.fromstring(result.stdout)
     except ElementTree.ParseError:
-        return 0, 0, f"the test binary crashed or printed no report (exit {result.returncode})"
-    cases = report.findall(".//TestCase")
-    failed = sum(1 for case in cases if case.find("OverallResult").get("success") != "true")
-    return len(cases), failed, ""
+        return TestRun(crash=f"the test binary crashed or printed no report (exit {result.returncode})")
+    run = TestRun()
+    for case in report.iter("TestCase"):
+        run.cases += 1
+        if case.find("OverallResult").get("success") != "true":
+            run.failed.append(case.get("name"))
+            if not re.search(r"\[ex\d\d\.\d+\]", case.get("tags", "")):
+                run.failed_untagged.append(case.get("name"))
+            run.missing |= {m["id"] for m in NOT_IMPLEMENTED.finditer("".join(case.itertext()))}
+    return run
+
+
+def grade_exercise(e, chapter_ids, listed, binary):
+    """The table row of one exercise and the problems found: its tagged tests must pass on the
+    solution, fail with its stub alone, and pass again when every exercise of its chapter that it
+    does not build on is a stub (what a student sees who did it and what it builds on)."""
+    tag = f"[ex{e.id}]"
+    needed = closure_in_chapter(e.id, listed)
+    solution = run_tests(binary, tag, [])
+    stub = run_tests(binary, tag, [e.id])
+    others = [other for other in chapter_ids if other != e.id and other not in needed]
+    student = run_tests(binary, tag, others)
+    shown = ", ".join(listed.get(e.id) or []) or "nothing"
+    row = (f"{e.id:9} {e.function:30} {shown:24} {solution.cases:>6} {solution.cases - len(solution.failed):>9} "
+           f"{len(stub.failed):>8} {student.cases - len(student.failed):>9}")
+    crash = solution.crash or stub.crash or student.crash
+    if listed.get(e.id) is None:
+        return row, [f"{e.id}: docs/{e.chapter}.md has no line 'Builds on: …' under its heading"]
+    if solution.cases == 0:
+        return row, [f"{e.id}: no test case is tagged {tag}"]
+    if crash:
+        return row, [f"{e.id}: {crash}"]
+    problems = []
+    if solution.failed:
+        problems.append(f"{e.id}: {len(solution.failed)} tagged test(s) fail on the solution: "
+                        f"{solution.failed}")
+    if not stub.failed:
+        problems.append(f"{e.id}: no tagged test fails when it is a stub: its tests do not grade it")
+    elif stub.missing != {e.id}:
+        problems.append(f"{e.id}: as a stub, its tests fail without naming it ({stub.missing or 'no exercise'}): "
+                        f"a student would not be told which exercise to do")
+    if student.failed:
+        extra = ", ".join(sorted(student.missing - {e.id}, key=exercise_key)) or "no exercise named"
+        problems.append(f"{e.id}: with only it and what it builds on ({shown}) done, "
+                        f"{len(student.failed)} of its tests (e.g. '{student.failed[0]}') still fail "
+                        f"for {extra}: list those under 'Builds on' in docs/{e.chapter}.md, or make "
+                        f"the tests need only {e.id} and what it builds on")
+    return row, problems
 
 
 def command_grade(args):
+    """Every exercise of the registered chapters, graded by its tagged tests [exNN.k]:
+      1. they pass on the solution;
+      2. with the exercise alone a stub, at least one fails, and the failures name that exercise;
+      3. with every other exercise of the chapter a stub except those it builds on (its docs'
+         "Builds on:" line, followed through), they all pass: a test needs nothing unlisted.
+    Also, with every exercise of a chapter a stub, its untagged tests pass (they grade no exercise,
+    so they may run only the code the chapter gives)."""
     root = Path(args.root)
     build = Path(args.build)
     # Only the chapters the build registers (fem_add_chapter in CMakeLists.txt) are graded; a
@@ -244,33 +371,36 @@ def command_grade(args):
     exercises = [e for e in all_exercises(root) if e.chapter[:2] in registered]
     if args.chapters:
         exercises = [e for e in exercises if e.chapter[:2] in args.chapters]
-    print(f"\nEach exercise stubbed alone: the tests tagged [exNN.k] must fail\n")
-    print(f"{'exercise':9} {'function':34} {'tagged tests':>12} {'pass as solution':>16} "
-          f"{'fail as stub':>12}")
+    print("\nEach exercise's tests [exNN.k]: pass on the solution, fail with it alone a stub, and pass")
+    print("when the rest of its chapter is stubs except what it builds on\n")
+    print(f"{'exercise':9} {'function':30} {'builds on':24} {'tests':>6} {'solution':>9} "
+          f"{'as stub':>8} {'pre only':>9}")
+    print(f"{'':9} {'':30} {'':24} {'':>6} {'passed':>9} {'failed':>8} {'passed':>9}")
     problems = []
-    for e in exercises:
-        binary = build / "bin" / f"test_ch{e.chapter[:2]}"
+    for chapter in sorted({e.chapter for e in exercises}):
+        binary = build / "bin" / f"test_ch{chapter[:2]}"
+        in_chapter = [e for e in exercises if e.chapter == chapter]
         if not binary.exists():
-            problems.append(f"{e.id}: no test binary {binary}")
+            problems.append(f"chapter {chapter}: no test binary {binary}")
             continue
-        tag = f"ex{e.id}"
-        total, failed_solution, crash_solution = run_tagged_tests(binary, tag, "")
-        total_stub, failed_stub, crash_stub = run_tagged_tests(binary, tag, e.id)
-        print(f"{e.id:9} {e.function:34} {total:>12} {total - failed_solution:>16} {failed_stub:>12}")
-        if total == 0:
-            problems.append(f"{e.id}: no test case is tagged [{tag}]")
-        elif crash_solution or crash_stub:
-            problems.append(f"{e.id}: {crash_solution or crash_stub}")
-        elif failed_solution:
-            problems.append(f"{e.id}: {failed_solution} tagged test(s) fail on the solution")
-        elif failed_stub == 0:
-            problems.append(f"{e.id}: no tagged test fails when it is a stub: its tests do not grade it")
+        listed = prerequisites(root, chapter)
+        chapter_ids = [e.id for e in all_exercises(root) if e.chapter == chapter]
+        for e in in_chapter:
+            row, found = grade_exercise(e, chapter_ids, listed, binary)
+            print(row)
+            problems += found
+        all_stubs = run_tests(binary, None, chapter_ids)
+        if all_stubs.crash or all_stubs.failed_untagged:
+            problems.append(f"chapter {chapter}: with every exercise a stub, untagged tests fail "
+                            f"({all_stubs.crash or all_stubs.failed_untagged}): tag each with the "
+                            f"exercise it grades")
     print()
     if problems:
         for problem in problems:
             print(f"FAIL {problem}")
         return 1
-    print(f"all {len(exercises)} exercises are graded: each fails at least one test as a stub")
+    print(f"all {len(exercises)} exercises are graded by their own tests, which need only what "
+          f"their docs say they build on")
     return 0
 
 

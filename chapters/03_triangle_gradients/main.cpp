@@ -173,7 +173,6 @@ void write_poisson_solution(const RunContext& run, const PoissonRun& result)
     fig::RenderOptions options;
     options.title = str("Poisson on a jittered mesh: u_h, ", mesh.F.rows(), " triangles");
     options.field = "u";
-    options.show_edges = true;
     if (run.figures) {
         fig::render_mesh_png(run.file("poisson_solution.png"), data, options);
         options.title = "Gradient error |grad u_h - grad u| at the centroids (constant per triangle)";

@@ -123,7 +123,6 @@ void field_study(const RunContext& run, const Settings& settings)
                 options.range = std::make_pair(0.0, std::max(1e-3, strain.maxCoeff()));
             options.view_direction = {-0.45, 0.75, -0.5};
             options.view_up = {0.0, 0.0, 1.0};
-            options.show_edges = true;
             options.height = 520;
             fig::render_mesh_png(run.file(field.name + ".png"), io::warped(data), options);
         }

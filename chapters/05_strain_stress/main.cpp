@@ -156,7 +156,7 @@ void conditioning_study(const RunContext& run, const Settings& settings)
     regular << 1, 1, 1, 1, -1, -1, -1, 1, -1, -1, -1, 1;
     Table table("Conditioning of K_e of a regular tet as nu -> 1/2 (rigid modes excluded)",
                 {{"nu", Format::fixed, 5}, {"lambda/mu", Format::scientific, 3}, {"cond(K_e)", Format::scientific, 3},
-                 {"cond / (lambda/mu)", Format::fixed, 4}, {"smallest non-zero / mu", Format::fixed, 4}});
+                 {"cond / (lambda/mu)", Format::fixed, 4}, {"smallest non-zero / (mu V)", Format::fixed, 4}});
     std::vector<double> ratio, condition;
     for (double nu : {0.1, 0.3, 0.45, 0.49, 0.499, 0.4999, 0.49999}) {
         const Lame m = lame_parameters(settings.youngs, nu);
@@ -318,7 +318,6 @@ void twisted_beam_study(const RunContext& run, const Settings& settings, const L
             options.range = std::make_pair(0.0, top);
             options.view_direction = {-0.45, 0.75, -0.5};
             options.view_up = {0.0, 0.0, 1.0};
-            options.show_edges = true;
             options.height = 520;
             fig::render_mesh_png(run.file(file), io::warped(data), options);
         }

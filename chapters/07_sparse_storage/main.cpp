@@ -138,7 +138,7 @@ void pattern_figure(const RunContext& run)
         options.title = str("Stored entries of K, box of ", n, "x", n, "x", n, " cubes: ", K.rows, " dofs, ",
                             K.nonzeros(), " nonzeros");
         options.field = "stored";
-        options.range = std::pair{0.0, 1.0};
+        options.categories = {{0.0, "zero (not stored)", {0.86, 0.86, 0.86}}, {1.0, "stored", {0.13, 0.40, 0.65}}};
         options.width = 760;
         options.height = 760;
         fig::render_grid_png(run.file("stiffness_pattern.png"), image, options);

@@ -361,8 +361,7 @@ void pattern_figure(const RunContext& run)
     io::ImageGrid image;
     image.dims = {side, side, 1};
     Eigen::MatrixXd value = Eigen::MatrixXd::Constant(Eigen::Index(side) * side, 1, 0.5);  // the gaps
-    std::string title =
-        str("L of a ", grid, "x", grid, " grid Laplacian (teal: A, yellow: fill), nnz(L) of each order\n");
+    std::string title = str("L of a ", grid, "x", grid, " grid Laplacian and nnz(L) in each ordering\n");
     for (int panel = 0; panel < 4; ++panel) {
         const SparseCholesky chol(A, {shown[panel], Factorization::up_looking});
         const sparse::CscMatrix L = chol.factor();
@@ -389,7 +388,9 @@ void pattern_figure(const RunContext& run)
         fig::RenderOptions options;
         options.title = title;
         options.field = "entry";
-        options.range = std::pair{0.0, 2.0};
+        options.categories = {{0.0, "zero", {0.86, 0.86, 0.86}},
+                              {1.0, "entry of A", {0.13, 0.40, 0.65}},
+                              {2.0, "fill", {0.99, 0.62, 0.10}}};  // the gaps (0.5) are no category: white
         options.width = 1000;
         options.height = 960;
         fig::render_grid_png(run.file("factor_patterns.png"), image, options);

@@ -1,7 +1,8 @@
 #pragma once
 // Independent references for the tests of chapter 02: the 5-point Laplacian built as a Kronecker
 // sum of 1D second-difference matrices (not by the chapter's code), the discrete eigenvalue
-// written out, and the max-norm distance between grid functions.
+// written out, the explicit stability limit written out, and the max-norm distance between grid
+// functions.
 
 #include "02_heat_equation/heat_grid.hpp"
 
@@ -37,6 +38,13 @@ inline double eigenvalue_formula(int n, int k, int l)
     const double h = 1.0 / (n + 1), pi = std::numbers::pi;
     return -(4.0 / (h * h)) *
            (std::pow(std::sin(k * pi * h / 2.0), 2) + std::pow(std::sin(l * pi * h / 2.0), 2));
+}
+
+/// The explicit stability limit h²/(4c) written out, so that the tests of the exercises before
+/// explicit_stability_limit (02.5) do not need it to pick their time steps.
+inline double explicit_limit_formula(double h, double c)
+{
+    return h * h / (4.0 * c);
 }
 
 /// max_k |a_k − b_k|

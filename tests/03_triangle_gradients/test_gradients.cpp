@@ -225,7 +225,7 @@ TEST_CASE("the permutation from vertex-major to coordinate-major order", "[ex03.
     CHECK_THROWS_AS(coordinate_major_permutation(0), fem::Error);
 }
 
-TEST_CASE("the block Jacobian in our vertex-major ordering is J P", "[ex03.4][ex03.5]")
+TEST_CASE("the block Jacobian in our vertex-major ordering is J P", "[ex03.5]")
 {
     RandomTriangles triangles;
     const SparseMatrix P = coordinate_major_permutation(3);

@@ -6,6 +6,7 @@
 #include "common/mesh.hpp"
 
 #include "04_tet_jacobians/tet_fixtures.hpp"
+#include "common/test_support.hpp"
 #include <catch2/catch.hpp>
 
 #include <Eigen/Geometry>
@@ -19,6 +20,8 @@ using fem::test::skew_tet;
 using fem::test::random_matrix;
 using fem::test::row_major_vec;
 using Catch::Matchers::Contains;
+using fem::test::EntriesNear;
+using fem::test::entries_of;
 
 namespace {
 
@@ -160,8 +163,8 @@ TEST_CASE("jacobian matrix: the lecture's coordinate-major J_e is B with permute
     for (int i = 0; i < 12; ++i)
         index[i] = i;
     const Eigen::Matrix<double, 12, 1> reordered = P * index;
-    const double expected[12] = {0, 3, 6, 9, 1, 4, 7, 10, 2, 5, 8, 11};
-    for (int i = 0; i < 12; ++i)
-        CHECK(reordered[i] == expected[i]);
+    const Eigen::Matrix<double, 12, 1> expected =
+        (Eigen::Matrix<double, 12, 1>() << 0, 3, 6, 9, 1, 4, 7, 10, 2, 5, 8, 11).finished();
+    CHECK_THAT(entries_of(reordered), EntriesNear(expected, 0.0));
     CHECK((jacobian_matrix(X) - coordinate_major_jacobian(X) * P).norm() == Approx(0.0).margin(1e-13));
 }

@@ -6,6 +6,7 @@
 #include "common/error.hpp"
 
 #include "04_tet_jacobians/tet_fixtures.hpp"
+#include "common/test_support.hpp"
 #include <catch2/catch.hpp>
 
 #include <Eigen/Eigenvalues>
@@ -18,6 +19,8 @@ using namespace fem::elastic;
 using fem::test::random_matrix;
 using fem::test::row_major_vec;
 using Catch::Matchers::Contains;
+using fem::test::EntriesNear;
+using fem::test::entries_of;
 
 namespace {
 
@@ -115,9 +118,8 @@ TEST_CASE("C: sigma = C eps reproduces lambda tr(eps) I + 2 mu eps, and pure she
     Eigen::SelfAdjointEigenSolver<Matrix6d> eig(C);
     const Eigen::VectorXd values = eig.eigenvalues();
     const double mu = rubber.mu, lambda = rubber.lambda;
-    const double want[6] = {mu, mu, mu, 2 * mu, 2 * mu, 3 * lambda + 2 * mu};
-    for (int i = 0; i < 6; ++i)
-        CHECK(values[i] == Approx(want[i]).epsilon(1e-12));
+    const Vector6d want = (Vector6d() << mu, mu, mu, 2 * mu, 2 * mu, 3 * lambda + 2 * mu).finished();
+    CHECK_THAT(entries_of(values), EntriesNear(want, 0.0, 1e-12));
 }
 
 TEST_CASE("C rejects unstable materials with fem::Error", "[ex05.6]")

@@ -122,7 +122,7 @@ TEST_CASE("solve_spd refuses indefinite and mismatched systems", "[ch06]")
     CHECK(solve_spd(A.sparseView(), Eigen::Vector2d(2.0, 3.0)).isApprox(Eigen::Vector2d(1.0, 1.0)));
 }
 
-TEST_CASE("pinning rejects bad indices, and the reduce/expand sizes are checked", "[ch06]")
+TEST_CASE("pinning rejects bad indices, and the reduce/expand sizes are checked", "[ex06.8]")
 {
     CHECK_THROWS_WITH(free_selection_matrix(5, {1, 5}), Contains("pinned vertex 5") && Contains("[0, 5)"));
     CHECK_THROWS_AS(free_selection_matrix(5, {-1}), fem::Error);
@@ -135,7 +135,7 @@ TEST_CASE("pinning rejects bad indices, and the reduce/expand sizes are checked"
     CHECK(vertices_on_plane(mesh, 2, 1.0) == std::vector<int>{4, 5, 6, 7});
 
     const SparseMatrix P = free_selection_matrix(8, {0});
-    const SparseMatrix A = lumped_mass_matrix(fem::box_mesh(2, 1, 1), rho);  // 36×36, P has 24 rows
+    const SparseMatrix A = SparseMatrix(Eigen::MatrixXd::Identity(36, 36).sparseView());  // P has 24 rows
     CHECK_THROWS_AS(reduce(A, P), fem::Error);
     CHECK_THROWS_AS(expand(P, Eigen::VectorXd::Zero(24)), fem::Error);
 }

@@ -35,7 +35,7 @@ bool listed(const std::string& name)
 
 }  // namespace
 
-TEST_CASE("every solver of the interface solves the elastic box and a Laplacian", "[solvers]")
+TEST_CASE("every solver of the interface solves the elastic box and a Laplacian", "[ex09.5]")
 {
     const ElasticBox box = clamped_box(4, fem::elastic::lame_parameters(1e5, 0.45), 1000.0);
     const Eigen::SparseMatrix<double> laplacian = fem::sparse::to_eigen(fem::direct::laplacian_3d(7));
@@ -81,7 +81,7 @@ TEST_CASE("the solver names, the default and CHOLMOD", "[solvers]")
     CHECK_THROWS_AS(make_solver("ours-cg", bad), fem::Error);
 }
 
-TEST_CASE("every solver refuses an indefinite matrix with fem::Error", "[solvers]")
+TEST_CASE("every solver refuses an indefinite matrix with fem::Error", "[ex09.5]")
 {
     const Eigen::MatrixXd dense = spd_with_spectrum((Eigen::VectorXd(6) << -1, 1, 2, 3, 4, 5).finished(), 3u);
     const Eigen::SparseMatrix<double> A = dense.sparseView();
@@ -116,7 +116,7 @@ TEST_CASE("prepare checks the matrix, solve checks b", "[solvers]")
     CHECK_THROWS_WITH(solver->solve(Eigen::VectorXd::Ones(4)), Contains("b has 4 entries"));
 }
 
-TEST_CASE("an iterative solver that misses its tolerance says so", "[solvers]")
+TEST_CASE("an iterative solver that misses its tolerance says so", "[ex09.5]")
 {
     SolverOptions options;
     options.max_iterations = 3;
@@ -129,7 +129,7 @@ TEST_CASE("an iterative solver that misses its tolerance says so", "[solvers]")
     }
 }
 
-TEST_CASE("a warm start from the last solution costs an iterative solver nothing", "[solvers]")
+TEST_CASE("a warm start from the last solution costs an iterative solver nothing", "[ex09.5]")
 {
     const Eigen::SparseMatrix<double> A = fem::sparse::to_eigen(fem::direct::laplacian_2d(30));
     const Eigen::VectorXd b = random_vector(A.rows(), 6u);
@@ -148,7 +148,7 @@ TEST_CASE("a warm start from the last solution costs an iterative solver nothing
     }
 }
 
-TEST_CASE("prepare again with new values on the same pattern", "[solvers]")
+TEST_CASE("prepare again with new values on the same pattern", "[ex09.5]")
 {
     const ElasticBox box = clamped_box(3, fem::elastic::lame_parameters(1e5, 0.3), 1000.0);
     const Eigen::SparseMatrix<double> stiffer = 2.0 * box.K;

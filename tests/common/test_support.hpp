@@ -3,8 +3,16 @@
 
 #include "common/files.hpp"
 
+#include <catch2/catch.hpp>
+
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
+#include <sstream>
 #include <string>
+#include <utility>
 
 namespace fem::test {
 
@@ -17,4 +25,96 @@ inline std::filesystem::path fresh_output_dir(const std::string& name)
     return dir;
 }
 
+/// The entries of a matrix or vector, dense or sparse, as compared by EntriesNear. Catch2 prints
+/// it as its shape only ("a 12×12 matrix"): the matcher names the entries that matter.
+struct MatrixEntries {
+    Eigen::MatrixXd values;
+};
+
+/// What CHECK_THAT(entries_of(actual), EntriesNear(expected, ...)) compares: any Eigen matrix,
+/// vector or sparse matrix, or an expression of them.
+template <typename Matrix>
+MatrixEntries entries_of(const Matrix& matrix)
+{
+    return {Eigen::MatrixXd(matrix)};
+}
+
+/// Catch2 matcher for a matrix compared entry by entry, as Catch's Approx compares one number:
+/// |actual_ij − expected_ij| ≤ max(absolute, relative · |expected_ij|) for every entry, and the
+/// same shape. On failure it says which entry
+/// differs first (row, column, expected, got) and how many differ:
+///
+///     CHECK_THAT(entries_of(K), EntriesNear(K_expected, 1e-12 * scale));
+class EntriesNear : public Catch::MatcherBase<MatrixEntries> {
+public:
+    /// expected: any Eigen matrix, vector or sparse matrix; absolute and relative: the tolerance.
+    template <typename Matrix>
+    explicit EntriesNear(const Matrix& expected, double absolute, double relative = 0.0)
+        : expected_(expected), absolute_(absolute), relative_(relative)
+    {
+    }
+
+    bool match(const MatrixEntries& actual) const override
+    {
+        const Eigen::MatrixXd& a = actual.values;
+        std::ostringstream out;
+        if (a.rows() != expected_.rows() || a.cols() != expected_.cols()) {
+            out << "is not " << expected_.rows() << "×" << expected_.cols() << " like the expected matrix";
+            report_ = out.str();
+            return false;
+        }
+        Eigen::Index differing = 0;
+        for (Eigen::Index j = 0; j < a.cols(); ++j)
+            for (Eigen::Index i = 0; i < a.rows(); ++i) {
+                const double want = expected_(i, j), got = a(i, j);
+                if (std::abs(got - want) <= std::max(absolute_, relative_ * std::abs(want)))
+                    continue;  // (a NaN on either side never passes)
+                if (differing++ == 0) {
+                    out.precision(17);
+                    out << "differs at " << (a.cols() == 1 ? "entry " + std::to_string(i)
+                                                            : "(" + std::to_string(i) + ", " + std::to_string(j) + ")")
+                        << ": expected " << want << ", got " << got;
+                }
+            }
+        if (differing > 1)
+            out << " (and " << differing - 1 << " more of its " << a.size() << " entries)";
+        report_ = out.str();
+        return differing == 0;
+    }
+
+    std::string describe() const override
+    {
+        std::ostringstream out;
+        out << "is within ";
+        if (relative_ > 0.0)
+            out << "max(" << absolute_ << ", " << relative_ << "·|expected|)";
+        else
+            out << absolute_;
+        out << " of the expected matrix entry by entry";
+        if (!report_.empty())
+            out << ", but " << report_;
+        return out.str();
+    }
+
+private:
+    Eigen::MatrixXd expected_;
+    double absolute_;
+    double relative_;
+    mutable std::string report_;  // what match() found, for describe()
+};
+
 }  // namespace fem::test
+
+namespace Catch {
+
+/// Prints the compared matrix as its shape; EntriesNear names the entries that differ.
+template <>
+struct StringMaker<fem::test::MatrixEntries> {
+    static std::string convert(const fem::test::MatrixEntries& entries)
+    {
+        return "a " + std::to_string(entries.values.rows()) + "×" + std::to_string(entries.values.cols()) +
+               " matrix";
+    }
+};
+
+}  // namespace Catch
