@@ -73,10 +73,10 @@ State initial_state(Body& body, const Eigen::VectorXd& u0, const Eigen::VectorXd
 Energies energies(const Body& body, const State& state)
 {
     Energies e;
-    // EXERCISE 10.4 (energies): see docs/10_linear_dynamics.md#energy
+    // EXERCISE 10.3 (energies): see docs/10_linear_dynamics.md#energy
     // HINT: kinetic ½ vᵀ M v (kinetic_energy), elastic: the force model's U kept in the state,
     // HINT: gravitational: the load potential −f_extᵀ u (load_potential).
-    throw fem::NotImplemented("10.4", "energies", "docs/10_linear_dynamics.md#energy");
+    throw fem::NotImplemented("10.3", "energies", "docs/10_linear_dynamics.md#energy");
     return e;
 }
 
@@ -161,13 +161,13 @@ StepInfo ThetaMethod::step(Body& body, double time_step, State& state)
     }
 
     Eigen::VectorXd v_next, v_theta, u_next;
-    // EXERCISE 10.3 (theta_step): see docs/10_linear_dynamics.md#the-implicit-step
+    // EXERCISE 10.4 (theta_step): see docs/10_linear_dynamics.md#the-implicit-step
     // HINT: velocity_change form: r = velocity_change_right_hand_side(M, v, K v, f, f_ext, D, Δt, θ),
     // HINT: solve A Δv = r, v⁺ = v + Δv. velocity form: b = step_right_hand_side(M, v, f, f_ext, Δt),
     // HINT: minus (1 − θ)Δt (D v + θΔt K v) when θ < 1 (damping_times gives D v); solve A v⁺ = b.
     // HINT: Solve on the free dofs (eliminate: gather, solve, scatter; keep: zero the pinned rows
     // HINT: of the right-hand side, solve all 3n). Then v_θ = θ v⁺ + (1 − θ) v, u⁺ = u + Δt v_θ.
-    throw fem::NotImplemented("10.3", "theta_step", "docs/10_linear_dynamics.md#the-implicit-step");
+    throw fem::NotImplemented("10.4", "theta_step", "docs/10_linear_dynamics.md#the-implicit-step");
 
     info.solver_iterations = solver_->stats().iterations;
     const Damping& d = body.scene().damping;

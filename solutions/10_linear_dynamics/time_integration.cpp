@@ -71,7 +71,7 @@ State initial_state(Body& body, const Eigen::VectorXd& u0, const Eigen::VectorXd
 Energies energies(const Body& body, const State& state)
 {
     Energies e;
-    // BEGIN EXERCISE 10.4 energies #energy
+    // BEGIN EXERCISE 10.3 energies #energy
     // HINT: kinetic ½ vᵀ M v (kinetic_energy), elastic: the force model's U kept in the state,
     // HINT: gravitational: the load potential −f_extᵀ u (load_potential).
     e.kinetic = kinetic_energy(body.mass_matrix(), state.v);
@@ -165,7 +165,7 @@ StepInfo ThetaMethod::step(Body& body, double time_step, State& state)
     }
 
     Eigen::VectorXd v_next, v_theta, u_next;
-    // BEGIN EXERCISE 10.3 theta_step #the-implicit-step
+    // BEGIN EXERCISE 10.4 theta_step #the-implicit-step
     // HINT: velocity_change form: r = velocity_change_right_hand_side(M, v, K v, f, f_ext, D, Δt, θ),
     // HINT: solve A Δv = r, v⁺ = v + Δv. velocity form: b = step_right_hand_side(M, v, f, f_ext, Δt),
     // HINT: minus (1 − θ)Δt (D v + θΔt K v) when θ < 1 (damping_times gives D v); solve A v⁺ = b.

@@ -36,7 +36,7 @@ Eigen::VectorXd sag_shape(const Scene& scene)
 
 }  // namespace
 
-TEST_CASE("the midpoint rule keeps an undamped body's energy to round-off over 1000 steps", "[ex10.3]")
+TEST_CASE("the midpoint rule keeps an undamped body's energy to round-off over 1000 steps", "[ex10.4]")
 {
     const Scene scene = cantilever_scene();
     Body body(scene);
@@ -69,7 +69,7 @@ TEST_CASE("the midpoint rule keeps an undamped body's energy to round-off over 1
 }
 
 TEST_CASE("energy balance: the loss splits into damping work and backward Euler's own dissipation",
-          "[ex10.3]")
+          "[ex10.4]")
 {
     Scene scene = cantilever_scene(8, 2, true);
     scene.damping = {0.02, 0.01};
@@ -97,7 +97,7 @@ TEST_CASE("energy balance: the loss splits into damping work and backward Euler'
     CHECK(simulation.last().integrator_dissipated > 0.0);
 }
 
-TEST_CASE("a damped beam under gravity settles to the static solution K^-1 f", "[ex10.3]")
+TEST_CASE("a damped beam under gravity settles to the static solution K^-1 f", "[ex10.4]")
 {
     Scene scene = cantilever_scene(8, 2, true);
     scene.damping = {0.0, 0.02};
@@ -117,7 +117,7 @@ TEST_CASE("a damped beam under gravity settles to the static solution K^-1 f", "
     CHECK(simulation.state().v.norm() <= 1e-7 * expected.norm() / scene.time_step);
 }
 
-TEST_CASE("free fall: nothing pinned, the body falls rigidly on backward Euler's discrete parabola", "[ex10.3]")
+TEST_CASE("free fall: nothing pinned, the body falls rigidly on backward Euler's discrete parabola", "[ex10.4]")
 {
     Scene scene = cantilever_scene(4, 1, true);
     scene.pinned.clear();
@@ -150,7 +150,7 @@ TEST_CASE("free fall: nothing pinned, the body falls rigidly on backward Euler's
     CHECK(std::abs(fallen - 0.5 * 9.81 * 1.0) > 0.01);  // the discrete parabola is not ½ g t²
 }
 
-TEST_CASE("pinned dofs eliminated or kept with P A P + (I - P): the same trajectory", "[ex10.3]")
+TEST_CASE("pinned dofs eliminated or kept with P A P + (I - P): the same trajectory", "[ex10.4]")
 {
     Scene scene = cantilever_scene(8, 2, true);
     scene.damping = {0.01, 0.01};
@@ -180,7 +180,7 @@ TEST_CASE("pinned dofs eliminated or kept with P A P + (I - P): the same traject
 }
 
 TEST_CASE("solvers: factor once = refactor every step, and warm-started PCG agrees and needs fewer iterations",
-          "[ex10.3]")
+          "[ex10.4]")
 {
     Scene scene = cantilever_scene(8, 2, true);
     Body body(scene);
@@ -268,7 +268,7 @@ TEST_CASE("stability: explicit Euler blows up at 1.01x its limit and the loop sa
 }
 
 TEST_CASE("backward Euler at 100x the explicit limit and a very stiff body at dt = 1/30 stay bounded",
-          "[ex10.3]")
+          "[ex10.4]")
 {
     Scene scene = cantilever_scene(6, 2, true);
     Body body(scene);

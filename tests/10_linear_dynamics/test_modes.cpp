@@ -74,7 +74,7 @@ TEST_CASE("oscillator step matrix: the theta-step's two equations solved, and ba
 // ε λ_max/λ₁; the phase ω₁ t accumulates it. A coarse beam (ω_max/ω₁ ≈ 100) keeps that near 1e-12,
 // so the 1e-10 below tests the integrator, not the eigensolver.
 TEST_CASE("a body started in mode 1 follows the modal recurrence of backward Euler and the midpoint rule",
-          "[ex10.3]")
+          "[ex10.4]")
 {
     const Scene scene = cantilever_scene(6, 1);
     Body body(scene);
@@ -90,7 +90,7 @@ TEST_CASE("a body started in mode 1 follows the modal recurrence of backward Eul
 }
 
 TEST_CASE("Rayleigh damping acts on each mode with xi = alpha/(2 omega) + beta omega/2, each term alone",
-          "[ex10.3]")
+          "[ex10.4]")
 {
     Scene scene = cantilever_scene(6, 1);
     Body body(scene);
@@ -116,7 +116,7 @@ TEST_CASE("Rayleigh damping acts on each mode with xi = alpha/(2 omega) + beta o
 }
 
 TEST_CASE("backward Euler's amplitude factor 1/sqrt(1 + w^2 dt^2) and phase atan(w dt) per step, measured",
-          "[ex10.3]")
+          "[ex10.4]")
 {
     Scene scene = cantilever_scene();
     Body body(scene);

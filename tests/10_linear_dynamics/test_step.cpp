@@ -48,7 +48,7 @@ TEST_CASE("right-hand side: M v - dt (K u - f_ext), the lecture's form", "[ex10.
     CHECK_THROWS_AS(step_right_hand_side(body.mass_matrix(), v.head(3), f, body.external_forces(), dt), fem::Error);
 }
 
-TEST_CASE("energies: kinetic, elastic and the potential of gravity", "[ex10.4]")
+TEST_CASE("energies: kinetic, elastic and the potential of gravity", "[ex10.3]")
 {
     Body body(cantilever_scene(3, 1, true));
     const Eigen::Index n = body.dofs().full_size();
