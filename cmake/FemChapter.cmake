@@ -138,7 +138,14 @@ function(fem_add_chapter number name)
 
   # A chapter's own additions to the build (e.g. an optional reference library for its
   # executable) go in chapters/NN_name/chapter.cmake, included here, where ${lib}, ${exe} and
-  # ${test_exe} name its targets.
+  # ${test_exe} name its targets and ${chapter_libraries} lists every library built from its
+  # sources: ${lib}, and in a student build also its reference twin ${lib}_reference. A package
+  # the chapter's code needs is linked to each of them.
+  set(chapter_libraries ${lib})
+  get_target_property(reference_aliased ${lib}_reference ALIASED_TARGET)
+  if(NOT reference_aliased)
+    list(APPEND chapter_libraries ${lib}_reference)
+  endif()
   if(EXISTS ${FEM_ROOT}/chapters/${id}/chapter.cmake)
     include(${FEM_ROOT}/chapters/${id}/chapter.cmake)
   endif()

@@ -3,12 +3,7 @@
 # The library links it publicly, so every later chapter that picks a solver by name can use it.
 # Included by fem_add_chapter, where ${lib} names the chapter's library.
 if(FEM_CHOLMOD_INCLUDE_DIR AND FEM_CHOLMOD_LIBRARY)
-  set(fem_ch09_libraries ${lib})
-  get_target_property(fem_ch09_aliased ${lib}_reference ALIASED_TARGET)
-  if(NOT fem_ch09_aliased)
-    list(APPEND fem_ch09_libraries ${lib}_reference)  # a student build: the reference is its own target
-  endif()
-  foreach(target IN LISTS fem_ch09_libraries)
+  foreach(target IN LISTS chapter_libraries)
     target_include_directories(${target} SYSTEM PRIVATE ${FEM_CHOLMOD_INCLUDE_DIR})
     target_link_libraries(${target} PUBLIC ${FEM_CHOLMOD_LIBRARY} ${CMAKE_DL_LIBS})  # dl: set_blas_threads
     target_compile_definitions(${target} PRIVATE FEM_HAVE_CHOLMOD)

@@ -2,12 +2,7 @@
 # libspectra-dev, installed by tools/setup.sh). Included by fem_add_chapter, where ${lib} names the
 # chapter's library.
 find_package(spectra 1.0 REQUIRED CONFIG PATHS /usr/share/spectra/cmake)
-set(fem_ch10_libraries ${lib})
-get_target_property(fem_ch10_aliased ${lib}_reference ALIASED_TARGET)
-if(NOT fem_ch10_aliased)
-  list(APPEND fem_ch10_libraries ${lib}_reference)  # a student build: the reference is its own target
-endif()
-foreach(target IN LISTS fem_ch10_libraries)
+foreach(target IN LISTS chapter_libraries)
   target_link_libraries(${target} PRIVATE Spectra::Spectra)
 endforeach()
 
