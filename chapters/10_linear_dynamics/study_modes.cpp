@@ -27,23 +27,6 @@ FreeSystem free_system(Body& body)
     return {body.dofs().reduce(body.model().stiffness(rest)), body.dofs().reduce(body.mass_matrix())};
 }
 
-/// Runs `steps` steps of `integrator` from the body at rest in mode φ (full vector) and returns
-/// the largest |u_tip − (Gⁿ (1, 0))₀ φ_tip| over the run, relative to the largest |u_tip|.
-double recurrence_deviation(Body& body, Integrator& integrator, double time_step, const Eigen::VectorXd& phi,
-                            int tip_dof, const Eigen::Matrix2d& G, int steps)
-{
-    Simulation simulation(body, integrator, initial_state(body, phi), time_step);
-    Eigen::Vector2d modal(1.0, 0.0);
-    double deviation = 0.0, largest = 0.0;
-    simulation.run(steps, [&](const State& state, const StepRecord&) {
-        if (state.step > 0)
-            modal = G * modal;
-        deviation = std::max(deviation, std::abs(state.u[tip_dof] - modal[0] * phi[tip_dof]));
-        largest = std::max(largest, std::abs(state.u[tip_dof]));
-    });
-    return deviation / largest;
-}
-
 }  // namespace
 
 void modes_study(const RunContext& run, const Settings& settings)
@@ -157,7 +140,7 @@ void recurrence_study(const RunContext& run, const Settings& settings)
                 explicit_step ? symplectic_oscillator_step_matrix(omega, xi, scene.time_step)
                               : oscillator_step_matrix(omega, xi, scene.time_step, name == "backward-euler" ? 1.0 : 0.5);
             table.add_row({integrator->name(), std::string(label), omega * scene.time_step, xi,
-                           recurrence_deviation(body, *integrator, scene.time_step, phi, tip_dof, G, 100)});
+                           modal_recurrence_deviation(body, *integrator, scene.time_step, phi, tip_dof, G, 100)});
         }
     }
     table.print(std::cout);

@@ -225,6 +225,25 @@ Eigen::Matrix2d symplectic_oscillator_step_matrix(double omega, double xi, doubl
     return G;
 }
 
+double modal_recurrence_deviation(Body& body, Integrator& integrator, double time_step, const Eigen::VectorXd& start,
+                                  Eigen::Index dof, const Eigen::Matrix2d& G, int steps)
+{
+    if (dof < 0 || dof >= body.dofs().full_size())
+        throw Error(str("modal recurrence: dof ", dof, " is outside [0, ", body.dofs().full_size(), ")"));
+    if (steps < 1)
+        throw Error(str("modal recurrence: steps must be >= 1, got ", steps));
+    Simulation simulation(body, integrator, initial_state(body, start), time_step);
+    Eigen::Vector2d modal(1.0, 0.0);
+    double deviation = 0.0, largest = 0.0;
+    simulation.run(steps, [&](const State& state, const StepRecord&) {
+        if (state.step > 0)
+            modal = G * modal;
+        deviation = std::max(deviation, std::abs(state.u[dof] - modal[0] * start[dof]));
+        largest = std::max(largest, std::abs(state.u[dof]));
+    });
+    return deviation / largest;
+}
+
 Eigen::Vector2d exact_oscillator(double omega, double xi, double q0, double p0, double t)
 {
     require_positive(omega, "angular frequency omega [rad/s]");
@@ -291,13 +310,6 @@ double ModalSolution::displacement(double t, Eigen::Index dof) const
     return u;
 }
 
-Eigen::VectorXd ModalSolution::velocity(double t) const
-{
-    Eigen::VectorXd p(modes_.omega.size());
-    for (Eigen::Index k = 0; k < p.size(); ++k)
-        p[k] = coordinate(k, t)[1];
-    return modes_.shapes * p;
-}
 
 double euler_bernoulli_first_frequency(double youngs_modulus, double density, double length, double area,
                                        double second_moment)

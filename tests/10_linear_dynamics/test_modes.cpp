@@ -28,16 +28,7 @@ double recurrence_deviation(const Scene& scene, Integrator& integrator, const Ei
     const int tip_dof = 3 * fem::test::tip_vertex(scene) + 2;
     Eigen::VectorXd phi = fem::test::expanded(body, modes.shapes.col(0));
     phi *= 1e-3 / std::abs(phi[tip_dof]);
-    Simulation simulation(body, integrator, initial_state(body, phi), scene.time_step);
-    Eigen::Vector2d modal(1.0, 0.0);
-    double deviation = 0.0, largest = 0.0;
-    simulation.run(steps, [&](const State& state, const StepRecord&) {
-        if (state.step > 0)
-            modal = G * modal;
-        deviation = std::max(deviation, std::abs(state.u[tip_dof] - modal[0] * phi[tip_dof]));
-        largest = std::max(largest, std::abs(state.u[tip_dof]));
-    });
-    return deviation / largest;
+    return modal_recurrence_deviation(body, integrator, scene.time_step, phi, tip_dof, G, steps);
 }
 
 }  // namespace
