@@ -106,6 +106,10 @@ public:
     std::vector<Eigen::Matrix3d> rotations(const Eigen::VectorXd& u) const;
 
 private:
+    /// rotations(u), kept for the last u: a step asks for the forces and then K_R at the same u,
+    /// and the SVDs are the expensive part of both.
+    const std::vector<Eigen::Matrix3d>& rotations_at(const Eigen::VectorXd& u);
+
     TetMesh mesh_;
     elastic::Lame lame_;
     RotationFit fit_;
@@ -113,6 +117,8 @@ private:
     assembly::AssemblyPattern pattern_;
     assembly::CsrMatrix K_R_csr_;
     dynamics::SparseMatrix K_R_;
+    Eigen::VectorXd rotated_at_;                  // the u of rotations_
+    std::vector<Eigen::Matrix3d> rotations_;
 };
 
 }  // namespace fem::corot

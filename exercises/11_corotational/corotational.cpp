@@ -132,9 +132,18 @@ std::vector<Eigen::Matrix3d> CorotationalElasticity::rotations(const Eigen::Vect
     return R;
 }
 
+const std::vector<Eigen::Matrix3d>& CorotationalElasticity::rotations_at(const Eigen::VectorXd& u)
+{
+    if (rotations_.empty() || rotated_at_.size() != u.size() || rotated_at_ != u) {
+        rotations_ = rotations(u);
+        rotated_at_ = u;
+    }
+    return rotations_;
+}
+
 double CorotationalElasticity::evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& forces)
 {
-    const std::vector<Eigen::Matrix3d> R = rotations(u);
+    const std::vector<Eigen::Matrix3d>& R = rotations_at(u);
     const MatrixX3d x = mesh_.V + io::vertex_rows(u);
     forces = Eigen::VectorXd::Zero(u.size());
     double energy = 0.0;
@@ -153,7 +162,7 @@ double CorotationalElasticity::evaluate(const Eigen::VectorXd& u, Eigen::VectorX
 
 const dynamics::SparseMatrix& CorotationalElasticity::stiffness(const Eigen::VectorXd& u)
 {
-    const std::vector<Eigen::Matrix3d> R = rotations(u);
+    const std::vector<Eigen::Matrix3d>& R = rotations_at(u);
     assembly::ElementMatrices warped(K_e_.size());
     // EXERCISE 11.4 (warped_stiffness): see docs/11_corotational.md#forces-and-warped-stiffness
     // HINT: one rotated_stiffness per tet, then chapter 06's pattern_.assemble into K_R_csr_ (the
