@@ -46,14 +46,20 @@ Eigen::Matrix3d edge_covariance(const tet::TetVertices& X, const tet::TetVertice
 /// docs/11_corotational.md#edges-centroid-or-polar-decomposition
 Eigen::Matrix3d centroid_covariance(const tet::TetVertices& X, const tet::TetVertices& x);
 
+/// The proper rotation closest to A Bᵀ, for A and B orthogonal (3×3) with their columns in the
+/// order of descending singular values (as an SVD gives them): A Bᵀ when det(A Bᵀ) = +1, else
+/// A diag(1, 1, −1) Bᵀ — the reflection moved onto the smallest singular value, where it changes
+/// the fit least. docs/11_corotational.md#reflections
+Eigen::Matrix3d proper_rotation(Eigen::Matrix3d A, const Eigen::Matrix3d& B);
+
 /// The proper rotation R (RᵀR = I, det R = +1) that best maps rest edges to deformed edges:
-/// S = U Σ Vᵀ (Eigen's JacobiSVD), R = V Uᵀ, and when det(V Uᵀ) < 0 the column of V belonging to
-/// the smallest singular value changes sign. S = 0 (every edge collapsed) gives R = I. Never NaN for
+/// S = U Σ Vᵀ (Eigen's JacobiSVD), R = proper_rotation(V, U): V Uᵀ, and when det(V Uᵀ) < 0 the
+/// column of V belonging to the smallest singular value changes sign. S = 0 (every edge collapsed) gives R = I. Never NaN for
 /// finite S; fem::Error for a non-finite S. docs/11_corotational.md#the-best-fit-rotation
 Eigen::Matrix3d best_fit_rotation(const Eigen::Matrix3d& S);
 
 /// The rotation of the polar decomposition F = R_p S_p (S_p symmetric positive semi-definite), from
-/// the SVD F = U Σ Vᵀ: R_p = U Vᵀ, with the same reflection fix; the rotation closest to F
+/// the SVD F = U Σ Vᵀ: R_p = proper_rotation(U, V) = U Vᵀ, with the same reflection fix; the rotation closest to F
 /// (it minimises ‖F − R‖). For a tet, F = Qᵀ P⁻ᵀ; R_p equals the edge fit when PᵀP ∝ I (the corner
 /// tet) and the centroid fit when the corners' covariance is ∝ I (a regular tet), and differs from
 /// both for skewed tets. docs/11_corotational.md#edges-centroid-or-polar-decomposition

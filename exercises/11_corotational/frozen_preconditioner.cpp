@@ -31,14 +31,15 @@ void FrozenFactorPcg::do_prepare(const Eigen::SparseMatrix<double>& A, bool same
 
 int FrozenFactorPcg::do_solve(const Eigen::VectorXd& b, Eigen::VectorXd& x)
 {
-    const cg::EigenOperator A(A_);
-    const cg::FunctionOperator preconditioner(A_.rows(), [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) {
-        z = factor_->solve(r);
-    });
     cg::CgSettings settings;
     settings.relative_tolerance = options_.relative_tolerance;
     settings.max_iterations = options_.max_iterations;
-    const cg::CgResult result = cg::preconditioned_conjugate_gradient(A, preconditioner, b, x, settings);
+    cg::CgResult result;
+    // EXERCISE 11.7 (frozen_factor_pcg): see docs/11_corotational.md#solving-a-changing-matrix
+    // HINT: chapter 09's preconditioned_conjugate_gradient on the current matrix (cg::EigenOperator of
+    // HINT: A_) from x, with a cg::FunctionOperator preconditioner that applies the frozen factor:
+    // HINT: z = factor_->solve(r).
+    throw fem::NotImplemented("11.7", "frozen_factor_pcg", "docs/11_corotational.md#solving-a-changing-matrix");
     if (!result.converged)
         throw Error(str(name(), ": CG missed its tolerance ", options_.relative_tolerance, " within ",
                         result.iterations, " iterations"));

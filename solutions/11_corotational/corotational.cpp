@@ -11,16 +11,6 @@
 namespace fem::corot {
 namespace {
 
-/// The proper rotation closest to A Bᵀ from the SVD parts: A Bᵀ, or with the column of the smallest
-/// singular value flipped in A when det(A Bᵀ) < 0. JacobiSVD sorts singular values descending, so
-/// that column is the last.
-Eigen::Matrix3d proper(Eigen::Matrix3d A, const Eigen::Matrix3d& B)
-{
-    if ((A * B.transpose()).determinant() < 0.0)
-        A.col(2) = -A.col(2);
-    return A * B.transpose();
-}
-
 /// x_e as 12 vertex-major coordinates of tet t from a #V×3 matrix.
 Vector12d element_vector(const TetMesh& mesh, const MatrixX3d& positions, Eigen::Index t)
 {
@@ -31,6 +21,16 @@ Vector12d element_vector(const TetMesh& mesh, const MatrixX3d& positions, Eigen:
 }
 
 }  // namespace
+
+Eigen::Matrix3d proper_rotation(Eigen::Matrix3d A, const Eigen::Matrix3d& B)
+{
+    // BEGIN EXERCISE 11.1 proper_rotation #reflections
+    // HINT: If det(A Bᵀ) < 0, negate A's last column (the smallest singular value's); return A Bᵀ.
+    if ((A * B.transpose()).determinant() < 0.0)
+        A.col(2) = -A.col(2);
+    return A * B.transpose();
+    // END EXERCISE
+}
 
 Eigen::Matrix3d edge_covariance(const tet::TetVertices& X, const tet::TetVertices& x)
 {
@@ -55,10 +55,10 @@ Eigen::Matrix3d best_fit_rotation(const Eigen::Matrix3d& S)
     if (S.isZero(0.0))
         return Eigen::Matrix3d::Identity();
     const Eigen::JacobiSVD<Eigen::Matrix3d> svd(S, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    // BEGIN EXERCISE 11.1 best_fit_rotation #the-best-fit-rotation
-    // HINT: S = U Σ Vᵀ. The rotation from rest to deformed is R = V Uᵀ (not the slide's U Vᵀ).
-    // HINT: If det(V Uᵀ) < 0, flip the sign of V's last column (the smallest singular value) first.
-    return proper(svd.matrixV(), svd.matrixU());
+    // BEGIN EXERCISE 11.2 best_fit_rotation #the-best-fit-rotation
+    // HINT: S = U Σ Vᵀ. The rotation from rest to deformed is R = V Uᵀ (not the slide's U Vᵀ):
+    // HINT: proper_rotation of V and U, which also fixes a reflection.
+    return proper_rotation(svd.matrixV(), svd.matrixU());
     // END EXERCISE
 }
 
@@ -69,13 +69,16 @@ Eigen::Matrix3d polar_rotation(const Eigen::Matrix3d& F)
     if (F.isZero(0.0))
         return Eigen::Matrix3d::Identity();
     const Eigen::JacobiSVD<Eigen::Matrix3d> svd(F, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    return proper(svd.matrixU(), svd.matrixV());
+    // BEGIN EXERCISE 11.3 polar_rotation #edges-centroid-or-polar-decomposition
+    // HINT: F = U Σ Vᵀ = (U Vᵀ)(V Σ Vᵀ): the rotation is U Vᵀ, made proper by proper_rotation.
+    return proper_rotation(svd.matrixU(), svd.matrixV());
+    // END EXERCISE
 }
 
 Matrix12d rotated_stiffness(const Matrix12d& K_e, const Eigen::Matrix3d& R)
 {
     Matrix12d rotated;
-    // BEGIN EXERCISE 11.2 rotated_stiffness #forces-and-warped-stiffness
+    // BEGIN EXERCISE 11.4 rotated_stiffness #forces-and-warped-stiffness
     // HINT: block (a, b) of the result is R K_ab Rᵀ, K_ab the 3×3 block K_e(3a…3a+2, 3b…3b+2).
     for (int a = 0; a < 4; ++a)
         for (int b = 0; b < 4; ++b)
@@ -100,7 +103,7 @@ Vector12d corotated_displacement(const Eigen::Matrix3d& R, const Vector12d& x_e,
 Vector12d corotated_force(const Matrix12d& K_e, const Eigen::Matrix3d& R, const Vector12d& x_e, const Vector12d& X_e)
 {
     Vector12d force;
-    // BEGIN EXERCISE 11.3 corotated_force #forces-and-warped-stiffness
+    // BEGIN EXERCISE 11.5 corotated_force #forces-and-warped-stiffness
     // HINT: d = corotated_displacement(R, x_e, X_e); apply K_e; rotate each 3-block of K_e d back
     // HINT: with R and negate: f_e = −R̂ K_e (R̂ᵀ x_e − X_e).
     const Vector12d local_force = K_e * corotated_displacement(R, x_e, X_e);
@@ -169,7 +172,7 @@ const dynamics::SparseMatrix& CorotationalElasticity::stiffness(const Eigen::Vec
 {
     const std::vector<Eigen::Matrix3d>& R = rotations_at(u);
     assembly::ElementMatrices warped(K_e_.size());
-    // BEGIN EXERCISE 11.4 warped_stiffness #forces-and-warped-stiffness
+    // BEGIN EXERCISE 11.6 warped_stiffness #forces-and-warped-stiffness
     // HINT: one rotated_stiffness per tet, then chapter 06's pattern_.assemble into K_R_csr_ (the
     // HINT: values of the fixed CSR pattern are overwritten; nothing is allocated).
     for (std::size_t t = 0; t < K_e_.size(); ++t)

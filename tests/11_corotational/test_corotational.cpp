@@ -6,10 +6,14 @@
 
 #include "10_linear_dynamics/time_integration.hpp"
 
+#include "06_assembly/assembly.hpp"
+
 #include "common/error.hpp"
 #include "common/mesh.hpp"
 #include "common/random.hpp"
 #include "common/vtk_io.hpp"
+
+#include "../common/test_support.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -63,7 +67,21 @@ double orthogonality_error(const Eigen::Matrix3d& R)
 
 }  // namespace
 
-TEST_CASE("best-fit rotation: R = V U^T recovers known rotations, the slide's U V^T is its inverse", "[ex11.1]")
+TEST_CASE("reflection fix: A B^T, with A's last column negated when det(A B^T) = -1", "[ex11.1]")
+{
+    for (unsigned seed = 1; seed <= 10; ++seed) {
+        const Eigen::Matrix3d A = rotation(0.5 * seed, seed), B = rotation(0.3 * seed, seed + 50);
+        CHECK((proper_rotation(A, B) - A * B.transpose()).norm() <= 1e-14);  // already proper
+        const Eigen::Matrix3d flip = Eigen::Vector3d(1.0, 1.0, -1.0).asDiagonal();
+        const Eigen::Matrix3d reflected = A * flip;  // det(reflected Bᵀ) = −1
+        const Eigen::Matrix3d R = proper_rotation(reflected, B);
+        CAPTURE(seed);
+        CHECK(R.determinant() == Approx(1.0).epsilon(1e-13));
+        CHECK((R - A * B.transpose()).norm() <= 1e-14);  // the last column flipped back, not another
+    }
+}
+
+TEST_CASE("best-fit rotation: R = V U^T recovers known rotations, the slide's U V^T is its inverse", "[ex11.2]")
 {
     for (unsigned seed = 1; seed <= 40; ++seed) {
         const double angle = 0.16 * seed;  // up to 6.4 rad: beyond pi
@@ -84,7 +102,7 @@ TEST_CASE("best-fit rotation: R = V U^T recovers known rotations, the slide's U 
 }
 
 TEST_CASE("best-fit rotation: reflections, flat, collapsed and uniformly scaled tets give proper rotations",
-          "[ex11.1]")
+          "[ex11.2]")
 {
     const tet::TetVertices X = random_tet(7);
     // Inverted: vertex 3 pushed through the opposite face (a reflection of the edges).
@@ -111,7 +129,34 @@ TEST_CASE("best-fit rotation: reflections, flat, collapsed and uniformly scaled 
     CHECK_THROWS_AS(best_fit_rotation(Eigen::Matrix3d::Constant(std::nan(""))), Error);
 }
 
-TEST_CASE("edges, centroid or polar: equal for the tets they were made for, different for skewed ones", "[ch11]")
+TEST_CASE("polar rotation: F = R S with S symmetric positive semi-definite, a proper R for any F", "[ex11.3]")
+{
+    for (unsigned seed = 1; seed <= 20; ++seed) {
+        const Eigen::Matrix3d Q = rotation(0.3 * seed, seed);
+        Eigen::Matrix3d stretch = Eigen::Matrix3d(fem::random_matrix(3, 3, seed + 10));
+        stretch = stretch * stretch.transpose() + 0.1 * Eigen::Matrix3d::Identity();  // SPD
+        const Eigen::Matrix3d R = polar_rotation(Q * stretch);
+        CAPTURE(seed);
+        CHECK((R - Q).norm() <= 1e-12);
+    }
+    // Inverted (det F < 0), flat (rank 2), a line (rank 1), zero: proper rotations, no NaN.
+    Eigen::Matrix3d inverted = rotation(1.0, 3) * Eigen::Vector3d(1.2, 0.9, -0.3).asDiagonal();
+    Eigen::Matrix3d flat = rotation(2.0, 4) * Eigen::Vector3d(1.0, 0.5, 0.0).asDiagonal();
+    Eigen::Matrix3d line = Eigen::Vector3d(1, 2, 3) * Eigen::RowVector3d(0.5, -1, 0.2);
+    for (const Eigen::Matrix3d& F : {inverted, flat, line, Eigen::Matrix3d(Eigen::Matrix3d::Zero())}) {
+        const Eigen::Matrix3d R = polar_rotation(F);
+        CHECK(R.allFinite());
+        CHECK(orthogonality_error(R) <= 1e-12);
+        CHECK(R.determinant() == Approx(1.0).epsilon(1e-12));
+    }
+    // The inverted F: R^T F is symmetric with one negative eigenvalue (the smallest stretch).
+    const Eigen::Matrix3d S = polar_rotation(inverted).transpose() * inverted;
+    CHECK((S - S.transpose()).norm() <= 1e-12);
+    CHECK(S.determinant() < 0.0);
+    CHECK_THROWS_AS(polar_rotation(Eigen::Matrix3d::Constant(INFINITY)), Error);
+}
+
+TEST_CASE("edges, centroid or polar: equal for the tets they were made for, different for skewed ones", "[ex11.3]")
 {
     tet::TetVertices corner;  // edges from vertex 0 orthonormal: PᵀP = I
     corner << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
@@ -145,7 +190,7 @@ TEST_CASE("edges, centroid or polar: equal for the tets they were made for, diff
     CHECK((stretch - stretch.transpose()).norm() <= 1e-12 * stretch.norm());
 }
 
-TEST_CASE("rotated stiffness: every 3x3 block becomes R K_ab R^T", "[ex11.2]")
+TEST_CASE("rotated stiffness: every 3x3 block becomes R K_ab R^T", "[ex11.4]")
 {
     const Matrix12d K_e = elastic::element_stiffness(random_tet(5), elastic::lame_parameters(1e5, 0.3));
     const Eigen::Matrix3d R = rotation(2.0, 9);
@@ -157,7 +202,7 @@ TEST_CASE("rotated stiffness: every 3x3 block becomes R K_ab R^T", "[ex11.2]")
     CHECK((rotated_stiffness(K_e, Eigen::Matrix3d::Identity()) - K_e).norm() == 0.0);
 }
 
-TEST_CASE("corotated force: -R K_e (R^T x - X), zero for rigid motions, the linear force at R = I", "[ex11.3]")
+TEST_CASE("corotated force: -R K_e (R^T x - X), zero for rigid motions, the linear force at R = I", "[ex11.5]")
 {
     const tet::TetVertices X = random_tet(11);
     const Matrix12d K_e = elastic::element_stiffness(X, elastic::lame_parameters(1e5, 0.3));
@@ -181,7 +226,7 @@ TEST_CASE("corotated force: -R K_e (R^T x - X), zero for rigid motions, the line
         CHECK((f.segment<3>(3 * i) - Q * f0.segment<3>(3 * i)).norm() <= 1e-10 * f0.norm());
 }
 
-TEST_CASE("corotational body: no force under rigid motion, rotation covariance of f and K_R", "[ex11.4]")
+TEST_CASE("corotational body: no force under rigid motion, rotation covariance of f and K_R", "[ex11.6]")
 {
     const TetMesh mesh = box_mesh(3, 2, 2, Eigen::Vector3d(0.3, 0.2, 0.2));
     CorotationalElasticity corotational(mesh, rubber);
@@ -222,7 +267,7 @@ TEST_CASE("corotational body: no force under rigid motion, rotation covariance o
     CHECK((K_x - K_x.transpose()).cwiseAbs().maxCoeff() <= 1e-12 * K_x.cwiseAbs().maxCoeff());
 }
 
-TEST_CASE("small deformations: corotational and linear forces differ by O(eps^2)", "[ch11]")
+TEST_CASE("small deformations: corotational and linear forces differ by O(eps^2)", "[ex11.6]")
 {
     const TetMesh mesh = box_mesh(2, 2, 2);
     CorotationalElasticity corotational(mesh, rubber);
@@ -243,7 +288,7 @@ TEST_CASE("small deformations: corotational and linear forces differ by O(eps^2)
 }
 
 TEST_CASE("vertex order: corners permuted or the mesh renumbered change nothing, except the lecture's edge fit",
-          "[ch11]")
+          "[ex11.6]")
 {
     const TetMesh mesh = box_mesh(2, 1, 1);
     const Eigen::VectorXd u = 0.05 * fem::random_vector(3 * mesh.V.rows(), 61);
@@ -291,7 +336,7 @@ TEST_CASE("vertex order: corners permuted or the mesh renumbered change nothing,
 // energy here, backward Euler too, by an amount that shrinks with dt (a discretisation error that
 // a Newton-converged step, chapter 12, removes).
 TEST_CASE("a spinning body: linear elasticity swells, corotational keeps its volume, energy gain shrinks with dt",
-          "[ch11]")
+          "[ex11.6]")
 {
     dynamics::Scene scene;
     scene.mesh = box_mesh(2, 2, 2, Eigen::Vector3d(0.1, 0.1, 0.1));
@@ -340,6 +385,88 @@ TEST_CASE("a spinning body: linear elasticity swells, corotational keeps its vol
     CHECK(backward_fine.energy_gain < backward.energy_gain / 2.0);
 }
 
+TEST_CASE("finite differences: the polar fit's force is -dU/du, the edge fit's is not; K_R misses the dR term",
+          "[ex11.6]")
+{
+    const TetMesh mesh = box_mesh(2, 1, 1, Eigen::Vector3d(0.2, 0.1, 0.1));
+    const Eigen::VectorXd direction = fem::random_vector(3 * mesh.V.rows(), 91);
+    // A bent and turned state: a rotation by 0.8 rad plus a 3 % random strain.
+    const Eigen::VectorXd turned = displacement(rigidly_moved(mesh.V, rotation(0.8, 93), Eigen::Vector3d::Zero()), mesh.V);
+    const Eigen::VectorXd u = turned + 0.003 * fem::random_vector(turned.size(), 92);
+    for (const RotationFit fit : {RotationFit::polar, RotationFit::edges}) {
+        CorotationalElasticity model(mesh, rubber, fit);
+        Eigen::VectorXd f;
+        model.evaluate(u, f);
+        const Eigen::VectorXd slope = Eigen::VectorXd::Constant(1, -f.dot(direction));  // dU/dh = −f·d
+        const std::vector<double> errors = test::central_difference_errors(
+            [&](double h) {
+                Eigen::VectorXd g;
+                return Eigen::VectorXd::Constant(1, model.evaluate(u + h * direction, g));
+            },
+            slope, 0.1);
+        const double best = *std::min_element(errors.begin(), errors.end());
+        CAPTURE(int(fit), errors[0], errors[1], errors[2], best);
+        if (fit == RotationFit::polar) {
+            CHECK(best <= 1e-6);
+            CHECK(errors[1] < errors[0]);
+        } else {
+            CHECK(best > 1e-4);  // the edge fit leaves a rotation in R^T F: its force is no gradient
+        }
+    }
+    // The warped stiffness against the derivative of the force: exact at rest and for a rigid
+    // rotation, off by a gap that grows in proportion to the strain otherwise.
+    CorotationalElasticity model(mesh, rubber);
+    const auto tangent_gap = [&](const Eigen::VectorXd& state) {
+        const Eigen::VectorXd K_d = model.stiffness(state) * direction;
+        const std::vector<double> errors = test::central_difference_errors(
+            [&](double h) {
+                Eigen::VectorXd g;
+                model.evaluate(state + h * direction, g);
+                return Eigen::VectorXd(-g);
+            },
+            K_d, 0.1);
+        return *std::min_element(errors.begin(), errors.end());
+    };
+    const Eigen::VectorXd strain = 0.01 * fem::random_vector(turned.size(), 94);
+    const double at_rest = tangent_gap(Eigen::VectorXd::Zero(turned.size())), rigid = tangent_gap(turned);
+    const double strained = tangent_gap(turned + strain), twice = tangent_gap(turned + 2.0 * strain);
+    CAPTURE(at_rest, rigid, strained, twice);
+    CHECK(at_rest <= 1e-7);
+    CHECK(rigid <= 1e-7);
+    CHECK(strained > 1e-4);
+    CHECK(twice / strained == Approx(2.0).margin(0.3));
+}
+
+// The midpoint rule conserves a linear body's energy; with the warped stiffness, which is smaller
+// than the true tangent of a stretched body (above), its stiff modes grow by about 1 + 2|δ| a step
+// (δ the relative gap), and the run diverges. θ a little above ½ damps them.
+TEST_CASE("the midpoint rule with the warped stiffness diverges on a large swing; theta = 0.55 stays bounded",
+          "[ex11.6]")
+{
+    dynamics::Scene scene;
+    scene.mesh = beam_mesh(0.2, 0.02, 0.02, 20);  // 480 tets: stiff modes far above 1/dt
+    scene.material = {2e5, 0.45, 1100.0};
+    scene.pinned = assembly::vertices_on_plane(scene.mesh, 0, 0.0);
+    scene.time_step = 1.0 / 60.0;
+    const auto run = [&](double theta, double& gain) {
+        dynamics::Body body(scene, std::make_unique<CorotationalElasticity>(scene.mesh, scene.material));
+        dynamics::ThetaMethod stepper(theta);
+        dynamics::Simulation simulation(body, stepper, dynamics::initial_state(body), scene.time_step);
+        double h0 = 0.0, scale = 0.0;
+        simulation.run(90, [&](const dynamics::State& state, const dynamics::StepRecord& record) {
+            if (state.step == 0)
+                h0 = record.energies.total();
+            scale = std::max(scale, record.energies.magnitude());
+            gain = std::max(gain, (record.energies.total() - h0) / scale);
+        });
+    };
+    double gain = 0.0;
+    CHECK_THROWS_WITH(run(0.5, gain), Contains("diverged"));
+    double damped_gain = 0.0;
+    CHECK_NOTHROW(run(0.55, damped_gain));
+    CHECK(damped_gain < 0.1);
+}
+
 TEST_CASE("bad input: a zero-volume rest tet is named", "[ch11]")
 {
     TetMesh mesh = box_mesh(1, 1, 1);
@@ -350,7 +477,7 @@ TEST_CASE("bad input: a zero-volume rest tet is named", "[ch11]")
     CHECK_THROWS_WITH(good.evaluate(Eigen::VectorXd::Zero(5), f), Contains("3n"));
 }
 
-TEST_CASE("frozen-factor PCG: exact at rest, more iterations as the body turns, the same answer", "[ch11]")
+TEST_CASE("frozen-factor PCG: exact at rest, more iterations as the body turns, the same answer", "[ex11.7]")
 {
     const TetMesh mesh = box_mesh(3, 2, 2, Eigen::Vector3d(0.3, 0.2, 0.2));
     CorotationalElasticity model(mesh, rubber);

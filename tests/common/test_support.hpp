@@ -10,9 +10,11 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace fem::test {
 
@@ -23,6 +25,19 @@ inline std::filesystem::path fresh_output_dir(const std::string& name)
     std::filesystem::remove_all(dir);
     fem::ensure_directory(dir);
     return dir;
+}
+
+/// The finite-difference sweep (HOBAK's habit): the relative errors ‖(g(h) − g(−h))/(2h) − exact‖ /
+/// ‖exact‖ of central differences of g (any vector-valued function of a step h along one direction)
+/// for h = scale·10⁻³, scale·10⁻⁴, …, scale·10⁻⁸. A correct derivative has a best error far below
+/// 1e-6 and errors that first fall with h (as h², until round-off takes over); a wrong one stalls.
+inline std::vector<double> central_difference_errors(const std::function<Eigen::VectorXd(double)>& g,
+                                                     const Eigen::VectorXd& exact, double scale = 1.0)
+{
+    std::vector<double> errors;
+    for (double h = 1e-3 * scale; h > 0.5e-8 * scale; h /= 10.0)
+        errors.push_back(((g(h) - g(-h)) / (2.0 * h) - exact).norm() / exact.norm());
+    return errors;
 }
 
 /// The entries of a matrix or vector, dense or sparse, as compared by EntriesNear. Catch2 prints

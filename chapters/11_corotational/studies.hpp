@@ -1,0 +1,55 @@
+#pragma once
+// The studies of ch11_corotational, one file each (study_*.cpp), called in order by main.cpp.
+// Not part of the chapter's library: only the executable uses them.
+
+#include "11_corotational/corotational.hpp"
+
+#include "10_linear_dynamics/body.hpp"
+#include "10_linear_dynamics/time_integration.hpp"
+
+#include "common/cli.hpp"
+#include "common/vtk_io.hpp"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace fem::corot::study {
+
+/// The executable's options (main.cpp validates them before any study runs).
+struct Settings {
+    dynamics::Material soft{2e5, 0.45, 1100.0};   ///< the swinging beam: soft enough to droop ~60°
+    dynamics::Material sofa{2e6, 0.45, 1100.0};   ///< SOFA's validation cantilever (the cost goal)
+    double duration = 1.5;                        ///< length of the swing [s]
+    int swing_cells = 20;                         ///< cells along the swinging beam
+    std::vector<int> cost_cells{20, 40, 60, 100}; ///< cells along the beams of the cost study
+    double seconds = 0.2;                         ///< measuring time per timed kernel [s]
+};
+
+/// The beam 0.2 × 0.02 × 0.02 m along x with `cells_along` cubes along it, clamped at x = 0, under
+/// gravity −z, undamped, Δt = 1/60 s: chapter 10's cantilever, here released from the horizontal.
+dynamics::Scene beam_scene(const dynamics::Material& material, int cells_along, double duration);
+
+/// The tip: the vertex at the free end's top corner (x = L, y = W, z = H).
+int beam_tip(const TetMesh& mesh);
+
+/// The force model called "linear" or "corotational" (polar fit) for a scene.
+std::unique_ptr<dynamics::ForceModel> force_model(const std::string& name, const dynamics::Scene& scene);
+
+/// The solvers of a changing step matrix compared side by side, by name: "refactor" (chapter 08's
+/// Cholesky, its symbolic analysis reused), "pcg-ic0-warm", "pcg-ic0-cold" (from zero every step)
+/// and "frozen-factor-pcg"; all converge to the relative residual `tolerance`.
+dynamics::ImplicitOptions solver_option(const std::string& name, double tolerance);
+
+/// The solver option names, in the order of the tables.
+const std::vector<std::string>& solver_option_names();
+
+/// One frame of a body for the .pvd: rest positions, displacement and velocity (point fields) and
+/// the von Mises stress (cell field, from the force model).
+io::MeshData frame(const dynamics::Body& body, const dynamics::State& state);
+
+void rotation_study(const RunContext& run, const Settings& settings);
+void swing_study(const RunContext& run, const Settings& settings);
+void cost_study(const RunContext& run, const Settings& settings);
+
+}  // namespace fem::corot::study

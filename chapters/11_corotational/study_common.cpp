@@ -1,0 +1,77 @@
+// What the studies of ch11_corotational share: the beam scene, its tip, the force models, the
+// solver options of a changing step matrix, and a body's frame.
+#include "11_corotational/frozen_preconditioner.hpp"
+#include "11_corotational/studies.hpp"
+
+#include "06_assembly/assembly.hpp"
+
+#include "common/error.hpp"
+
+namespace fem::corot::study {
+
+dynamics::Scene beam_scene(const dynamics::Material& material, int cells_along, double duration)
+{
+    dynamics::Scene scene;
+    scene.mesh = beam_mesh(0.2, 0.02, 0.02, cells_along);
+    scene.material = material;
+    scene.pinned = assembly::vertices_on_plane(scene.mesh, 0, 0.0);
+    scene.gravity = Eigen::Vector3d(0.0, 0.0, -9.81);
+    scene.time_step = 1.0 / 60.0;
+    scene.duration = duration;
+    return scene;
+}
+
+int beam_tip(const TetMesh& mesh)
+{
+    Eigen::Index tip = 0;
+    mesh.V.rowwise().sum().maxCoeff(&tip);
+    return static_cast<int>(tip);
+}
+
+std::unique_ptr<dynamics::ForceModel> force_model(const std::string& name, const dynamics::Scene& scene)
+{
+    if (name == "linear")
+        return std::make_unique<dynamics::LinearElasticity>(scene.mesh, scene.material);
+    if (name == "corotational")
+        return std::make_unique<CorotationalElasticity>(scene.mesh, scene.material);
+    throw Error(str("unknown force model '", name, "' (linear, corotational)"));
+}
+
+const std::vector<std::string>& solver_option_names()
+{
+    static const std::vector<std::string> names{"refactor", "pcg-ic0-warm", "pcg-ic0-cold", "frozen-factor-pcg"};
+    return names;
+}
+
+dynamics::ImplicitOptions solver_option(const std::string& name, double tolerance)
+{
+    dynamics::ImplicitOptions options;
+    options.solver_options.relative_tolerance = tolerance;
+    if (name == "refactor") {
+        options.solver = "ours-cholesky";
+    } else if (name == "pcg-ic0-warm") {
+        options.solver = "ours-pcg-ic0";
+    } else if (name == "pcg-ic0-cold") {
+        options.solver = "ours-pcg-ic0";
+        options.warm_start = false;
+    } else if (name == "frozen-factor-pcg") {
+        options.make_solver = [tolerance] {
+            cg::SolverOptions pcg;
+            pcg.relative_tolerance = tolerance;
+            return std::make_unique<FrozenFactorPcg>(pcg, 30);
+        };
+    } else {
+        throw Error(str("unknown solver option '", name, "' (refactor, pcg-ic0-warm, pcg-ic0-cold, frozen-factor-pcg)"));
+    }
+    return options;
+}
+
+io::MeshData frame(const dynamics::Body& body, const dynamics::State& state)
+{
+    io::MeshData data = io::displaced_mesh(body.mesh().V, body.mesh().T, io::vertex_rows(state.u));
+    data.point_data.push_back({"velocity", io::vertex_rows(state.v)});
+    data.cell_data.push_back({"von Mises stress", body.model().von_mises_stress(state.u)});
+    return data;
+}
+
+}  // namespace fem::corot::study
