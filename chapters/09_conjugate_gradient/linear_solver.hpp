@@ -103,6 +103,7 @@ protected:
 private:
     std::string name_;
     Eigen::SparseMatrix<double> A_;  // for the residual check and the pattern comparison
+    std::vector<Eigen::Index> mirror_;  // per entry of A_, where its transpose entry is (or −1)
     SolveStats stats_;
 };
 

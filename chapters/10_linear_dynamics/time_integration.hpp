@@ -107,8 +107,9 @@ struct ImplicitOptions {
     cg::SolverOptions solver_options;   ///< tolerance and cap of an iterative solver
     bool refactor_every_step = false;   ///< prepare A every step even when it is constant (to
                                         ///< measure what factoring once saves)
-    bool warm_start = true;             ///< an iterative solver starts from its previous answer;
-                                        ///< false: from the form's own guess (Δv = 0, or v)
+    bool warm_start = true;             ///< an iterative solver starts from its last answer (the
+                                        ///< last Δv, or v⁺ = v in the lecture's form); false: from
+                                        ///< zero (which in the Δv form is v⁺ = v as well)
     PinnedRoute pinned = PinnedRoute::eliminate;
     StepForm form = StepForm::velocity_change;
     /// When set, the solver is made by this instead of cg::make_solver(solver, solver_options): the

@@ -65,6 +65,17 @@ Eigen::Matrix3d best_fit_rotation(const Eigen::Matrix3d& S);
 /// both for skewed tets. docs/11_corotational.md#edges-centroid-or-polar-decomposition
 Eigen::Matrix3d polar_rotation(const Eigen::Matrix3d& F);
 
+/// The same rotation as polar_rotation, by Higham's scaled Newton iteration on the polar factor:
+/// X₀ = F, X_{k+1} = ½(ζ_k X_k + ζ_k⁻¹ X_k⁻ᵀ), ζ_k = |det X_k|^(−1/3) while X_k is far from
+/// orthogonal, 1 after; X⁻ᵀ from cross products of X's columns. Each step maps every singular
+/// value σ to ½(σ + 1/σ) and leaves the singular vectors alone, so it converges quadratically from
+/// any rotation, in about four steps for an element's F (σ near 1). Stops when a step changes X by
+/// less than 1e-9 (the next error is below round-off) and takes one more. Falls back to the SVD
+/// (polar_rotation) when det F ≤ 1e-6 ‖F‖³ — inverted or nearly flat, where the iteration would
+/// reach a reflection or crawl — or after 40 steps. N. J. Higham, Functions of Matrices, §8.9.
+/// docs/11_corotational.md#a-faster-polar-decomposition
+Eigen::Matrix3d polar_rotation_newton(const Eigen::Matrix3d& F);
+
 /// R̂ K_e R̂ᵀ with R̂ = diag(R, R, R, R): every 3×3 block (a, b) becomes R K_ab Rᵀ (12×12).
 /// docs/11_corotational.md#forces-and-warped-stiffness
 Matrix12d rotated_stiffness(const Matrix12d& K_e, const Eigen::Matrix3d& R);
@@ -88,6 +99,12 @@ enum class RotationFit {
     edges,     ///< best_fit_rotation of edge_covariance (the lecture's; depends on the corner order)
 };
 
+/// How the polar rotation of an element is computed (both give the same R to round-off).
+enum class PolarAlgorithm {
+    newton,  ///< polar_rotation_newton (the default: several times faster, SVD for hard cases)
+    svd,     ///< polar_rotation, Eigen's JacobiSVD (the reference)
+};
+
 /// Corotational linear elasticity as a chapter 10 force model: per step, one rotation per tet,
 /// the corotated forces and energy, and the warped stiffness K_R scattered into chapter 06's fixed
 /// CSR pattern (route c: no new pattern, no triplets). K changes with u: chapter 10's implicit step
@@ -97,7 +114,7 @@ public:
     /// K_e of every tet at rest (chapter 06's element_stiffnesses) and the assembly pattern.
     /// fem::Error for bad indices, a zero-volume rest tet (naming it) or a bad material.
     CorotationalElasticity(const TetMesh& mesh, const dynamics::Material& material,
-                           RotationFit fit = RotationFit::polar);
+                           RotationFit fit = RotationFit::polar, PolarAlgorithm algorithm = PolarAlgorithm::newton);
 
     std::string name() const override { return "corotational"; }
     /// Rotations at u, then U = Σ U_e and f = Σ E_eᵀ f_e. fem::Error if u has not 3n entries.
@@ -111,6 +128,11 @@ public:
     /// The rotation of every tet at u (#T), by the chosen fit.
     std::vector<Eigen::Matrix3d> rotations(const Eigen::VectorXd& u) const;
 
+    /// One rotation per vertex (#V), at the u of the last evaluate() or stiffness() call (identity
+    /// before any): the polar rotation of Σ_t vol_t R_t over the tets around the vertex — the frame
+    /// the vertex turned with. fem::Error before the model was evaluated.
+    std::vector<Eigen::Matrix3d> vertex_rotations() const;
+
 private:
     /// rotations(u), kept for the last u: a step asks for the forces and then K_R at the same u,
     /// and the SVDs are the expensive part of both.
@@ -119,12 +141,20 @@ private:
     TetMesh mesh_;
     elastic::Lame lame_;
     RotationFit fit_;
+    PolarAlgorithm algorithm_;
     assembly::ElementMatrices K_e_;
     assembly::AssemblyPattern pattern_;
     assembly::CsrMatrix K_R_csr_;
     dynamics::SparseMatrix K_R_;
+    Eigen::VectorXd volumes_;                     // rest volume of every tet
     Eigen::VectorXd rotated_at_;                  // the u of rotations_
     std::vector<Eigen::Matrix3d> rotations_;
 };
+
+/// The rotations of the free vertices of `dofs` (vertex_rotations of those whose three dofs are
+/// free, in the order of dofs.indices()): the block rotations of the body's reduced step matrix,
+/// for a FrozenFactorPcg that turns with the body. fem::Error if a vertex is only partly pinned or
+/// the sizes do not match. docs/11_corotational.md#solving-a-changing-matrix
+std::vector<Eigen::Matrix3d> free_vertex_rotations(const CorotationalElasticity& model, const dynamics::FreeDofs& dofs);
 
 }  // namespace fem::corot

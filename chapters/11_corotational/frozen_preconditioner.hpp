@@ -14,33 +14,51 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
+#include <functional>
 #include <memory>
+#include <vector>
 
 namespace fem::corot {
+
+/// The rotations of the unknowns' 3-blocks: entry i rotates unknowns 3i, 3i+1, 3i+2 (for a body's
+/// reduced step matrix, the free vertices in order). Asked for at every prepare().
+using BlockRotations = std::function<std::vector<Eigen::Matrix3d>()>;
 
 /// PCG preconditioned by a frozen sparse Cholesky factor (chapter 09's "default" solver), behind
 /// chapter 09's solver interface so that chapter 10's ThetaMethod can use it
 /// (ImplicitOptions::make_solver). docs/11_corotational.md#solving-a-changing-matrix
+///
+/// With block rotations, the frozen factor turns with the body: if A₀ was factored when the blocks
+/// had rotations R₀ᵢ and they have Rᵢ now, the preconditioner is Q A₀⁻¹ Qᵀ with the block-diagonal
+/// Q = diag(Rᵢ R₀ᵢᵀ). For a body that only rotated, A = Q A₀ Qᵀ exactly (a lumped mass is the same
+/// in every frame): the preconditioner stays exact however far the body turns, and only the
+/// element-to-element variation of the rotations costs iterations.
 class FrozenFactorPcg final : public cg::LinearSolver {
 public:
     /// options: CG's relative tolerance and cap; refresh_iterations: refactor the preconditioner
-    /// when a solve needed more iterations than this (0: never). fem::Error for a tolerance outside
-    /// (0, 1) or negative counts.
-    explicit FrozenFactorPcg(const cg::SolverOptions& options = {}, int refresh_iterations = 0);
+    /// when a solve needed more iterations than this (0: never); rotations: the blocks' rotations
+    /// (empty: a plain frozen factor). fem::Error for a tolerance outside (0, 1) or negative counts.
+    explicit FrozenFactorPcg(const cg::SolverOptions& options = {}, int refresh_iterations = 0,
+                             BlockRotations rotations = {});
 
     bool is_direct() const override { return false; }
     /// How many times the preconditioner was factored (1 after the first prepare()).
     int factorizations() const { return factorizations_; }
 
 protected:
+    /// Keeps A, asks for the rotations, and factors A when it must (first call, a new pattern, or a
+    /// refresh after too many iterations). fem::Error if the rotations do not match A's size.
     void do_prepare(const Eigen::SparseMatrix<double>& A, bool same_pattern) override;
     int do_solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) override;
 
 private:
     cg::SolverOptions options_;
     int refresh_iterations_;
+    BlockRotations rotations_;
     std::unique_ptr<cg::LinearSolver> factor_;
-    Eigen::SparseMatrix<double> A_;
+    const Eigen::SparseMatrix<double>* A_ = nullptr;  // the base class's copy, alive until the next prepare
+    std::vector<Eigen::Matrix3d> frozen_rotations_;   // R₀ᵢ, when the factor was made
+    std::vector<Eigen::Matrix3d> turn_;               // Qᵢ = Rᵢ R₀ᵢᵀ
     bool refresh_ = true;
     int factorizations_ = 0;
 };

@@ -37,9 +37,13 @@ int beam_tip(const TetMesh& mesh);
 std::unique_ptr<dynamics::ForceModel> force_model(const std::string& name, const dynamics::Scene& scene);
 
 /// The solvers of a changing step matrix compared side by side, by name: "refactor" (chapter 08's
-/// Cholesky, its symbolic analysis reused), "pcg-ic0-warm", "pcg-ic0-cold" (from zero every step)
-/// and "frozen-factor-pcg"; all converge to the relative residual `tolerance`.
-dynamics::ImplicitOptions solver_option(const std::string& name, double tolerance);
+/// Cholesky, its symbolic analysis reused); PCG with IC(0) on the lecture's v⁺ form from zero
+/// ("pcg-ic0 v+ from zero") and from the last velocity ("pcg-ic0 v+ from v"), and on the Δv form
+/// from the last Δv ("pcg-ic0 dv from last dv"); "frozen-factor-pcg", and the same turned with the
+/// body's free vertices ("rotated-frozen-factor-pcg", which needs a corotational body; body must
+/// outlive the integrator). All converge to the relative residual `tolerance` (relative to the
+/// right-hand side of their form).
+dynamics::ImplicitOptions solver_option(const std::string& name, double tolerance, dynamics::Body& body);
 
 /// The solver option names, in the order of the tables.
 const std::vector<std::string>& solver_option_names();

@@ -39,29 +39,43 @@ std::unique_ptr<dynamics::ForceModel> force_model(const std::string& name, const
 
 const std::vector<std::string>& solver_option_names()
 {
-    static const std::vector<std::string> names{"refactor", "pcg-ic0-warm", "pcg-ic0-cold", "frozen-factor-pcg"};
+    static const std::vector<std::string> names{"refactor", "pcg-ic0 v+ from zero", "pcg-ic0 v+ from v",
+                                                "pcg-ic0 dv from last dv", "frozen-factor-pcg",
+                                                "rotated-frozen-factor-pcg"};
     return names;
 }
 
-dynamics::ImplicitOptions solver_option(const std::string& name, double tolerance)
+dynamics::ImplicitOptions solver_option(const std::string& name, double tolerance, dynamics::Body& body)
 {
     dynamics::ImplicitOptions options;
     options.solver_options.relative_tolerance = tolerance;
+    options.solver = "ours-pcg-ic0";
     if (name == "refactor") {
         options.solver = "ours-cholesky";
-    } else if (name == "pcg-ic0-warm") {
-        options.solver = "ours-pcg-ic0";
-    } else if (name == "pcg-ic0-cold") {
-        options.solver = "ours-pcg-ic0";
+    } else if (name == "pcg-ic0 v+ from zero") {
+        options.form = dynamics::StepForm::velocity;
         options.warm_start = false;
+    } else if (name == "pcg-ic0 v+ from v") {
+        options.form = dynamics::StepForm::velocity;
+    } else if (name == "pcg-ic0 dv from last dv") {
+        // the default form, warm
     } else if (name == "frozen-factor-pcg") {
         options.make_solver = [tolerance] {
             cg::SolverOptions pcg;
             pcg.relative_tolerance = tolerance;
             return std::make_unique<FrozenFactorPcg>(pcg, 30);
         };
+    } else if (name == "rotated-frozen-factor-pcg") {
+        auto* model = dynamic_cast<CorotationalElasticity*>(&body.model());
+        if (model == nullptr)
+            throw Error("rotated-frozen-factor-pcg: the body's force model is not corotational");
+        options.make_solver = [tolerance, model, &dofs = body.dofs()] {
+            cg::SolverOptions pcg;
+            pcg.relative_tolerance = tolerance;
+            return std::make_unique<FrozenFactorPcg>(pcg, 30, [model, &dofs] { return free_vertex_rotations(*model, dofs); });
+        };
     } else {
-        throw Error(str("unknown solver option '", name, "' (refactor, pcg-ic0-warm, pcg-ic0-cold, frozen-factor-pcg)"));
+        throw Error(str("unknown solver option '", name, "'"));
     }
     return options;
 }

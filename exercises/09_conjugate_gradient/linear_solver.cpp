@@ -30,7 +30,8 @@ namespace {
 
 using SparseMatrix = Eigen::SparseMatrix<double>;
 
-void check_matrix(const SparseMatrix& A)
+/// fem::Error unless A is square, not empty and finite; returns max |A_ij|.
+double check_square_and_finite(const SparseMatrix& A)
 {
     if (A.rows() == 0 || A.rows() != A.cols())
         throw Error(str("LinearSolver::prepare: the matrix is ", A.rows(), "×", A.cols(),
@@ -43,14 +44,47 @@ void check_matrix(const SparseMatrix& A)
                                 " is not finite"));
             largest = std::max(largest, std::abs(it.value()));
         }
-    const SparseMatrix difference = SparseMatrix(A.transpose()) - A;
-    for (Eigen::Index j = 0; j < difference.outerSize(); ++j)
-        for (SparseMatrix::InnerIterator it(difference, j); it; ++it)
-            if (std::abs(it.value()) > symmetry_tolerance * largest)
-                throw Error(str("LinearSolver::prepare: A is not symmetric: A(", it.col(), ", ", it.row(), ") − A(",
-                                it.row(), ", ", it.col(), ") = ", -it.value(), " (allowed: ", symmetry_tolerance,
+    return largest;
+}
+
+/// For every stored entry k = (i, j) of a compressed A, the position of its mirror (j, i) in the
+/// value array, or −1 when the pattern has no (j, i). Built once per pattern: a matrix that
+/// changes every step (chapters 11–12) is then checked for symmetry in one pass, without forming
+/// Aᵀ − A.
+std::vector<Eigen::Index> mirror_entries(const SparseMatrix& A)
+{
+    std::vector<Eigen::Index> mirror(static_cast<std::size_t>(A.nonZeros()), -1);
+    const auto* outer = A.outerIndexPtr();
+    const auto* inner = A.innerIndexPtr();
+    for (Eigen::Index j = 0; j < A.outerSize(); ++j)
+        for (auto k = outer[j]; k < outer[j + 1]; ++k) {
+            const auto i = inner[k];
+            const auto* first = inner + outer[i];
+            const auto* last = inner + outer[i + 1];
+            const auto* found = std::lower_bound(first, last, static_cast<int>(j));
+            if (found != last && *found == j)
+                mirror[static_cast<std::size_t>(k)] = found - inner;
+        }
+    return mirror;
+}
+
+/// fem::Error unless max |A_ij − A_ji| ≤ symmetry_tolerance · largest (an entry without a mirror
+/// counts against zero).
+void check_symmetric(const SparseMatrix& A, const std::vector<Eigen::Index>& mirror, double largest)
+{
+    const auto* outer = A.outerIndexPtr();
+    const auto* inner = A.innerIndexPtr();
+    const double* value = A.valuePtr();
+    for (Eigen::Index j = 0; j < A.outerSize(); ++j)
+        for (auto k = outer[j]; k < outer[j + 1]; ++k) {
+            const Eigen::Index m = mirror[static_cast<std::size_t>(k)];
+            const double difference = m >= 0 ? value[m] - value[k] : -value[k];
+            if (std::abs(difference) > symmetry_tolerance * largest)
+                throw Error(str("LinearSolver::prepare: A is not symmetric: A(", j, ", ", inner[k], ") − A(",
+                                inner[k], ", ", j, ") = ", difference, " (allowed: ", symmetry_tolerance,
                                 " × max |A_ij| = ", symmetry_tolerance * largest,
                                 "); the solvers of this interface need a symmetric positive definite A"));
+        }
 }
 
 bool same_pattern(const SparseMatrix& a, const SparseMatrix& b)
@@ -206,7 +240,7 @@ const std::vector<std::string>& all_names()
 
 void LinearSolver::prepare(const Eigen::SparseMatrix<double>& A)
 {
-    check_matrix(A);
+    const double largest = check_square_and_finite(A);
     const bool same = A_.rows() > 0 && same_pattern(A, A_);
     // The solver keeps its own copy: Eigen's iterative solvers hold a reference to their matrix,
     // and the residual check needs it too. After a failed prepare the solver is unprepared.
@@ -215,9 +249,13 @@ void LinearSolver::prepare(const Eigen::SparseMatrix<double>& A)
     stats_ = SolveStats{};
     Timer timer;
     try {
+        if (!same)
+            mirror_ = mirror_entries(A_);
+        check_symmetric(A_, mirror_, largest);
         do_prepare(A_, same);
     } catch (...) {
         A_ = Eigen::SparseMatrix<double>();
+        mirror_.clear();
         throw;
     }
     stats_.prepare_seconds = timer.seconds();

@@ -5,9 +5,11 @@
 #include "common/error.hpp"
 #include "common/vtk_io.hpp"
 
+#include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <Eigen/SVD>
 
+#include <algorithm>
 #include <cmath>
 
 namespace fem::corot {
@@ -72,6 +74,37 @@ Eigen::Matrix3d polar_rotation(const Eigen::Matrix3d& F)
     throw fem::NotImplemented("11.3", "polar_rotation", "docs/11_corotational.md#edges-centroid-or-polar-decomposition");
 }
 
+Eigen::Matrix3d polar_rotation_newton(const Eigen::Matrix3d& F)
+{
+    if (!F.allFinite())
+        throw Error("polar rotation: F has a non-finite entry");
+    const double size = F.norm();
+    if (!(F.determinant() > 1e-6 * size * size * size))
+        return polar_rotation(F);  // inverted, flat or zero: the SVD and its reflection fix
+    Eigen::Matrix3d X = F, inverse_transpose;
+    bool scaled = true;
+    for (int step = 0; step < 40; ++step) {
+        inverse_transpose.col(0) = X.col(1).cross(X.col(2));
+        inverse_transpose.col(1) = X.col(2).cross(X.col(0));
+        inverse_transpose.col(2) = X.col(0).cross(X.col(1));
+        const double det = X.col(0).dot(inverse_transpose.col(0));
+        inverse_transpose /= det;
+        const double zeta = scaled ? std::cbrt(1.0 / std::abs(det)) : 1.0;
+        const Eigen::Matrix3d next = 0.5 * (zeta * X + inverse_transpose / zeta);
+        const double change = (next - X).norm();
+        X = next;
+        if (change < 1e-2)
+            scaled = false;  // near orthogonal: plain Newton converges quadratically
+        if (change < 1e-9) {
+            inverse_transpose.col(0) = X.col(1).cross(X.col(2));
+            inverse_transpose.col(1) = X.col(2).cross(X.col(0));
+            inverse_transpose.col(2) = X.col(0).cross(X.col(1));
+            return 0.5 * (X + inverse_transpose / X.col(0).dot(inverse_transpose.col(0)));
+        }
+    }
+    return polar_rotation(F);
+}
+
 Matrix12d rotated_stiffness(const Matrix12d& K_e, const Eigen::Matrix3d& R)
 {
     Matrix12d rotated;
@@ -106,10 +139,14 @@ Vector12d corotated_force(const Matrix12d& K_e, const Eigen::Matrix3d& R, const 
 
 // --- CorotationalElasticity ------------------------------------------------------------------------
 
-CorotationalElasticity::CorotationalElasticity(const TetMesh& mesh, const dynamics::Material& material, RotationFit fit)
+CorotationalElasticity::CorotationalElasticity(const TetMesh& mesh, const dynamics::Material& material, RotationFit fit,
+                                               PolarAlgorithm algorithm)
     : mesh_(mesh), lame_(elastic::lame_parameters(material.youngs_modulus, material.poisson_ratio)), fit_(fit),
-      K_e_(assembly::element_stiffnesses(mesh, lame_)), pattern_(mesh), K_R_csr_(pattern_.zero_matrix())
+      algorithm_(algorithm), K_e_(assembly::element_stiffnesses(mesh, lame_)), pattern_(mesh),
+      K_R_csr_(pattern_.zero_matrix()), volumes_(mesh.T.rows())
 {
+    for (Eigen::Index t = 0; t < mesh.T.rows(); ++t)
+        volumes_[t] = std::abs(tet_signed_volume6(mesh, static_cast<int>(t))) / 6.0;
 }
 
 std::vector<Eigen::Matrix3d> CorotationalElasticity::rotations(const Eigen::VectorXd& u) const
@@ -123,12 +160,29 @@ std::vector<Eigen::Matrix3d> CorotationalElasticity::rotations(const Eigen::Vect
         const tet::TetVertices now = tet::tet_vertices(mesh_, x, static_cast<int>(t));
         Eigen::Matrix3d& R_t = R[static_cast<std::size_t>(t)];
         switch (fit_) {
-        case RotationFit::polar: R_t = polar_rotation(tet::deformation_gradient(rest, now)); break;
+        case RotationFit::polar: {
+            const Eigen::Matrix3d F = tet::deformation_gradient(rest, now);
+            R_t = algorithm_ == PolarAlgorithm::newton ? polar_rotation_newton(F) : polar_rotation(F);
+            break;
+        }
         case RotationFit::centroid: R_t = best_fit_rotation(centroid_covariance(rest, now)); break;
         case RotationFit::edges: R_t = best_fit_rotation(edge_covariance(rest, now)); break;
         }
     }
     return R;
+}
+
+std::vector<Eigen::Matrix3d> CorotationalElasticity::vertex_rotations() const
+{
+    if (rotations_.empty())
+        throw Error("vertex_rotations: the model has not been evaluated yet (call evaluate or stiffness first)");
+    std::vector<Eigen::Matrix3d> sums(static_cast<std::size_t>(mesh_.V.rows()), Eigen::Matrix3d::Zero());
+    for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t)
+        for (int i = 0; i < 4; ++i)
+            sums[static_cast<std::size_t>(mesh_.T(t, i))] += volumes_[t] * rotations_[static_cast<std::size_t>(t)];
+    for (Eigen::Matrix3d& sum : sums)
+        sum = sum.isZero(0.0) ? Eigen::Matrix3d::Identity() : polar_rotation_newton(sum);
+    return sums;
 }
 
 const std::vector<Eigen::Matrix3d>& CorotationalElasticity::rotations_at(const Eigen::VectorXd& u)
@@ -162,10 +216,12 @@ double CorotationalElasticity::evaluate(const Eigen::VectorXd& u, Eigen::VectorX
 const dynamics::SparseMatrix& CorotationalElasticity::stiffness(const Eigen::VectorXd& u)
 {
     const std::vector<Eigen::Matrix3d>& R = rotations_at(u);
-    assembly::ElementMatrices warped(K_e_.size());
+    double* values = K_R_csr_.valuePtr();
+    std::fill(values, values + K_R_csr_.nonZeros(), 0.0);
     // EXERCISE 11.6 (warped_stiffness): see docs/11_corotational.md#forces-and-warped-stiffness
-    // HINT: one rotated_stiffness per tet, then chapter 06's pattern_.assemble into K_R_csr_ (the
-    // HINT: values of the fixed CSR pattern are overwritten; nothing is allocated).
+    // HINT: per tet t, W = rotated_stiffness(K_e_[t], R[t]); add each 3×3 block (i, j) of W into the
+    // HINT: fixed CSR pattern (chapter 06's route c): row c of the block starts at
+    // HINT: values + pattern_.block_offset(t, i, j) + c · pattern_.row_length(mesh_.T(t, i)).
     throw fem::NotImplemented("11.6", "warped_stiffness", "docs/11_corotational.md#forces-and-warped-stiffness");
     K_R_ = assembly::csc_of_symmetric(K_R_csr_);
     return K_R_;
@@ -184,6 +240,23 @@ Eigen::VectorXd CorotationalElasticity::von_mises_stress(const Eigen::VectorXd& 
         stress[t] = elastic::von_mises(C * (elastic::strain_displacement_matrix(rest) * d));
     }
     return stress;
+}
+
+std::vector<Eigen::Matrix3d> free_vertex_rotations(const CorotationalElasticity& model, const dynamics::FreeDofs& dofs)
+{
+    const std::vector<Eigen::Matrix3d> all = model.vertex_rotations();
+    if (dofs.full_size() != 3 * static_cast<Eigen::Index>(all.size()))
+        throw Error(str("free_vertex_rotations: ", dofs.full_size(), " dofs for a model of ", all.size(), " vertices"));
+    const std::vector<int>& free = dofs.indices();
+    std::vector<Eigen::Matrix3d> rotations;
+    rotations.reserve(free.size() / 3);
+    for (std::size_t i = 0; i < free.size(); i += 3) {
+        const int vertex = free[i] / 3;
+        if (free[i] % 3 != 0 || i + 2 >= free.size() || free[i + 1] != free[i] + 1 || free[i + 2] != free[i] + 2)
+            throw Error(str("free_vertex_rotations: vertex ", vertex, " is only partly pinned; pin all three dofs"));
+        rotations.push_back(all[static_cast<std::size_t>(vertex)]);
+    }
+    return rotations;
 }
 
 }  // namespace fem::corot

@@ -9,24 +9,36 @@
 
 namespace fem::corot {
 
-FrozenFactorPcg::FrozenFactorPcg(const cg::SolverOptions& options, int refresh_iterations)
-    : cg::LinearSolver("frozen-cholesky-pcg"), options_(options), refresh_iterations_(refresh_iterations)
+FrozenFactorPcg::FrozenFactorPcg(const cg::SolverOptions& options, int refresh_iterations, BlockRotations rotations)
+    : cg::LinearSolver(rotations ? "rotated-frozen-cholesky-pcg" : "frozen-cholesky-pcg"), options_(options),
+      refresh_iterations_(refresh_iterations), rotations_(std::move(rotations))
 {
     if (!(options.relative_tolerance > 0.0 && options.relative_tolerance < 1.0))
-        throw Error(str("frozen-cholesky-pcg: the tolerance must lie in (0, 1), got ", options.relative_tolerance));
+        throw Error(str(name(), ": the tolerance must lie in (0, 1), got ", options.relative_tolerance));
     if (options.max_iterations < 0 || refresh_iterations < 0)
-        throw Error("frozen-cholesky-pcg: the iteration cap and the refresh count must be >= 0");
+        throw Error(str(name(), ": the iteration cap and the refresh count must be >= 0"));
 }
 
 void FrozenFactorPcg::do_prepare(const Eigen::SparseMatrix<double>& A, bool same_pattern)
 {
-    A_ = A;
+    A_ = &A;
+    std::vector<Eigen::Matrix3d> current;
+    if (rotations_) {
+        current = rotations_();
+        if (3 * static_cast<Eigen::Index>(current.size()) != A.rows())
+            throw Error(str(name(), ": ", current.size(), " block rotations for a ", A.rows(), "x", A.rows(),
+                            " matrix; expected one per 3 unknowns"));
+    }
     if (refresh_ || !same_pattern || factor_ == nullptr) {
         factor_ = cg::make_solver("default");
         factor_->prepare(A);
         ++factorizations_;
         refresh_ = false;
+        frozen_rotations_ = current;
     }
+    turn_.resize(current.size());
+    for (std::size_t i = 0; i < current.size(); ++i)
+        turn_[i] = current[i] * frozen_rotations_[i].transpose();
 }
 
 int FrozenFactorPcg::do_solve(const Eigen::VectorXd& b, Eigen::VectorXd& x)
@@ -37,8 +49,9 @@ int FrozenFactorPcg::do_solve(const Eigen::VectorXd& b, Eigen::VectorXd& x)
     cg::CgResult result;
     // EXERCISE 11.7 (frozen_factor_pcg): see docs/11_corotational.md#solving-a-changing-matrix
     // HINT: chapter 09's preconditioned_conjugate_gradient on the current matrix (cg::EigenOperator of
-    // HINT: A_) from x, with a cg::FunctionOperator preconditioner that applies the frozen factor:
-    // HINT: z = factor_->solve(r).
+    // HINT: *A_) from x, with a cg::FunctionOperator preconditioner that applies the frozen factor,
+    // HINT: turned by the blocks' rotations when there are any: z = Q A₀⁻¹ Qᵀ r (turn_[i] = Qᵢ),
+    // HINT: else z = factor_->solve(r).
     throw fem::NotImplemented("11.7", "frozen_factor_pcg", "docs/11_corotational.md#solving-a-changing-matrix");
     if (!result.converged)
         throw Error(str(name(), ": CG missed its tolerance ", options_.relative_tolerance, " within ",

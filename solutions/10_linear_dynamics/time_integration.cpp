@@ -164,8 +164,8 @@ StepInfo ThetaMethod::step(Body& body, double time_step, State& state)
         info.prepared = true;
     }
 
-    if (!options_.warm_start)
-        solution_.resize(0);  // the step below starts from Δv = 0 (or v) instead of its last answer
+    if (!options_.warm_start)  // a cold start: from zero, not from the last answer
+        solution_ = Eigen::VectorXd::Zero(eliminate ? dofs.size() : dofs.full_size());
     Eigen::VectorXd v_next, v_theta, u_next;
     // BEGIN EXERCISE 10.4 theta_step #the-implicit-step
     // HINT: velocity_change form: r = velocity_change_right_hand_side(M, v, K v, f, f_ext, D, Δt, θ),

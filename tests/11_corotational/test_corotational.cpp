@@ -156,6 +156,32 @@ TEST_CASE("polar rotation: F = R S with S symmetric positive semi-definite, a pr
     CHECK_THROWS_AS(polar_rotation(Eigen::Matrix3d::Constant(INFINITY)), Error);
 }
 
+TEST_CASE("polar rotation by Newton's iteration: the SVD's rotation to round-off, the SVD for hard cases", "[ex11.3]")
+{
+    double largest_difference = 0.0, largest_orthogonality = 0.0;
+    for (unsigned seed = 1; seed <= 2000; ++seed) {
+        // Rotations up to 2π of stretches within 40 % (σ from about 0.3 to 1.7).
+        const Eigen::Matrix3d F = rotation(0.003 * seed, seed) *
+                                  (Eigen::Matrix3d::Identity() + 0.4 * Eigen::Matrix3d(fem::random_matrix(3, 3, seed + 7)));
+        if (F.determinant() <= 0.0)
+            continue;
+        const Eigen::Matrix3d R = polar_rotation_newton(F);
+        largest_difference = std::max(largest_difference, (R - polar_rotation(F)).cwiseAbs().maxCoeff());
+        largest_orthogonality = std::max(largest_orthogonality, orthogonality_error(R));
+    }
+    CAPTURE(largest_difference, largest_orthogonality);
+    CHECK(largest_difference <= 1e-12);
+    CHECK(largest_orthogonality <= 1e-14);
+    // Inverted, flat and zero F go to the SVD: a proper rotation, never a reflection.
+    const Eigen::Matrix3d inverted = rotation(1.0, 3) * Eigen::Vector3d(1.2, 0.9, -0.3).asDiagonal();
+    const Eigen::Matrix3d flat = rotation(2.0, 4) * Eigen::Vector3d(1.0, 0.5, 0.0).asDiagonal();
+    for (const Eigen::Matrix3d& F : {inverted, flat, Eigen::Matrix3d(Eigen::Matrix3d::Zero())}) {
+        const Eigen::Matrix3d R = polar_rotation_newton(F);
+        CHECK((R - polar_rotation(F)).norm() <= 1e-12);
+        CHECK(R.determinant() == Approx(1.0).epsilon(1e-12));
+    }
+}
+
 TEST_CASE("edges, centroid or polar: equal for the tets they were made for, different for skewed ones", "[ex11.3]")
 {
     tet::TetVertices corner;  // edges from vertex 0 orthonormal: PᵀP = I
@@ -265,6 +291,11 @@ TEST_CASE("corotational body: no force under rigid motion, rotation covariance o
     const Eigen::MatrixXd K_rest(corotational.stiffness(Eigen::VectorXd::Zero(u.size())));
     CHECK((K_rest - Eigen::MatrixXd(linear.K())).cwiseAbs().maxCoeff() <= 1e-12 * K_rest.cwiseAbs().maxCoeff());
     CHECK((K_x - K_x.transpose()).cwiseAbs().maxCoeff() <= 1e-12 * K_x.cwiseAbs().maxCoeff());
+    // The polar rotations by Newton's iteration (the default) or by the SVD: the same forces.
+    CorotationalElasticity by_svd(mesh, rubber, RotationFit::polar, PolarAlgorithm::svd);
+    Eigen::VectorXd f_svd;
+    by_svd.evaluate(u, f_svd);
+    CHECK((f_x - f_svd).norm() <= 1e-12 * f_svd.norm());
 }
 
 TEST_CASE("small deformations: corotational and linear forces differ by O(eps^2)", "[ex11.6]")
@@ -385,7 +416,7 @@ TEST_CASE("a spinning body: linear elasticity swells, corotational keeps its vol
     CHECK(backward_fine.energy_gain < backward.energy_gain / 2.0);
 }
 
-TEST_CASE("finite differences: the polar fit's force is -dU/du, the edge fit's is not; K_R misses the dR term",
+TEST_CASE("finite differences: the polar fit's force is -dU/du, the edge fit's is not, K_R misses the dR term",
           "[ex11.6]")
 {
     const TetMesh mesh = box_mesh(2, 1, 1, Eigen::Vector3d(0.2, 0.1, 0.1));
@@ -440,7 +471,7 @@ TEST_CASE("finite differences: the polar fit's force is -dU/du, the edge fit's i
 // The midpoint rule conserves a linear body's energy; with the warped stiffness, which is smaller
 // than the true tangent of a stretched body (above), its stiff modes grow by about 1 + 2|δ| a step
 // (δ the relative gap), and the run diverges. θ a little above ½ damps them.
-TEST_CASE("the midpoint rule with the warped stiffness diverges on a large swing; theta = 0.55 stays bounded",
+TEST_CASE("the midpoint rule with the warped stiffness diverges on a large swing, theta = 0.55 stays bounded",
           "[ex11.6]")
 {
     dynamics::Scene scene;
@@ -515,4 +546,25 @@ TEST_CASE("frozen-factor PCG: exact at rest, more iterations as the body turns, 
     refreshing.solve(b);          // many iterations: the next prepare refactors
     refreshing.prepare(turned_A);
     CHECK(refreshing.factorizations() == 2);
+
+    // Turned with the body: a rigidly rotated body's matrix is Q A₀ Qᵀ, so the rotated frozen factor
+    // stays exact (one iteration) at any angle, where the plain one needs more and more.
+    const dynamics::FreeDofs all(static_cast<int>(mesh.V.rows()), {});
+    FrozenFactorPcg turning({}, 0, [&] { return free_vertex_rotations(model, all); });
+    (void)model.stiffness(rest);
+    turning.prepare(step_matrix(rest));
+    for (const double angle : {0.3, 1.0, 2.0}) {
+        const Eigen::VectorXd turned = displacement(rigidly_moved(mesh.V, rotation(angle, 81), Eigen::Vector3d::Zero()), mesh.V);
+        const dynamics::SparseMatrix A = step_matrix(turned);  // evaluates the model at `turned`
+        turning.prepare(A);
+        x = turning.solve(b);
+        CAPTURE(angle);
+        CHECK(turning.stats().iterations <= 1);
+        const auto direct = cg::make_solver("default");
+        direct->prepare(A);
+        CHECK((x - direct->solve(b)).norm() <= 1e-7 * x.norm());
+    }
+    CHECK(turning.factorizations() == 1);
+    FrozenFactorPcg wrong_size({}, 0, [] { return std::vector<Eigen::Matrix3d>(2, Eigen::Matrix3d::Identity()); });
+    CHECK_THROWS_WITH(wrong_size.prepare(step_matrix(rest)), Contains("block rotations"));
 }
