@@ -9,6 +9,7 @@
 // and drifts away as its elements rotate, so the iterations grow with the rotation. The frozen
 // factor is refreshed when CG needs more than refresh_iterations.
 
+#include "08_direct_solvers/sparse_cholesky.hpp"
 #include "09_conjugate_gradient/linear_solver.hpp"
 
 #include <Eigen/Core>
@@ -16,6 +17,7 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <vector>
 
 namespace fem::corot {
@@ -24,7 +26,7 @@ namespace fem::corot {
 /// reduced step matrix, the free vertices in order). Asked for at every prepare().
 using BlockRotations = std::function<std::vector<Eigen::Matrix3d>()>;
 
-/// PCG preconditioned by a frozen sparse Cholesky factor (chapter 09's "default" solver), behind
+/// PCG preconditioned by a frozen sparse Cholesky factor (chapter 08's supernodal factorization), behind
 /// chapter 09's solver interface so that chapter 10's ThetaMethod can use it
 /// (ImplicitOptions::make_solver). docs/11_corotational.md#solving-a-changing-matrix
 ///
@@ -55,7 +57,7 @@ private:
     cg::SolverOptions options_;
     int refresh_iterations_;
     BlockRotations rotations_;
-    std::unique_ptr<cg::LinearSolver> factor_;
+    std::optional<direct::SparseCholesky> factor_;   // used directly: no residual check per application
     const Eigen::SparseMatrix<double>* A_ = nullptr;  // the base class's copy, alive until the next prepare
     std::vector<Eigen::Matrix3d> frozen_rotations_;   // R₀ᵢ, when the factor was made
     std::vector<Eigen::Matrix3d> turn_;               // Qᵢ = Rᵢ R₀ᵢᵀ

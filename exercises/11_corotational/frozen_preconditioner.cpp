@@ -29,9 +29,8 @@ void FrozenFactorPcg::do_prepare(const Eigen::SparseMatrix<double>& A, bool same
             throw Error(str(name(), ": ", current.size(), " block rotations for a ", A.rows(), "x", A.rows(),
                             " matrix; expected one per 3 unknowns"));
     }
-    if (refresh_ || !same_pattern || factor_ == nullptr) {
-        factor_ = cg::make_solver("default");
-        factor_->prepare(A);
+    if (refresh_ || !same_pattern || !factor_) {
+        factor_.emplace(A);
         ++factorizations_;
         refresh_ = false;
         frozen_rotations_ = current;
