@@ -52,7 +52,11 @@ int main(int argc, char** argv)
         require_positive(settings.duration, "--duration");
         if (settings.duration > 10.0)
             throw Error(str("--duration: at most 10 s, got ", settings.duration));
-        dynamics::step_count(settings.duration, 1.0 / 30.0);  // a whole number of the largest steps
+        try {
+            dynamics::step_count(settings.duration, 1.0 / 30.0);  // a whole number of the largest steps
+        } catch (const Error& e) {
+            throw Error(str("--duration must be a multiple of 1/30 s, the swing's largest step: ", e.what()));
+        }
         if (settings.swing_cells < 2 || settings.swing_cells > 60)
             throw Error(str("--swing-cells must lie in [2, 60], got ", settings.swing_cells));
         for (int cells : settings.cost_cells)
