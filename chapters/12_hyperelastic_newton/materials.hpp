@@ -1,0 +1,118 @@
+#pragma once
+// Chapter 12: hyperelastic energy densities ψ(F), their first Piola–Kirchhoff stress P = ∂ψ/∂F and
+// its derivative ∂P/∂F, per tet. docs/12_hyperelastic_newton.md
+//
+// Orderings as in chapter 04: vec(F) is ROW-MAJOR, vec(F)[3a + b] = F(a, b), and the 9×9 derivative
+// has (∂P/∂F)(3a + b, 3c + d) = ∂P_ab / ∂F_cd. With B the 9×12 of chapter 04 (vec(F) = B q_e), one
+// tet of rest volume V has the energy V ψ(F), the forces f_e = −V Bᵀ vec(P) and the Hessian
+// V Bᵀ (∂P/∂F) B (12×12). Every material is parametrised by the Lamé λ, μ of chapter 05 and agrees
+// with linear elasticity (chapter 05) for small strains.
+
+#include "05_strain_stress/strain_stress.hpp"
+
+#include <Eigen/Core>
+
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace fem::hyper {
+
+using Matrix9d = Eigen::Matrix<double, 9, 9>;
+using Vector9d = Eigen::Matrix<double, 9, 1>;
+using Matrix12d = Eigen::Matrix<double, 12, 12>;
+
+/// vec(F), row-major (9): vec[3a + b] = F(a, b).
+Vector9d flatten(const Eigen::Matrix3d& F);
+
+/// An energy density ψ(F) [J/m³] with its stress and stress derivative.
+/// docs/12_hyperelastic_newton.md#energy-densities
+class Material {
+public:
+    explicit Material(const elastic::Lame& lame) : lame_(lame) {}
+    virtual ~Material() = default;
+    virtual std::string name() const = 0;
+    /// Whether ψ, P and ∂P/∂F are defined for det F ≤ 0 (an inverted or flat element).
+    virtual bool defined_when_inverted() const = 0;
+    /// ψ(F). +∞ where the material is undefined (det F ≤ 0 for neo-Hookean), so that a line search
+    /// rejects the step.
+    virtual double energy_density(const Eigen::Matrix3d& F) const = 0;
+    /// P = ∂ψ/∂F (3×3). fem::Error where the material is undefined.
+    virtual Eigen::Matrix3d first_piola(const Eigen::Matrix3d& F) const = 0;
+    /// ∂P/∂F (9×9, row-major vec on both sides). fem::Error where the material is undefined.
+    virtual Matrix9d piola_derivative(const Eigen::Matrix3d& F) const = 0;
+    const elastic::Lame& lame() const { return lame_; }
+
+private:
+    elastic::Lame lame_;
+};
+
+/// St. Venant–Kirchhoff: ψ = μ E:E + (λ/2) tr(E)², E = ½(FᵀF − I) (chapter 05's Green strain);
+/// P = F S with S = 2μE + λ tr(E) I; ∂P_ab/∂F_cd = δ_ac S_db + μ (F_ad F_cb + (FFᵀ)_ac δ_bd) + λ F_ab F_cd.
+/// Defined for every F, but it softens under compression and offers no resistance at all to a
+/// tet flattened to zero volume. docs/12_hyperelastic_newton.md#st-venantkirchhoff
+class StVenantKirchhoff final : public Material {
+public:
+    using Material::Material;
+    std::string name() const override { return "stvk"; }
+    bool defined_when_inverted() const override { return true; }
+    double energy_density(const Eigen::Matrix3d& F) const override;
+    Eigen::Matrix3d first_piola(const Eigen::Matrix3d& F) const override;
+    Matrix9d piola_derivative(const Eigen::Matrix3d& F) const override;
+};
+
+/// Neo-Hookean: ψ = (μ/2)(tr(FᵀF) − 3) − μ ln J + (λ/2)(ln J)², J = det F;
+/// P = μ(F − F⁻ᵀ) + λ ln J F⁻ᵀ; ∂P_ab/∂F_cd = μ δ_ac δ_bd + (μ − λ ln J) G_ad G_cb + λ G_ab G_cd
+/// with G = F⁻ᵀ. Undefined for J ≤ 0 (ψ = +∞ there). docs/12_hyperelastic_newton.md#neo-hookean
+class NeoHookean final : public Material {
+public:
+    using Material::Material;
+    std::string name() const override { return "neo-hookean"; }
+    bool defined_when_inverted() const override { return false; }
+    double energy_density(const Eigen::Matrix3d& F) const override;
+    Eigen::Matrix3d first_piola(const Eigen::Matrix3d& F) const override;
+    Matrix9d piola_derivative(const Eigen::Matrix3d& F) const override;
+};
+
+/// Stable neo-Hookean (Smith, de Goes, Kim 2018, in the form without the log term):
+/// ψ = (μ/2)(tr(FᵀF) − 3) − μ(J − 1) + (λ̂/2)(J − 1)², λ̂ = λ + μ (which makes it agree with linear
+/// elasticity for small strains). With the cofactor C = ∂J/∂F (C = J F⁻ᵀ when F is invertible,
+/// defined for every F): P = μF + (λ̂(J − 1) − μ) C;
+/// ∂P_ab/∂F_cd = μ δ_ac δ_bd + λ̂ C_ab C_cd + (λ̂(J − 1) − μ) ε_ack ε_bdl F_kl.
+/// Defined for every F, inverted ones included: an inverted tet is pushed back.
+/// docs/12_hyperelastic_newton.md#stable-neo-hookean
+class StableNeoHookean final : public Material {
+public:
+    using Material::Material;
+    std::string name() const override { return "stable-neo-hookean"; }
+    bool defined_when_inverted() const override { return true; }
+    double energy_density(const Eigen::Matrix3d& F) const override;
+    Eigen::Matrix3d first_piola(const Eigen::Matrix3d& F) const override;
+    Matrix9d piola_derivative(const Eigen::Matrix3d& F) const override;
+};
+
+/// The material called `name` ("stvk", "neo-hookean", "stable-neo-hookean") with the Lamé
+/// parameters of Y and ν (chapter 05). fem::Error for another name (the message lists these) or a
+/// bad Y, ν. docs/12_hyperelastic_newton.md#energy-densities
+std::unique_ptr<Material> make_material(std::string_view name, double youngs_modulus, double poisson_ratio);
+
+/// The names make_material accepts.
+std::vector<std::string> material_names();
+
+/// The cofactor matrix C = ∂(det F)/∂F (3×3): its rows are cross products of F's rows, so it is
+/// defined for every F and equals det F · F⁻ᵀ when F is invertible.
+Eigen::Matrix3d cofactor(const Eigen::Matrix3d& F);
+
+/// How a symmetric matrix is made positive semi-definite (docs/12_hyperelastic_newton.md#definiteness).
+enum class Projection {
+    clamp,     ///< negative eigenvalues set to 0
+    absolute,  ///< negative eigenvalues replaced by their absolute values
+};
+
+/// The nearest positive semi-definite matrix by an eigen-decomposition of the symmetric part of
+/// A = Q Λ Qᵀ: Q max(Λ, 0) Qᵀ (clamp) or Q |Λ| Qᵀ (absolute). 9×9 or 12×12.
+template <int N>
+Eigen::Matrix<double, N, N> project_to_psd(const Eigen::Matrix<double, N, N>& A, Projection projection);
+
+}  // namespace fem::hyper

@@ -1,0 +1,163 @@
+// Chapter 12: energy densities, stresses and their derivatives against finite differences, the
+// rest state, small strains against linear elasticity, and the positive semi-definite projection.
+// docs/12_hyperelastic_newton.md
+#include "12_hyperelastic_newton/materials.hpp"
+
+#include "common/error.hpp"
+#include "common/random.hpp"
+
+#include "../common/test_support.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+
+using namespace fem;
+using namespace fem::hyper;
+using Catch::Matchers::Contains;
+
+namespace {
+
+const elastic::Lame steel_like = elastic::lame_parameters(1e6, 0.35);
+
+/// A random F near I (seeded): I + 0.3 × noise, det > 0.
+Eigen::Matrix3d random_deformation(unsigned seed)
+{
+    Eigen::Matrix3d F = Eigen::Matrix3d::Identity() + 0.3 * Eigen::Matrix3d(fem::random_matrix(3, 3, seed));
+    if (F.determinant() <= 0.0)
+        F.row(0) = -F.row(0);
+    return F;
+}
+
+/// The matrix with entry (a, b) = F(a, b) + h at (row, column) = index (row-major), others F.
+Eigen::Matrix3d nudged(const Eigen::Matrix3d& F, int index, double h)
+{
+    Eigen::Matrix3d G = F;
+    G(index / 3, index % 3) += h;
+    return G;
+}
+
+/// The best relative error of the finite-difference sweep of P against ψ, and of ∂P/∂F against P.
+std::pair<double, double> derivative_errors(const Material& material, const Eigen::Matrix3d& F)
+{
+    const Vector9d P = flatten(material.first_piola(F));
+    const Matrix9d dP = material.piola_derivative(F);
+    double best_P = 1e300, best_dP = 1e300;
+    const double scale = std::max(1.0, F.norm());
+    for (double h = 1e-3 * scale; h > 0.5e-8 * scale; h /= 10.0) {
+        Vector9d fd_P;
+        Matrix9d fd_dP;
+        for (int i = 0; i < 9; ++i) {
+            fd_P[i] = (material.energy_density(nudged(F, i, h)) - material.energy_density(nudged(F, i, -h))) / (2.0 * h);
+            fd_dP.col(i) = (flatten(material.first_piola(nudged(F, i, h))) -
+                            flatten(material.first_piola(nudged(F, i, -h)))) / (2.0 * h);
+        }
+        best_P = std::min(best_P, (fd_P - P).norm() / P.norm());
+        best_dP = std::min(best_dP, (fd_dP - dP).norm() / dP.norm());
+    }
+    return {best_P, best_dP};
+}
+
+}  // namespace
+
+TEST_CASE("materials: P = dpsi/dF and dP/dF by finite differences, at random, inverted and isotropic F", "[ch12]")
+{
+    for (const std::string& name : material_names()) {
+        const auto material = make_material(name, 1e6, 0.35);
+        std::vector<Eigen::Matrix3d> samples;
+        for (unsigned seed = 1; seed <= 8; ++seed)
+            samples.push_back(random_deformation(seed));
+        // Repeated singular values: a rotated uniform stretch and a rotated uniaxial one.
+        const Eigen::Matrix3d R = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+        samples.push_back(1.3 * R);
+        samples.push_back(R * Eigen::Vector3d(1.4, 0.9, 0.9).asDiagonal());
+        if (material->defined_when_inverted()) {
+            samples.push_back(R * Eigen::Vector3d(1.1, 0.8, -0.4).asDiagonal());  // inverted
+            samples.push_back(R * Eigen::Vector3d(1.2, 0.7, 0.0).asDiagonal());   // flat
+        }
+        for (const Eigen::Matrix3d& F : samples) {
+            const auto [P_error, dP_error] = derivative_errors(*material, F);
+            CAPTURE(name, F.determinant(), P_error, dP_error);
+            CHECK(P_error < 1e-6);
+            CHECK(dP_error < 1e-6);
+            CHECK((material->piola_derivative(F) - material->piola_derivative(F).transpose()).norm() <=
+                  1e-12 * material->piola_derivative(F).norm());
+        }
+    }
+}
+
+TEST_CASE("materials: stress free at rest, zero stress energy under rotation, linear elasticity for small strains",
+          "[ch12]")
+{
+    const Eigen::Matrix3d G = Eigen::Matrix3d(fem::random_matrix(3, 3, 41));
+    const Eigen::Matrix3d R = Eigen::AngleAxisd(2.5, Eigen::Vector3d(-1, 2, 0.5).normalized()).toRotationMatrix();
+    for (const std::string& name : material_names()) {
+        const auto material = make_material(name, 1e6, 0.35);
+        const elastic::Lame lame = material->lame();
+        CAPTURE(name);
+        CHECK(material->first_piola(Eigen::Matrix3d::Identity()).norm() <= 1e-9 * lame.mu);
+        CHECK(std::abs(material->energy_density(Eigen::Matrix3d::Identity())) <= 1e-12 * lame.mu);
+        CHECK(std::abs(material->energy_density(R)) <= 1e-9 * lame.mu);      // rotations cost nothing
+        CHECK(material->first_piola(R).norm() <= 1e-9 * lame.mu);
+        // P(I + εG) − σ_linear(ε) = O(ε²): the gap falls 4× when ε halves.
+        std::vector<double> gaps;
+        for (const double eps : {1e-2, 5e-3, 2.5e-3}) {
+            const Eigen::Matrix3d grad = eps * G, strain = 0.5 * (grad + grad.transpose());
+            const Eigen::Matrix3d linear = 2.0 * lame.mu * strain + lame.lambda * strain.trace() * Eigen::Matrix3d::Identity();
+            gaps.push_back((material->first_piola(Eigen::Matrix3d::Identity() + grad) - linear).norm());
+        }
+        for (std::size_t k = 1; k < gaps.size(); ++k)
+            CHECK(std::log2(gaps[k - 1] / gaps[k]) == Approx(2.0).margin(0.1));
+    }
+}
+
+TEST_CASE("neo-Hookean: infinite energy and a clear error for det F <= 0, stable neo-Hookean pushes back", "[ch12]")
+{
+    const Eigen::Matrix3d inverted = Eigen::Vector3d(1.0, 1.0, -0.2).asDiagonal();
+    const NeoHookean neo(steel_like);
+    CHECK(std::isinf(neo.energy_density(inverted)));
+    CHECK_THROWS_WITH(neo.first_piola(inverted), Contains("det F"));
+    CHECK_THROWS_AS(neo.piola_derivative(inverted), Error);
+    // The stable one: the stress of an inverted element points back toward det F > 0.
+    const StableNeoHookean stable(steel_like);
+    const Eigen::Matrix3d P = stable.first_piola(inverted);
+    CHECK(P(2, 2) < 0.0);  // dψ/dF₂₂ < 0: increasing F₂₂ (un-inverting) lowers the energy
+    CHECK(std::isfinite(stable.energy_density(inverted)));
+    CHECK_THROWS_WITH(make_material("rubber", 1e6, 0.3), Contains("stable-neo-hookean"));
+    CHECK_THROWS_AS(make_material("stvk", 1e6, 0.5), Error);
+    CHECK_THROWS_AS(make_material("stvk", -1.0, 0.3), Error);
+    CHECK_THROWS_AS(stable.first_piola(Eigen::Matrix3d::Constant(NAN)), Error);
+}
+
+TEST_CASE("the cofactor is dJ/dF, J F^-T where F is invertible, and defined where it is not", "[ch12]")
+{
+    const Eigen::Matrix3d F = random_deformation(5);
+    CHECK((cofactor(F) - F.determinant() * F.inverse().transpose()).norm() <= 1e-12 * F.norm());
+    const Eigen::Matrix3d flat = Eigen::Vector3d(1.0, 2.0, 0.0).asDiagonal();
+    CHECK((cofactor(flat) - Eigen::Matrix3d(Eigen::Vector3d(0.0, 0.0, 2.0).asDiagonal())).norm() == 0.0);
+}
+
+TEST_CASE("PSD projection: clamp or mirror the negative eigenvalues, leave a PSD matrix alone", "[ch12]")
+{
+    const Eigen::Matrix3d compressed = Eigen::Vector3d(0.6, 0.7, 0.8).asDiagonal();
+    const Matrix9d dP = StVenantKirchhoff(steel_like).piola_derivative(compressed);
+    const Eigen::SelfAdjointEigenSolver<Matrix9d> before(dP);
+    CHECK(before.eigenvalues().minCoeff() < 0.0);  // StVK under compression: indefinite
+    for (const Projection projection : {Projection::clamp, Projection::absolute}) {
+        const Matrix9d projected = project_to_psd<9>(dP, projection);
+        const Eigen::SelfAdjointEigenSolver<Matrix9d> after(projected);
+        CHECK(after.eigenvalues().minCoeff() >= -1e-9 * dP.norm());
+        Eigen::Matrix<double, 9, 1> expected = before.eigenvalues();
+        for (int i = 0; i < 9; ++i)
+            if (expected[i] < 0.0)
+                expected[i] = projection == Projection::clamp ? 0.0 : -expected[i];
+        std::sort(expected.data(), expected.data() + 9);
+        CHECK((after.eigenvalues() - expected).norm() <= 1e-9 * dP.norm());
+    }
+    const Matrix9d positive = StableNeoHookean(steel_like).piola_derivative(Eigen::Matrix3d::Identity());
+    CHECK((project_to_psd<9>(positive, Projection::clamp) - positive).norm() <= 1e-9 * positive.norm());
+}
