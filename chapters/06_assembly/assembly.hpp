@@ -114,6 +114,13 @@ public:
     /// The same into a fresh matrix.
     CsrMatrix assemble(const ElementMatrices& element_matrices) const;
 
+    /// Adds one tet's K_t (12×12) into the value array of a matrix with this pattern: entry
+    /// (3i + c, 3j + d) goes to values[block_offset(t, i, j) + c · row_length(T(t, i)) + d]. What
+    /// assemble() does per tet, for callers that make each K_t just before adding it (chapters
+    /// 11–12 re-assemble every step without storing #T matrices). values must hold
+    /// nonzero_count() entries. fem::Error for t outside [0, #T).
+    void add_element(Eigen::Index t, const Matrix12d& K_t, double* values) const;
+
     /// Where entry (3i, 3j) of K_t goes in the value array (see the class comment).
     /// fem::Error for t outside [0, #T) or i, j outside [0, 3].
     int block_offset(int t, int i, int j) const;

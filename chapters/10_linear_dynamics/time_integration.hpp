@@ -58,6 +58,11 @@ struct State {
 /// fem::Error unless u0 and v0 have 3n finite entries and are zero on the pinned dofs.
 State initial_state(Body& body, const Eigen::VectorXd& u0 = {}, const Eigen::VectorXd& v0 = {});
 
+/// Commits a step an integrator has computed: the force model evaluated once at u⁺ (forces and
+/// energy kept in the state for the next step and the energies), then u, v, time and step. Nothing
+/// of state changes if the model throws. For integrators of later chapters (chapter 12's Newton).
+void commit_step(ForceModel& model, double time_step, Eigen::VectorXd u_next, Eigen::VectorXd v_next, State& state);
+
 /// T, U and W of a state (see Energies). docs/10_linear_dynamics.md#energy
 Energies energies(const Body& body, const State& state);
 

@@ -254,9 +254,18 @@ void AssemblyPattern::assemble(const ElementMatrices& element_matrices, CsrMatri
                         "×", dof_count(), ", ", nonzero_count(), " entries)"));
     double* values = K.valuePtr();
     std::fill(values, values + nonzero_count(), 0.0);
+    for (Eigen::Index t = 0; t < element_count_; ++t)
+        add_element(t, element_matrices[static_cast<std::size_t>(t)], values);
+}
+
+void AssemblyPattern::add_element(Eigen::Index t, const Matrix12d& K_t, double* values) const
+{
+    if (t < 0 || t >= element_count_)
+        throw Error(str("AssemblyPattern::add_element: tet ", t, " is outside [0, ", element_count_, ")"));
+    const int* record = &records_[static_cast<std::size_t>(20 * t)];
     // EXERCISE 06.5 (assemble): see docs/06_assembly.md#the-pattern-route
-    // HINT: for each tet and block (i, j): row c of the block starts at
-    // HINT: block_offset + c · row_length(T(t, i)); add K_t(3i + c, 3j + d) at + d.
+    // HINT: record[4 i + j] is block (i, j)'s offset, record[16 + i] the row length of vertex i:
+    // HINT: row c of the block starts at offset + c · row length; add K_t(3i + c, 3j + d) at + d.
     throw fem::NotImplemented("06.5", "assemble", "docs/06_assembly.md#the-pattern-route");
 }
 

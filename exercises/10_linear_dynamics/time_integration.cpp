@@ -33,9 +33,9 @@ Eigen::VectorXd damping_times(const Body& body, const Eigen::VectorXd& x, const 
     return Dx;
 }
 
-/// Commits a step: the force model evaluated once at u⁺ (forces and energy kept for the next step
-/// and the energies), then u, v, time and step. Nothing of state changes if the model throws.
-void advance(ForceModel& model, double time_step, Eigen::VectorXd u_next, Eigen::VectorXd v_next, State& state)
+}  // namespace
+
+void commit_step(ForceModel& model, double time_step, Eigen::VectorXd u_next, Eigen::VectorXd v_next, State& state)
 {
     Eigen::VectorXd forces;
     const double elastic = model.evaluate(u_next, forces);
@@ -46,8 +46,6 @@ void advance(ForceModel& model, double time_step, Eigen::VectorXd u_next, Eigen:
     state.time += time_step;
     state.step += 1;
 }
-
-}  // namespace
 
 State initial_state(Body& body, const Eigen::VectorXd& u0, const Eigen::VectorXd& v0)
 {
@@ -177,7 +175,7 @@ StepInfo ThetaMethod::step(Body& body, double time_step, State& state)
         const Eigen::VectorXd Kv = d.beta != 0.0 ? Eigen::VectorXd(K * v_theta) : Eigen::VectorXd();
         info.damping_work = time_step * v_theta.dot(damping_times(body, v_theta, Kv));
     }
-    advance(model, time_step, std::move(u_next), std::move(v_next), state);
+    commit_step(model, time_step, std::move(u_next), std::move(v_next), state);
     return info;
 }
 
@@ -211,7 +209,7 @@ StepInfo SymplecticEuler::step(Body& body, double time_step, State& state)
     throw fem::NotImplemented("10.5", "symplectic_euler_step", "docs/10_linear_dynamics.md#explicit-euler");
 
     info.damping_work = time_step * v_next.dot(damping_force);
-    advance(model, time_step, std::move(u_next), std::move(v_next), state);
+    commit_step(model, time_step, std::move(u_next), std::move(v_next), state);
     return info;
 }
 

@@ -219,9 +219,8 @@ const dynamics::SparseMatrix& CorotationalElasticity::stiffness(const Eigen::Vec
     double* values = K_R_csr_.valuePtr();
     std::fill(values, values + K_R_csr_.nonZeros(), 0.0);
     // EXERCISE 11.6 (warped_stiffness): see docs/11_corotational.md#forces-and-warped-stiffness
-    // HINT: per tet t, W = rotated_stiffness(K_e_[t], R[t]); add each 3×3 block (i, j) of W into the
-    // HINT: fixed CSR pattern (chapter 06's route c): row c of the block starts at
-    // HINT: values + pattern_.block_offset(t, i, j) + c · pattern_.row_length(mesh_.T(t, i)).
+    // HINT: per tet t, rotated_stiffness(K_e_[t], R[t]) added into the fixed pattern's values by
+    // HINT: pattern_.add_element (chapter 06's route c, one element at a time: nothing stored).
     throw fem::NotImplemented("11.6", "warped_stiffness", "docs/11_corotational.md#forces-and-warped-stiffness");
     K_R_ = assembly::csc_of_symmetric(K_R_csr_);
     return K_R_;

@@ -273,20 +273,25 @@ void AssemblyPattern::assemble(const ElementMatrices& element_matrices, CsrMatri
                         "×", dof_count(), ", ", nonzero_count(), " entries)"));
     double* values = K.valuePtr();
     std::fill(values, values + nonzero_count(), 0.0);
+    for (Eigen::Index t = 0; t < element_count_; ++t)
+        add_element(t, element_matrices[static_cast<std::size_t>(t)], values);
+}
+
+void AssemblyPattern::add_element(Eigen::Index t, const Matrix12d& K_t, double* values) const
+{
+    if (t < 0 || t >= element_count_)
+        throw Error(str("AssemblyPattern::add_element: tet ", t, " is outside [0, ", element_count_, ")"));
+    const int* record = &records_[static_cast<std::size_t>(20 * t)];
     // BEGIN EXERCISE 06.5 assemble #the-pattern-route
-    // HINT: for each tet and block (i, j): row c of the block starts at
-    // HINT: block_offset + c · row_length(T(t, i)); add K_t(3i + c, 3j + d) at + d.
-    for (Eigen::Index t = 0; t < element_count_; ++t) {
-        const int* record = &records_[20 * t];
-        const Matrix12d& K_t = element_matrices[t];
-        for (int i = 0; i < 4; ++i) {
-            const int stride = record[16 + i];
-            for (int j = 0; j < 4; ++j) {
-                double* block = values + record[4 * i + j];
-                for (int c = 0; c < 3; ++c)
-                    for (int d = 0; d < 3; ++d)
-                        block[c * stride + d] += K_t(3 * i + c, 3 * j + d);
-            }
+    // HINT: record[4 i + j] is block (i, j)'s offset, record[16 + i] the row length of vertex i:
+    // HINT: row c of the block starts at offset + c · row length; add K_t(3i + c, 3j + d) at + d.
+    for (int i = 0; i < 4; ++i) {
+        const int stride = record[16 + i];
+        for (int j = 0; j < 4; ++j) {
+            double* block = values + record[4 * i + j];
+            for (int c = 0; c < 3; ++c)
+                for (int d = 0; d < 3; ++d)
+                    block[c * stride + d] += K_t(3 * i + c, 3 * j + d);
         }
     }
     // END EXERCISE

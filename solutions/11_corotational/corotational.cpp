@@ -228,20 +228,11 @@ const dynamics::SparseMatrix& CorotationalElasticity::stiffness(const Eigen::Vec
     double* values = K_R_csr_.valuePtr();
     std::fill(values, values + K_R_csr_.nonZeros(), 0.0);
     // BEGIN EXERCISE 11.6 warped_stiffness #forces-and-warped-stiffness
-    // HINT: per tet t, W = rotated_stiffness(K_e_[t], R[t]); add each 3×3 block (i, j) of W into the
-    // HINT: fixed CSR pattern (chapter 06's route c): row c of the block starts at
-    // HINT: values + pattern_.block_offset(t, i, j) + c · pattern_.row_length(mesh_.T(t, i)).
-    for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t) {
-        const Matrix12d W = rotated_stiffness(K_e_[static_cast<std::size_t>(t)], R[static_cast<std::size_t>(t)]);
-        for (int i = 0; i < 4; ++i) {
-            const int row_length = pattern_.row_length(mesh_.T(t, i));
-            for (int j = 0; j < 4; ++j) {
-                double* block = values + pattern_.block_offset(static_cast<int>(t), i, j);
-                for (int c = 0; c < 3; ++c)
-                    Eigen::Map<Eigen::RowVector3d>(block + c * row_length) += W.block<1, 3>(3 * i + c, 3 * j);
-            }
-        }
-    }
+    // HINT: per tet t, rotated_stiffness(K_e_[t], R[t]) added into the fixed pattern's values by
+    // HINT: pattern_.add_element (chapter 06's route c, one element at a time: nothing stored).
+    for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t)
+        pattern_.add_element(t, rotated_stiffness(K_e_[static_cast<std::size_t>(t)], R[static_cast<std::size_t>(t)]),
+                             values);
     // END EXERCISE
     K_R_ = assembly::csc_of_symmetric(K_R_csr_);
     return K_R_;
