@@ -91,6 +91,14 @@ public:
     /// (resized). One call per step: the time loop keeps both for the next step and the energies.
     virtual double evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& forces) = 0;
 
+    /// U(u) alone, for a line search (chapter 12); +∞ where the model is undefined. The default
+    /// calls evaluate; a model that can skip the forces overrides it.
+    virtual double energy(const Eigen::VectorXd& u)
+    {
+        Eigen::VectorXd forces;
+        return evaluate(u, forces);
+    }
+
     /// The tangent stiffness K(u) = ∂²U/∂u² = −∂f/∂u (3n×3n, both triangles stored).
     virtual const SparseMatrix& stiffness(const Eigen::VectorXd& u) = 0;
 

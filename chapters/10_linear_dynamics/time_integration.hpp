@@ -126,6 +126,7 @@ struct ImplicitOptions {
 struct StepInfo {
     double damping_work = 0.0;   ///< energy removed by D in this step: Δt v_θᵀ D v_θ ≥ 0 [J]
     int solver_iterations = 0;   ///< iterations of an iterative solver (0 for a direct one)
+    int newton_iterations = 0;   ///< Newton iterations of a nonlinear step (chapter 12; 0 here)
     bool prepared = false;       ///< the step (re)factored its matrix
 };
 
@@ -201,6 +202,7 @@ struct StepRecord {
     double integrator_dissipated = 0.0;  ///< H(0) − H(t) − damping_dissipated: what the integrator
                                          ///< itself removed (> 0) or added (< 0) [J]
     int solver_iterations = 0;           ///< of this step
+    int newton_iterations = 0;           ///< of this step (a nonlinear integrator's)
 };
 
 /// The divergence rule: a run fails when its total energy H has risen above H(0) by more than this

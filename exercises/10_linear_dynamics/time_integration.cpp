@@ -260,6 +260,7 @@ void Simulation::run(int steps, const Observer& observer)
         record.time = state_.time;
         record.energies = energies(body_, state_);
         record.solver_iterations = info.solver_iterations;
+        record.newton_iterations = info.newton_iterations;
         record.damping_dissipated = last_.damping_dissipated + info.damping_work;
         const double total = record.energies.total();
         const auto where = [&] {

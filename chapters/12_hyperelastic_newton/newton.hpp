@@ -1,0 +1,79 @@
+#pragma once
+// Chapter 12: backward Euler as a minimisation, solved by Newton's method with a backtracking line
+// search (notes 001, "Backward Euler as optimisation" to "Line Search"), as a chapter 10 integrator.
+// docs/12_hyperelastic_newton.md#backward-euler-as-minimisation
+//
+// The step from (qᵗ, q̇ᵗ) finds the velocity v that minimises
+//     E(v) = ½ (v − q̇ᵗ)ᵀ M (v − q̇ᵗ) + U(qᵗ + Δt v) − Δt vᵀ f_ext,
+// and sets q⁺ = qᵗ + Δt v, q̇⁺ = v. Its gradient ∇E = M (v − q̇ᵗ) − Δt (f(qᵗ + Δt v) + f_ext) is zero
+// exactly at the backward Euler step; its Hessian is M + Δt² K(qᵗ + Δt v). The notes write the
+// kinetic term with qᵗ instead of q̇ᵗ, drop the Δt in the update, and loop while ‖∇E‖ is *below*
+// the tolerance; all three are corrected here (docs: where the notes slip).
+
+#include "12_hyperelastic_newton/hyperelastic.hpp"
+
+#include "10_linear_dynamics/time_integration.hpp"
+
+#include "09_conjugate_gradient/linear_solver.hpp"
+
+#include <Eigen/Core>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace fem::hyper {
+
+/// Every constant of the Newton step, named once (docs/12_hyperelastic_newton.md#newton-with-line-search).
+struct NewtonOptions {
+    double relative_tolerance = 1e-6;  ///< stop when ‖∇E‖ ≤ this × the step's momentum scale
+    int max_iterations = 50;           ///< Newton iterations per step before fem::Error
+    double armijo = 1e-4;              ///< c: accept α when E(v + αd) ≤ E(v) + c α ∇Eᵀd
+    double shrink = 0.5;               ///< α ← shrink · α after a rejected trial
+    double smallest_step = 1e-10;      ///< a line search that needs α below this fails (fem::Error)
+    bool line_search = true;           ///< false: plain Newton, α = 1 always (to show what it risks)
+    std::string solver = "default";    ///< chapter 09's solver of H d = −∇E
+};
+
+/// E(v) of the header comment for the full velocity v (3n), with model's energy at qᵗ + Δt v
+/// (+∞ where the model is undefined). fem::Error on sizes or Δt ≤ 0.
+double backward_euler_objective(dynamics::Body& body, const dynamics::State& state, double time_step,
+                                const Eigen::VectorXd& v);
+
+/// ∇E(v) = M (v − q̇ᵗ) − Δt (f(qᵗ + Δt v) + f_ext) (3n; pinned entries included). fem::Error on sizes,
+/// Δt ≤ 0, or where the model is undefined.
+Eigen::VectorXd backward_euler_gradient(dynamics::Body& body, const dynamics::State& state, double time_step,
+                                        const Eigen::VectorXd& v);
+
+/// The scale the gradient is measured against: ‖M q̇ᵗ‖ + Δt ‖f_ext‖ + Δt ‖f(qᵗ)‖ over the free dofs
+/// (momentum: the inertia and the loads of the step). A step that starts at rest under no load has
+/// scale 0 and a zero gradient: it is converged at once.
+double momentum_scale(const dynamics::Body& body, const dynamics::State& state, double time_step);
+
+/// Backward Euler by Newton's method with a backtracking (Armijo) line search, for any force model
+/// (chapter 10's linear one converges in one iteration). docs/12_hyperelastic_newton.md#newton-with-line-search
+class NewtonBackwardEuler final : public dynamics::Integrator {
+public:
+    /// fem::Error for a tolerance outside (0, 1), a cap < 1, c outside (0, ½), shrink outside (0, 1),
+    /// a smallest step outside (0, 1), or an unknown solver.
+    explicit NewtonBackwardEuler(NewtonOptions options = {});
+
+    std::string name() const override { return "Newton backward Euler"; }
+    int order() const override { return 1; }
+    /// One step: Newton iterations from v = q̇ᵗ until ‖∇E‖ ≤ tol · momentum_scale. fem::Error (state
+    /// unchanged) when the cap is reached, the line search fails, or d is no descent direction (an
+    /// indefinite Hessian: use a projection).
+    dynamics::StepInfo step(dynamics::Body& body, double time_step, dynamics::State& state) override;
+
+    /// ‖∇E‖ / momentum scale at each iteration of the last step (the first entry: at v = q̇ᵗ).
+    const std::vector<double>& gradient_history() const { return gradient_history_; }
+    /// The step lengths α the line search accepted in the last step.
+    const std::vector<double>& step_lengths() const { return step_lengths_; }
+
+private:
+    NewtonOptions options_;
+    std::unique_ptr<cg::LinearSolver> solver_;
+    std::vector<double> gradient_history_, step_lengths_;
+};
+
+}  // namespace fem::hyper

@@ -1,0 +1,136 @@
+#include "12_hyperelastic_newton/hyperelastic.hpp"
+
+#include "common/error.hpp"
+#include "common/vtk_io.hpp"
+
+#include <Eigen/LU>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace fem::hyper {
+
+double element_energy(const Material& material, double volume, const Eigen::Matrix3d& F)
+{
+    return volume * material.energy_density(F);
+}
+
+Vector12d element_forces(const Material& material, double volume, const tet::Jacobian& B, const Eigen::Matrix3d& F)
+{
+    return -volume * (B.transpose() * flatten(material.first_piola(F)));
+}
+
+Matrix12d element_hessian(const Material& material, double volume, const tet::Jacobian& B, const Eigen::Matrix3d& F,
+                          std::optional<Projection> projection)
+{
+    Matrix9d dP = material.piola_derivative(F);
+    if (projection)
+        dP = project_to_psd<9>(dP, *projection);
+    return volume * (B.transpose() * dP * B);
+}
+
+HyperelasticElasticity::HyperelasticElasticity(const TetMesh& mesh, std::unique_ptr<Material> material,
+                                               std::optional<Projection> projection)
+    : mesh_(mesh), material_(std::move(material)), projection_(projection), volumes_(mesh.T.rows()), pattern_(mesh),
+      K_csr_(pattern_.zero_matrix())
+{
+    if (!material_)
+        throw Error("HyperelasticElasticity: no material");
+    B_.reserve(static_cast<std::size_t>(mesh.T.rows()));
+    gradients_.reserve(static_cast<std::size_t>(mesh.T.rows()));
+    for (Eigen::Index t = 0; t < mesh.T.rows(); ++t) {
+        const tet::TetVertices X = tet::tet_vertices(mesh, mesh.V, static_cast<int>(t));
+        B_.push_back(tet::jacobian_matrix(X));  // fem::Error for a zero-volume tet
+        gradients_.push_back(tet::shape_gradients(X));
+        volumes_[t] = std::abs(tet::signed_volume(X));
+    }
+}
+
+MatrixX3d HyperelasticElasticity::positions(const Eigen::VectorXd& u) const
+{
+    if (u.size() != 3 * mesh_.V.rows())
+        throw Error(str("displacement has ", u.size(), " entries, expected 3n = ", 3 * mesh_.V.rows()));
+    return mesh_.V + io::vertex_rows(u);
+}
+
+Eigen::Matrix3d HyperelasticElasticity::deformation_gradient(const MatrixX3d& x, Eigen::Index t) const
+{
+    Eigen::Matrix<double, 4, 3> corners;
+    for (int i = 0; i < 4; ++i)
+        corners.row(i) = x.row(mesh_.T(t, i));
+    return corners.transpose() * gradients_[static_cast<std::size_t>(t)];  // F = Σᵢ xᵢ ∇φᵢᵀ
+}
+
+double HyperelasticElasticity::energy(const Eigen::VectorXd& u)
+{
+    const MatrixX3d x = positions(u);
+    double total = 0.0;
+    for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t) {
+        total += element_energy(*material_, volumes_[t], deformation_gradient(x, t));
+        if (!std::isfinite(total))
+            return std::numeric_limits<double>::infinity();
+    }
+    return total;
+}
+
+double HyperelasticElasticity::evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& forces)
+{
+    const MatrixX3d x = positions(u);
+    forces = Eigen::VectorXd::Zero(u.size());
+    double total = 0.0;
+    for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t) {
+        const Eigen::Matrix3d F = deformation_gradient(x, t);
+        const double e = element_energy(*material_, volumes_[t], F);
+        if (!std::isfinite(e))
+            throw Error(str(material_->name(), ": tet ", t, " has det F = ", F.determinant(),
+                            ", where the material is undefined (inverted)"));
+        total += e;
+        const Vector12d f = element_forces(*material_, volumes_[t], B_[static_cast<std::size_t>(t)], F);
+        for (int i = 0; i < 4; ++i)
+            forces.segment<3>(3 * mesh_.T(t, i)) += f.segment<3>(3 * i);
+    }
+    return total;
+}
+
+const dynamics::SparseMatrix& HyperelasticElasticity::stiffness(const Eigen::VectorXd& u)
+{
+    const MatrixX3d x = positions(u);
+    double* values = K_csr_.valuePtr();
+    std::fill(values, values + K_csr_.nonZeros(), 0.0);
+    for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t)
+        pattern_.add_element(t, element_hessian(*material_, volumes_[t], B_[static_cast<std::size_t>(t)],
+                                                deformation_gradient(x, t), projection_),
+                             values);
+    K_ = assembly::csc_of_symmetric(K_csr_);
+    return K_;
+}
+
+Eigen::VectorXd HyperelasticElasticity::von_mises_stress(const Eigen::VectorXd& u) const
+{
+    const MatrixX3d x = positions(u);
+    Eigen::VectorXd stress(mesh_.T.rows());
+    for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t) {
+        const Eigen::Matrix3d F = deformation_gradient(x, t);
+        const double J = F.determinant();
+        if (!(J > 0.0) && !material_->defined_when_inverted()) {
+            stress[t] = 0.0;
+            continue;
+        }
+        const Eigen::Matrix3d sigma = material_->first_piola(F) * F.transpose() / (J > 0.0 ? J : 1.0);
+        const Eigen::Matrix3d deviator = sigma - sigma.trace() / 3.0 * Eigen::Matrix3d::Identity();
+        stress[t] = std::sqrt(1.5 * deviator.squaredNorm());  // √(3/2 s:s), as chapter 05's von_mises
+    }
+    return stress;
+}
+
+double HyperelasticElasticity::smallest_volume_ratio(const Eigen::VectorXd& u) const
+{
+    const MatrixX3d x = positions(u);
+    double smallest = std::numeric_limits<double>::infinity();
+    for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t)
+        smallest = std::min(smallest, deformation_gradient(x, t).determinant());
+    return smallest;
+}
+
+}  // namespace fem::hyper

@@ -1,0 +1,119 @@
+#include "12_hyperelastic_newton/newton.hpp"
+
+#include "common/error.hpp"
+
+#include <cmath>
+#include <limits>
+
+namespace fem::hyper {
+namespace {
+
+void require_sizes(const dynamics::Body& body, const dynamics::State& state, double time_step, const Eigen::VectorXd& v)
+{
+    require_positive(time_step, "time step dt [s]");
+    const Eigen::Index n = body.dofs().full_size();
+    if (v.size() != n || state.u.size() != n || state.v.size() != n)
+        throw Error(str("backward Euler objective: v, u and q̇ must have 3n = ", n, " entries, got ", v.size(), ", ",
+                        state.u.size(), " and ", state.v.size()));
+}
+
+}  // namespace
+
+double backward_euler_objective(dynamics::Body& body, const dynamics::State& state, double time_step,
+                                const Eigen::VectorXd& v)
+{
+    require_sizes(body, state, time_step, v);
+    const double elastic = body.model().energy(state.u + time_step * v);
+    if (!std::isfinite(elastic))
+        return std::numeric_limits<double>::infinity();
+    const Eigen::VectorXd change = v - state.v;
+    return 0.5 * change.dot(body.mass_matrix() * change) + elastic - time_step * v.dot(body.external_forces());
+}
+
+Eigen::VectorXd backward_euler_gradient(dynamics::Body& body, const dynamics::State& state, double time_step,
+                                        const Eigen::VectorXd& v)
+{
+    require_sizes(body, state, time_step, v);
+    Eigen::VectorXd forces;
+    body.model().evaluate(state.u + time_step * v, forces);
+    return body.mass_matrix() * (v - state.v) - time_step * (forces + body.external_forces());
+}
+
+double momentum_scale(const dynamics::Body& body, const dynamics::State& state, double time_step)
+{
+    const dynamics::FreeDofs& dofs = body.dofs();
+    return dofs.gather(body.mass_matrix() * state.v).norm() + time_step * dofs.gather(body.external_forces()).norm() +
+           time_step * dofs.gather(state.forces).norm();
+}
+
+NewtonBackwardEuler::NewtonBackwardEuler(NewtonOptions options)
+    : options_(std::move(options)), solver_(cg::make_solver(options_.solver))
+{
+    const auto require_in = [](double value, double low, double high, const char* what) {
+        if (!(value > low && value < high))
+            throw Error(str("Newton: ", what, " must lie in (", low, ", ", high, "), got ", value));
+    };
+    require_in(options_.relative_tolerance, 0.0, 1.0, "the relative tolerance");
+    require_in(options_.armijo, 0.0, 0.5, "the Armijo constant c");
+    require_in(options_.shrink, 0.0, 1.0, "the shrink factor");
+    require_in(options_.smallest_step, 0.0, 1.0, "the smallest step");
+    if (options_.max_iterations < 1)
+        throw Error(str("Newton: the iteration cap must be >= 1, got ", options_.max_iterations));
+}
+
+dynamics::StepInfo NewtonBackwardEuler::step(dynamics::Body& body, double time_step, dynamics::State& state)
+{
+    require_positive(time_step, "time step dt [s]");
+    const dynamics::Damping& damping = body.scene().damping;
+    if (damping.alpha != 0.0 || damping.beta != 0.0)
+        throw Error("Newton backward Euler: Rayleigh damping is not part of its objective yet; set alpha = beta = 0");
+    const dynamics::FreeDofs& dofs = body.dofs();
+    const double scale = momentum_scale(body, state, time_step);
+    gradient_history_.clear();
+    step_lengths_.clear();
+    dynamics::StepInfo info;
+    Eigen::VectorXd v = state.v;  // the start: the last velocity
+    for (int iteration = 0;; ++iteration) {
+        const Eigen::VectorXd gradient = dofs.gather(backward_euler_gradient(body, state, time_step, v));
+        const double norm = gradient.norm();
+        gradient_history_.push_back(scale > 0.0 ? norm / scale : norm);
+        if (norm <= options_.relative_tolerance * scale)
+            break;
+        if (iteration == options_.max_iterations)
+            throw Error(str("Newton: step ", state.step + 1, " (t = ", state.time + time_step, " s) did not converge in ",
+                            options_.max_iterations, " iterations: |grad E| / scale = ", norm / scale,
+                            " (tolerance ", options_.relative_tolerance, "); use a smaller dt or raise the cap"));
+        // The Newton direction: H d = −∇E on the free dofs, H = M + Δt² K(qᵗ + Δt v).
+        const dynamics::SparseMatrix H = dofs.reduce(dynamics::step_matrix(
+            body.mass_matrix(), body.model().stiffness(state.u + time_step * v), dynamics::Damping{}, time_step, 1.0));
+        solver_->prepare(H);
+        Eigen::VectorXd direction = solver_->solve(-gradient);
+        info.solver_iterations += solver_->stats().iterations;
+        const double slope = gradient.dot(direction);
+        if (!(slope < 0.0))
+            throw Error(str("Newton: step ", state.step + 1, ": the direction is not a descent direction (∇Eᵀd = ", slope,
+                            "): the Hessian is indefinite; project the element Hessians"));
+        Eigen::VectorXd d_full = Eigen::VectorXd::Zero(v.size());
+        dofs.scatter(direction, d_full);
+        // Backtracking: the largest α = shrinkᵏ with E(v + α d) ≤ E(v) + c α ∇Eᵀd.
+        double alpha = 1.0;
+        if (options_.line_search) {
+            const double start = backward_euler_objective(body, state, time_step, v);
+            while (!(backward_euler_objective(body, state, time_step, v + alpha * d_full) <=
+                     start + options_.armijo * alpha * slope)) {
+                alpha *= options_.shrink;
+                if (alpha < options_.smallest_step)
+                    throw Error(str("Newton: step ", state.step + 1, ": the line search found no decrease down to α = ",
+                                    options_.smallest_step));
+            }
+        }
+        step_lengths_.push_back(alpha);
+        v += alpha * d_full;
+        ++info.newton_iterations;
+    }
+    info.prepared = info.newton_iterations > 0;
+    dynamics::commit_step(body.model(), time_step, state.u + time_step * v, v, state);
+    return info;
+}
+
+}  // namespace fem::hyper

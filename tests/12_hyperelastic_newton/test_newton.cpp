@@ -1,0 +1,173 @@
+// Chapter 12: the hyperelastic force model and backward Euler by Newton's method, against finite
+// differences, chapter 10's linear step, the patch test and quadratic convergence.
+// docs/12_hyperelastic_newton.md
+#include "12_hyperelastic_newton/hyperelastic.hpp"
+#include "12_hyperelastic_newton/newton.hpp"
+
+#include "06_assembly/assembly.hpp"
+
+#include "common/error.hpp"
+#include "common/mesh.hpp"
+#include "common/random.hpp"
+#include "common/vtk_io.hpp"
+
+#include "../common/test_support.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+using namespace fem;
+using namespace fem::hyper;
+using Catch::Matchers::Contains;
+
+namespace {
+
+double best(const std::vector<double>& errors)
+{
+    return *std::min_element(errors.begin(), errors.end());
+}
+
+dynamics::Scene cube_scene(double youngs, double poisson)
+{
+    dynamics::Scene scene;
+    scene.mesh = box_mesh(2, 2, 2, Eigen::Vector3d(0.1, 0.1, 0.1));
+    scene.material = {youngs, poisson, 1000.0};
+    scene.pinned = assembly::vertices_on_plane(scene.mesh, 2, 0.0);
+    scene.time_step = 1.0 / 30.0;
+    return scene;
+}
+
+}  // namespace
+
+TEST_CASE("hyperelastic model: forces are -dU/du and K is df/du (finite differences), for every material", "[ch12]")
+{
+    const TetMesh mesh = box_mesh(2, 1, 1, Eigen::Vector3d(0.2, 0.1, 0.1));
+    const Eigen::VectorXd u = 0.01 * fem::random_vector(3 * mesh.V.rows(), 3);
+    const Eigen::VectorXd direction = fem::random_vector(u.size(), 4);
+    for (const std::string& name : material_names()) {
+        HyperelasticElasticity model(mesh, make_material(name, 1e5, 0.4), std::nullopt);
+        Eigen::VectorXd f;
+        model.evaluate(u, f);
+        const double force_error = best(test::central_difference_errors(
+            [&](double h) { return Eigen::VectorXd::Constant(1, model.energy(u + h * direction)); },
+            Eigen::VectorXd::Constant(1, -f.dot(direction)), 0.01));
+        const Eigen::VectorXd K_d = model.stiffness(u) * direction;
+        const double hessian_error = best(test::central_difference_errors(
+            [&](double h) {
+                Eigen::VectorXd g;
+                model.evaluate(u + h * direction, g);
+                return Eigen::VectorXd(-g);
+            },
+            K_d, 0.01));
+        CAPTURE(name, force_error, hessian_error);
+        CHECK(force_error < 1e-6);
+        CHECK(hessian_error < 1e-6);
+    }
+}
+
+TEST_CASE("hyperelastic model: the affine patch test and rigid motions", "[ch12]")
+{
+    const TetMesh mesh = box_mesh(3, 3, 3);
+    Eigen::Matrix3d F;
+    F << 1.1, 0.05, 0.0, -0.02, 0.95, 0.03, 0.01, 0.0, 1.05;
+    const MatrixX3d x = mesh.V * F.transpose();
+    const Eigen::VectorXd u = Eigen::Map<const Eigen::VectorXd>(MatrixX3d(x - mesh.V).data(), 3 * mesh.V.rows());
+    Eigen::VectorXd u_vertex_major(u.size());
+    const MatrixX3d displacement = x - mesh.V;
+    for (Eigen::Index v = 0; v < mesh.V.rows(); ++v)
+        u_vertex_major.segment<3>(3 * v) = displacement.row(v).transpose();
+    for (const std::string& name : material_names()) {
+        HyperelasticElasticity model(mesh, make_material(name, 1e5, 0.4));
+        Eigen::VectorXd f;
+        model.evaluate(u_vertex_major, f);
+        // Interior vertices (not on the boundary of the unit cube) feel no net force.
+        double interior = 0.0, scale = 0.0;
+        for (Eigen::Index v = 0; v < mesh.V.rows(); ++v) {
+            const bool inside = (mesh.V.row(v).array() > 1e-9).all() && (mesh.V.row(v).array() < 1.0 - 1e-9).all();
+            (inside ? interior : scale) = std::max(inside ? interior : scale, f.segment<3>(3 * v).norm());
+        }
+        CAPTURE(name, interior, scale);
+        CHECK(scale > 0.0);
+        CHECK(interior <= 1e-10 * scale);
+        // The energy is V ψ(F) for the whole unit cube.
+        CHECK(model.energy(u_vertex_major) == Approx(model.material().energy_density(F)).epsilon(1e-10));
+    }
+}
+
+TEST_CASE("Newton backward Euler: one iteration and chapter 10's step for a linear body", "[ch12]")
+{
+    dynamics::Scene scene = cube_scene(1e5, 0.3);
+    dynamics::Body newton_body(scene), theta_body(scene);
+    NewtonBackwardEuler newton;
+    dynamics::ThetaMethod theta(1.0);
+    dynamics::State a = dynamics::initial_state(newton_body), b = dynamics::initial_state(theta_body);
+    for (int k = 0; k < 5; ++k) {
+        const dynamics::StepInfo info = newton.step(newton_body, scene.time_step, a);
+        theta.step(theta_body, scene.time_step, b);
+        CHECK(info.newton_iterations == 1);
+    }
+    CHECK((a.u - b.u).norm() <= 1e-8 * b.u.norm());
+    CHECK((a.v - b.v).norm() <= 1e-8 * b.v.norm());
+}
+
+TEST_CASE("Newton backward Euler: the gradient and Hessian of E by finite differences, quadratic convergence",
+          "[ch12]")
+{
+    dynamics::Scene scene = cube_scene(1e5, 0.4);
+    scene.gravity = Eigen::Vector3d(0.0, 0.0, -200.0);  // a large sag: a nonlinear step
+    dynamics::Body body(scene, std::make_unique<HyperelasticElasticity>(scene.mesh, make_material("neo-hookean", 1e5, 0.4)));
+    const dynamics::State state = dynamics::initial_state(body);
+    const Eigen::VectorXd v = 0.3 * fem::random_vector(state.v.size(), 9).cwiseProduct(body.dofs().free_mask());
+    const Eigen::VectorXd direction = fem::random_vector(v.size(), 10).cwiseProduct(body.dofs().free_mask());
+    const double dt = scene.time_step;
+    const Eigen::VectorXd gradient = backward_euler_gradient(body, state, dt, v);
+    CHECK(best(test::central_difference_errors(
+              [&](double h) { return Eigen::VectorXd::Constant(1, backward_euler_objective(body, state, dt, v + h * direction)); },
+              Eigen::VectorXd::Constant(1, gradient.dot(direction)), 0.1)) < 1e-6);
+    HyperelasticElasticity exact(scene.mesh, make_material("neo-hookean", 1e5, 0.4), std::nullopt);  // no projection
+    const Eigen::VectorXd H_d = dynamics::step_matrix(body.mass_matrix(), exact.stiffness(state.u + dt * v),
+                                                      dynamics::Damping{}, dt, 1.0) * direction;
+    CHECK(best(test::central_difference_errors([&](double h) { return backward_euler_gradient(body, state, dt, v + h * direction); },
+                                               H_d, 0.1)) < 1e-6);
+
+    // Quadratic convergence needs the true Hessian: the body with the unprojected model.
+    dynamics::Body exact_body(scene, std::make_unique<HyperelasticElasticity>(scene.mesh, make_material("neo-hookean", 1e5, 0.4),
+                                                                                  std::nullopt));
+    NewtonOptions options;
+    options.relative_tolerance = 1e-8;
+    NewtonBackwardEuler newton(options);
+    dynamics::State stepped = dynamics::initial_state(exact_body);
+    newton.step(exact_body, dt, stepped);
+    const std::vector<double>& g = newton.gradient_history();
+    CAPTURE(g);
+    REQUIRE(g.size() >= 4);
+    // Near the solution the gradient falls quadratically: g_{k+1} ≤ C g_k² with a modest C, on the
+    // last iteration that starts below 10⁻² (full steps there: α = 1).
+    std::size_t k = g.size() - 2;
+    while (k > 0 && g[k] < 1e-6)
+        --k;
+    CAPTURE(g[k], g[k + 1]);
+    CHECK(g[k] < 1e-2);
+    CHECK(g[k + 1] <= 100.0 * g[k] * g[k]);
+    CHECK(g.back() <= 1e-8);
+    for (const double alpha : newton.step_lengths())
+        CHECK(alpha > 0.0);
+}
+
+TEST_CASE("Newton backward Euler: bad options are refused", "[ch12]")
+{
+    NewtonOptions bad;
+    bad.relative_tolerance = 1.5;
+    CHECK_THROWS_WITH(NewtonBackwardEuler(bad), Contains("relative tolerance"));
+    bad = {};
+    bad.max_iterations = 0;
+    CHECK_THROWS_AS(NewtonBackwardEuler(bad), Error);
+    bad = {};
+    bad.armijo = 0.7;
+    CHECK_THROWS_AS(NewtonBackwardEuler(bad), Error);
+    bad = {};
+    bad.solver = "nonsense";
+    CHECK_THROWS_AS(NewtonBackwardEuler(bad), Error);
+}
