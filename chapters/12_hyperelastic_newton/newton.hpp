@@ -35,10 +35,16 @@ struct NewtonOptions {
     std::string solver = "default";    ///< chapter 09's solver of H d = −∇E
 };
 
+/// The relative round-off of the objective: the line search accepts a trial whose E misses the
+/// Armijo line by less than this times the size of E's terms (|kinetic| + |U| + |work|), where a
+/// difference of E says nothing. Near convergence that is what keeps a step from failing.
+inline constexpr double objective_round_off = 1e-13;
+
 /// E(v) of the header comment for the full velocity v (3n), with model's energy at qᵗ + Δt v
-/// (+∞ where the model is undefined). fem::Error on sizes or Δt ≤ 0.
+/// (+∞ where the model is undefined); magnitude (if given) receives |½ΔvᵀMΔv| + |U| + |Δt vᵀf_ext|,
+/// the scale of E's round-off. fem::Error on sizes or Δt ≤ 0.
 double backward_euler_objective(dynamics::Body& body, const dynamics::State& state, double time_step,
-                                const Eigen::VectorXd& v);
+                                const Eigen::VectorXd& v, double* magnitude = nullptr);
 
 /// ∇E(v) = M (v − q̇ᵗ) − Δt (f(qᵗ + Δt v) + f_ext) (3n; pinned entries included). fem::Error on sizes,
 /// Δt ≤ 0, or where the model is undefined.
@@ -60,7 +66,8 @@ public:
 
     std::string name() const override { return "Newton backward Euler"; }
     int order() const override { return 1; }
-    /// One step: Newton iterations from v = q̇ᵗ until ‖∇E‖ ≤ tol · momentum_scale. fem::Error (state
+    /// One step: Newton iterations from v = q̇ᵗ (or v = 0 when E(q̇ᵗ) = +∞) until
+    /// ‖∇E‖ ≤ tol · momentum_scale. fem::Error (state
     /// unchanged) when the cap is reached, the line search fails, or d is no descent direction (an
     /// indefinite Hessian: use a projection).
     dynamics::StepInfo step(dynamics::Body& body, double time_step, dynamics::State& state) override;

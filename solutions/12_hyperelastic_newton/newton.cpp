@@ -20,14 +20,18 @@ void require_sizes(const dynamics::Body& body, const dynamics::State& state, dou
 }  // namespace
 
 double backward_euler_objective(dynamics::Body& body, const dynamics::State& state, double time_step,
-                                const Eigen::VectorXd& v)
+                                const Eigen::VectorXd& v, double* magnitude)
 {
     require_sizes(body, state, time_step, v);
     const double elastic = body.model().energy(state.u + time_step * v);
     if (!std::isfinite(elastic))
         return std::numeric_limits<double>::infinity();
     const Eigen::VectorXd change = v - state.v;
-    return 0.5 * change.dot(body.mass_matrix() * change) + elastic - time_step * v.dot(body.external_forces());
+    const double kinetic = 0.5 * change.dot(body.mass_matrix() * change);
+    const double work = time_step * v.dot(body.external_forces());
+    if (magnitude != nullptr)
+        *magnitude = std::abs(kinetic) + std::abs(elastic) + std::abs(work);
+    return kinetic + elastic - work;
 }
 
 Eigen::VectorXd backward_euler_gradient(dynamics::Body& body, const dynamics::State& state, double time_step,
@@ -72,7 +76,11 @@ dynamics::StepInfo NewtonBackwardEuler::step(dynamics::Body& body, double time_s
     gradient_history_.clear();
     step_lengths_.clear();
     dynamics::StepInfo info;
-    Eigen::VectorXd v = state.v;  // the start: the last velocity
+    // The start: the last velocity, unless it already leaves the material's domain (a neo-Hookean
+    // tet inverted by qᵗ + Δt q̇ᵗ); then v = 0, which keeps qᵗ, where E is finite.
+    Eigen::VectorXd v = state.v;
+    if (!std::isfinite(backward_euler_objective(body, state, time_step, v)))
+        v.setZero();
     for (int iteration = 0;; ++iteration) {
         const Eigen::VectorXd gradient = dofs.gather(backward_euler_gradient(body, state, time_step, v));
         const double norm = gradient.norm();
@@ -98,9 +106,12 @@ dynamics::StepInfo NewtonBackwardEuler::step(dynamics::Body& body, double time_s
         // Backtracking: the largest α = shrinkᵏ with E(v + α d) ≤ E(v) + c α ∇Eᵀd.
         double alpha = 1.0;
         if (options_.line_search) {
-            const double start = backward_euler_objective(body, state, time_step, v);
+            double magnitude = 0.0;
+            const double start = backward_euler_objective(body, state, time_step, v, &magnitude);
+            // E is a sum of terms that cancel; differences below its round-off carry no information.
+            const double noise = objective_round_off * magnitude;
             while (!(backward_euler_objective(body, state, time_step, v + alpha * d_full) <=
-                     start + options_.armijo * alpha * slope)) {
+                     start + options_.armijo * alpha * slope + noise)) {
                 alpha *= options_.shrink;
                 if (alpha < options_.smallest_step)
                     throw Error(str("Newton: step ", state.step + 1, ": the line search found no decrease down to α = ",

@@ -156,6 +156,64 @@ TEST_CASE("Newton backward Euler: the gradient and Hessian of E by finite differ
         CHECK(alpha > 0.0);
 }
 
+TEST_CASE("Newton backward Euler: the line search keeps neo-Hookean tets uninverted where plain Newton fails",
+          "[ch12]")
+{
+    // A soft cube pinned at its base, its top slammed down at 40 m/s: one step of 1/24 s would move
+    // the top by sixteen times the cube's height.
+    dynamics::Scene scene = cube_scene(1e5, 0.4);
+    scene.gravity.setZero();
+    scene.time_step = 1.0 / 24.0;
+    Eigen::VectorXd v0 = Eigen::VectorXd::Zero(3 * scene.mesh.V.rows());
+    for (Eigen::Index v = 0; v < scene.mesh.V.rows(); ++v)
+        v0[3 * v + 2] = -400.0 * scene.mesh.V(v, 2);  // −40 m/s at the top, 0 at the pinned base
+    const auto run = [&](bool line_search, double& smallest_ratio, int& iterations) {
+        auto model = std::make_unique<HyperelasticElasticity>(scene.mesh, make_material("neo-hookean", 1e4, 0.4));
+        const HyperelasticElasticity& view = *model;
+        dynamics::Body body(scene, std::move(model));
+        NewtonOptions options;
+        options.line_search = line_search;
+        NewtonBackwardEuler newton(options);
+        dynamics::State state = dynamics::initial_state(body, {}, v0);
+        const dynamics::StepInfo info = newton.step(body, scene.time_step, state);
+        smallest_ratio = view.smallest_volume_ratio(state.u);
+        iterations = info.newton_iterations;
+    };
+    double ratio = 0.0;
+    int iterations = 0;
+    CHECK_THROWS_WITH(run(false, ratio, iterations), Contains("det F"));  // plain Newton inverts a tet
+    REQUIRE_NOTHROW(run(true, ratio, iterations));
+    CAPTURE(ratio, iterations);
+    CHECK(ratio > 0.0);  // every tet still positively oriented
+}
+
+TEST_CASE("stable neo-Hookean: a tet squashed through inversion recovers, neo-Hookean refuses to start", "[ch12]")
+{
+    dynamics::Scene scene;
+    scene.mesh = box_mesh(1, 1, 1, Eigen::Vector3d(0.1, 0.1, 0.1));
+    scene.material = {1e5, 0.4, 1000.0};
+    scene.gravity.setZero();
+    scene.pinned = assembly::vertices_on_plane(scene.mesh, 2, 0.0);
+    scene.time_step = 1.0 / 60.0;
+    // The top face pushed 1.5 heights down: through the base, every tet inverted.
+    Eigen::VectorXd u0 = Eigen::VectorXd::Zero(3 * scene.mesh.V.rows());
+    for (Eigen::Index v = 0; v < scene.mesh.V.rows(); ++v)
+        u0[3 * v + 2] = -1.5 * scene.mesh.V(v, 2);
+    auto stable_model = std::make_unique<HyperelasticElasticity>(scene.mesh, make_material("stable-neo-hookean", 1e5, 0.4));
+    const HyperelasticElasticity& stable = *stable_model;
+    dynamics::Body body(scene, std::move(stable_model));
+    dynamics::State state = dynamics::initial_state(body, u0);
+    CHECK(stable.smallest_volume_ratio(state.u) < 0.0);
+    NewtonBackwardEuler newton;
+    for (int k = 0; k < 60; ++k) {
+        newton.step(body, scene.time_step, state);
+        REQUIRE(state.u.allFinite());
+    }
+    CHECK(stable.smallest_volume_ratio(state.u) > 0.0);  // every tet turned right side out again
+    dynamics::Body neo(scene, std::make_unique<HyperelasticElasticity>(scene.mesh, make_material("neo-hookean", 1e5, 0.4)));
+    CHECK_THROWS_WITH(dynamics::initial_state(neo, u0), Contains("det F"));
+}
+
 TEST_CASE("Newton backward Euler: bad options are refused", "[ch12]")
 {
     NewtonOptions bad;
