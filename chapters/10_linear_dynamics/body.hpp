@@ -102,6 +102,11 @@ public:
     /// The tangent stiffness K(u) = ∂²U/∂u² = −∂f/∂u (3n×3n, both triangles stored).
     virtual const SparseMatrix& stiffness(const Eigen::VectorXd& u) = 0;
 
+    /// A positive semi-definite stand-in for K(u), for a Newton step whose K(u) is indefinite
+    /// (chapter 12 projects its element Hessians). The default: stiffness(u), for models whose K
+    /// is never indefinite.
+    virtual const SparseMatrix& definite_stiffness(const Eigen::VectorXd& u) { return stiffness(u); }
+
     /// True when K does not depend on u (linear elasticity): an implicit step then factors its
     /// matrix once for the whole run.
     virtual bool constant_stiffness() const = 0;

@@ -21,27 +21,29 @@ namespace fem::hyper {
 
 using Vector12d = Eigen::Matrix<double, 12, 1>;
 
-/// One tet's elastic energy V ψ(F) [J] (V its rest volume, F = mat(B x_e)).
-double element_energy(const Material& material, double volume, const Eigen::Matrix3d& F);
+/// One tet's elastic energy V ψ(F) [J] (V its rest volume, F = I + H, H = mat(B u_e) its
+/// displacement gradient).
+double element_energy(const Material& material, double volume, const Eigen::Matrix3d& H);
 
 /// One tet's internal forces f_e = −V Bᵀ vec(P(F)) (12, vertex-major; B: chapter 04's 9×12).
 /// docs/12_hyperelastic_newton.md#element-forces-and-hessians
-Vector12d element_forces(const Material& material, double volume, const tet::Jacobian& B, const Eigen::Matrix3d& F);
+Vector12d element_forces(const Material& material, double volume, const tet::Jacobian& B, const Eigen::Matrix3d& H);
 
 /// One tet's Hessian V Bᵀ (∂P/∂F) B (12×12), with ∂P/∂F first made positive semi-definite when
 /// projection is set (then the element Hessian is too: Bᵀ A B is PSD for PSD A).
 /// docs/12_hyperelastic_newton.md#definiteness
-Matrix12d element_hessian(const Material& material, double volume, const tet::Jacobian& B, const Eigen::Matrix3d& F,
+Matrix12d element_hessian(const Material& material, double volume, const tet::Jacobian& B, const Eigen::Matrix3d& H,
                           std::optional<Projection> projection);
 
-/// A hyperelastic body: U(u) = Σ V_t ψ(F_t), f = −∂U/∂u, K = ∂²U/∂u² (optionally projected per
-/// element), K written into chapter 06's fixed CSR pattern every call.
+/// A hyperelastic body: U(u) = Σ V_t ψ(F_t), f = −∂U/∂u, K = ∂²U/∂u² (the true Hessian, possibly
+/// indefinite) and a definite stand-in with every element Hessian projected; either is written into
+/// chapter 06's fixed CSR pattern every call.
 class HyperelasticElasticity final : public dynamics::ForceModel {
 public:
-    /// B and V of every rest tet and the pattern. projection: none (the true Hessian, possibly
-    /// indefinite) or clamp/absolute per element. fem::Error for a zero-volume rest tet or bad indices.
+    /// B and V of every rest tet and the pattern; projection: how definite_stiffness makes each
+    /// element Hessian PSD. fem::Error for a zero-volume rest tet or bad indices.
     HyperelasticElasticity(const TetMesh& mesh, std::unique_ptr<Material> material,
-                           std::optional<Projection> projection = Projection::clamp);
+                           Projection projection = Projection::clamp);
 
     std::string name() const override { return material_->name(); }
     /// U(u) and f(u). fem::Error naming the first tet where the material is undefined (an
@@ -49,7 +51,10 @@ public:
     double evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& forces) override;
     /// U(u) alone: +∞ if any tet is where the material is undefined (the line search's test).
     double energy(const Eigen::VectorXd& u) override;
+    /// The true Hessian K(u) (3n×3n).
     const dynamics::SparseMatrix& stiffness(const Eigen::VectorXd& u) override;
+    /// Σ of the element Hessians projected to PSD (3n×3n, PSD).
+    const dynamics::SparseMatrix& definite_stiffness(const Eigen::VectorXd& u) override;
     bool constant_stiffness() const override { return false; }
     /// von Mises of the Cauchy stress σ = P Fᵀ / J per tet (0 for a tet with J ≤ 0).
     Eigen::VectorXd von_mises_stress(const Eigen::VectorXd& u) const override;
@@ -59,13 +64,15 @@ public:
     double smallest_volume_ratio(const Eigen::VectorXd& u) const;
 
 private:
-    /// F of tet t from the deformed positions x (#V×3).
-    Eigen::Matrix3d deformation_gradient(const MatrixX3d& x, Eigen::Index t) const;
-    MatrixX3d positions(const Eigen::VectorXd& u) const;
+    /// H = ∇u = Σᵢ uᵢ ∇φᵢᵀ of tet t from the displacements (#V×3): F − I without its round-off.
+    Eigen::Matrix3d displacement_gradient(const MatrixX3d& displacement, Eigen::Index t) const;
+    MatrixX3d displacement_rows(const Eigen::VectorXd& u) const;
+    /// K(u) assembled with every element Hessian projected (when projection is set) or not.
+    const dynamics::SparseMatrix& assemble_hessian(const Eigen::VectorXd& u, std::optional<Projection> projection);
 
     TetMesh mesh_;
     std::unique_ptr<Material> material_;
-    std::optional<Projection> projection_;
+    Projection projection_;
     std::vector<tet::Jacobian> B_;
     std::vector<tet::ShapeGradients> gradients_;
     Eigen::VectorXd volumes_;

@@ -7,6 +7,12 @@
 // tet of rest volume V has the energy V ψ(F), the forces f_e = −V Bᵀ vec(P) and the Hessian
 // V Bᵀ (∂P/∂F) B (12×12). Every material is parametrised by the Lamé λ, μ of chapter 05 and agrees
 // with linear elasticity (chapter 05) for small strains.
+//
+// The functions take the displacement gradient H = ∇u = F − I, not F: near rest ψ and P are small
+// differences of terms of size μ (tr(FᵀF) − 3, J − 1, F − J F⁻ᵀ), and written in H those differences
+// are exact (tr(FᵀF) − 3 = 2 tr H + ‖H‖², J − 1 = tr H + ½(tr²H − tr H²) + det H). Computed from F,
+// they carry a round-off of ε μ that swamps the stress of a small strain and stalls Newton when a
+// body comes to rest (docs: round-off near rest). ∂/∂F = ∂/∂H.
 
 #include "05_strain_stress/strain_stress.hpp"
 
@@ -35,13 +41,13 @@ public:
     virtual std::string name() const = 0;
     /// Whether ψ, P and ∂P/∂F are defined for det F ≤ 0 (an inverted or flat element).
     virtual bool defined_when_inverted() const = 0;
-    /// ψ(F). +∞ where the material is undefined (det F ≤ 0 for neo-Hookean), so that a line search
-    /// rejects the step.
-    virtual double energy_density(const Eigen::Matrix3d& F) const = 0;
-    /// P = ∂ψ/∂F (3×3). fem::Error where the material is undefined.
-    virtual Eigen::Matrix3d first_piola(const Eigen::Matrix3d& F) const = 0;
-    /// ∂P/∂F (9×9, row-major vec on both sides). fem::Error where the material is undefined.
-    virtual Matrix9d piola_derivative(const Eigen::Matrix3d& F) const = 0;
+    /// ψ(F) at F = I + H. +∞ where the material is undefined (det F ≤ 0 for neo-Hookean), so that a
+    /// line search rejects the step. fem::Error for a non-finite H.
+    virtual double energy_density(const Eigen::Matrix3d& H) const = 0;
+    /// P = ∂ψ/∂F (3×3) at F = I + H. fem::Error where the material is undefined.
+    virtual Eigen::Matrix3d first_piola(const Eigen::Matrix3d& H) const = 0;
+    /// ∂P/∂F (9×9, row-major vec on both sides) at F = I + H. fem::Error where the material is undefined.
+    virtual Matrix9d piola_derivative(const Eigen::Matrix3d& H) const = 0;
     const elastic::Lame& lame() const { return lame_; }
 
 private:
@@ -57,9 +63,9 @@ public:
     using Material::Material;
     std::string name() const override { return "stvk"; }
     bool defined_when_inverted() const override { return true; }
-    double energy_density(const Eigen::Matrix3d& F) const override;
-    Eigen::Matrix3d first_piola(const Eigen::Matrix3d& F) const override;
-    Matrix9d piola_derivative(const Eigen::Matrix3d& F) const override;
+    double energy_density(const Eigen::Matrix3d& H) const override;
+    Eigen::Matrix3d first_piola(const Eigen::Matrix3d& H) const override;
+    Matrix9d piola_derivative(const Eigen::Matrix3d& H) const override;
 };
 
 /// Neo-Hookean: ψ = (μ/2)(tr(FᵀF) − 3) − μ ln J + (λ/2)(ln J)², J = det F;
@@ -70,9 +76,9 @@ public:
     using Material::Material;
     std::string name() const override { return "neo-hookean"; }
     bool defined_when_inverted() const override { return false; }
-    double energy_density(const Eigen::Matrix3d& F) const override;
-    Eigen::Matrix3d first_piola(const Eigen::Matrix3d& F) const override;
-    Matrix9d piola_derivative(const Eigen::Matrix3d& F) const override;
+    double energy_density(const Eigen::Matrix3d& H) const override;
+    Eigen::Matrix3d first_piola(const Eigen::Matrix3d& H) const override;
+    Matrix9d piola_derivative(const Eigen::Matrix3d& H) const override;
 };
 
 /// Stable neo-Hookean (Smith, de Goes, Kim 2018, in the form without the log term):
@@ -87,9 +93,9 @@ public:
     using Material::Material;
     std::string name() const override { return "stable-neo-hookean"; }
     bool defined_when_inverted() const override { return true; }
-    double energy_density(const Eigen::Matrix3d& F) const override;
-    Eigen::Matrix3d first_piola(const Eigen::Matrix3d& F) const override;
-    Matrix9d piola_derivative(const Eigen::Matrix3d& F) const override;
+    double energy_density(const Eigen::Matrix3d& H) const override;
+    Eigen::Matrix3d first_piola(const Eigen::Matrix3d& H) const override;
+    Matrix9d piola_derivative(const Eigen::Matrix3d& H) const override;
 };
 
 /// The material called `name` ("stvk", "neo-hookean", "stable-neo-hookean") with the Lamé
@@ -103,6 +109,12 @@ std::vector<std::string> material_names();
 /// The cofactor matrix C = ∂(det F)/∂F (3×3): its rows are cross products of F's rows, so it is
 /// defined for every F and equals det F · F⁻ᵀ when F is invertible.
 Eigen::Matrix3d cofactor(const Eigen::Matrix3d& F);
+
+/// det(I + H) − 1 = tr H + ½(tr²H − tr(H²)) + det H, without the cancellation of det F − 1.
+double volume_change(const Eigen::Matrix3d& H);
+
+/// cofactor(I + H) − I = tr H · I − Hᵀ + cofactor(H), without the cancellation.
+Eigen::Matrix3d cofactor_change(const Eigen::Matrix3d& H);
 
 /// How a symmetric matrix is made positive semi-definite (docs/12_hyperelastic_newton.md#definiteness).
 enum class Projection {

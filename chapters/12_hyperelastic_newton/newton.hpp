@@ -24,6 +24,16 @@
 
 namespace fem::hyper {
 
+/// Which Hessian a Newton iteration solves with (docs/12_hyperelastic_newton.md#definiteness).
+enum class HessianChoice {
+    exact_then_definite,  ///< M + Δt² K; if that is not positive definite (the factorization fails or
+                          ///< d is no descent direction), M + Δt² K_PSD (the default: quadratic
+                          ///< convergence wherever the exact Hessian allows it)
+    definite,             ///< always M + Δt² K_PSD (ForceModel::definite_stiffness): safe, linear
+                          ///< convergence where the projection changed K
+    exact,                ///< always M + Δt² K: fails with fem::Error where K is too indefinite
+};
+
 /// Every constant of the Newton step, named once (docs/12_hyperelastic_newton.md#newton-with-line-search).
 struct NewtonOptions {
     double relative_tolerance = 1e-6;  ///< stop when ‖∇E‖ ≤ this × the step's momentum scale
@@ -32,6 +42,7 @@ struct NewtonOptions {
     double shrink = 0.5;               ///< α ← shrink · α after a rejected trial
     double smallest_step = 1e-10;      ///< a line search that needs α below this fails (fem::Error)
     bool line_search = true;           ///< false: plain Newton, α = 1 always (to show what it risks)
+    HessianChoice hessian = HessianChoice::exact_then_definite;
     std::string solver = "default";    ///< chapter 09's solver of H d = −∇E
 };
 
@@ -76,11 +87,19 @@ public:
     const std::vector<double>& gradient_history() const { return gradient_history_; }
     /// The step lengths α the line search accepted in the last step.
     const std::vector<double>& step_lengths() const { return step_lengths_; }
+    /// How many iterations of the last step fell back to the definite Hessian.
+    int definite_fallbacks() const { return definite_fallbacks_; }
 
 private:
     NewtonOptions options_;
     std::unique_ptr<cg::LinearSolver> solver_;
+    /// d with H d = −gradient for the chosen Hessian at u; slope = gradientᵀd. False if that Hessian
+    /// is not positive definite or d is no descent direction.
+    bool newton_direction(dynamics::Body& body, const Eigen::VectorXd& u, double time_step, bool definite,
+                          const Eigen::VectorXd& gradient, Eigen::VectorXd& direction, double& slope, int& iterations);
+
     std::vector<double> gradient_history_, step_lengths_;
+    int definite_fallbacks_ = 0;
 };
 
 }  // namespace fem::hyper

@@ -67,6 +67,25 @@ NewtonBackwardEuler::NewtonBackwardEuler(NewtonOptions options)
         throw Error(str("Newton: the iteration cap must be >= 1, got ", options_.max_iterations));
 }
 
+bool NewtonBackwardEuler::newton_direction(dynamics::Body& body, const Eigen::VectorXd& u, double time_step,
+                                           bool definite, const Eigen::VectorXd& gradient, Eigen::VectorXd& direction,
+                                           double& slope, int& iterations)
+{
+    dynamics::ForceModel& model = body.model();
+    const dynamics::SparseMatrix& K = definite ? model.definite_stiffness(u) : model.stiffness(u);
+    try {
+        solver_->prepare(body.dofs().reduce(dynamics::step_matrix(body.mass_matrix(), K, dynamics::Damping{}, time_step, 1.0)));
+        direction = solver_->solve(-gradient);
+    } catch (const Error&) {
+        if (definite)
+            throw;  // a definite Hessian that fails to factor is a real error, not a choice
+        return false;
+    }
+    iterations += solver_->stats().iterations;
+    slope = gradient.dot(direction);
+    return slope < 0.0;
+}
+
 dynamics::StepInfo NewtonBackwardEuler::step(dynamics::Body& body, double time_step, dynamics::State& state)
 {
     require_positive(time_step, "time step dt [s]");
@@ -77,6 +96,7 @@ dynamics::StepInfo NewtonBackwardEuler::step(dynamics::Body& body, double time_s
     const double scale = momentum_scale(body, state, time_step);
     gradient_history_.clear();
     step_lengths_.clear();
+    definite_fallbacks_ = 0;
     dynamics::StepInfo info;
     // The start: the last velocity, unless it already leaves the material's domain (a neo-Hookean
     // tet inverted by qᵗ + Δt q̇ᵗ); then v = 0, which keeps qᵗ, where E is finite.
@@ -94,15 +114,18 @@ dynamics::StepInfo NewtonBackwardEuler::step(dynamics::Body& body, double time_s
                             options_.max_iterations, " iterations: |grad E| / scale = ", norm / scale,
                             " (tolerance ", options_.relative_tolerance, "); use a smaller dt or raise the cap"));
         // The Newton direction: H d = −∇E on the free dofs, H = M + Δt² K(qᵗ + Δt v).
-        const dynamics::SparseMatrix H = dofs.reduce(dynamics::step_matrix(
-            body.mass_matrix(), body.model().stiffness(state.u + time_step * v), dynamics::Damping{}, time_step, 1.0));
-        solver_->prepare(H);
-        Eigen::VectorXd direction = solver_->solve(-gradient);
-        info.solver_iterations += solver_->stats().iterations;
-        const double slope = gradient.dot(direction);
-        if (!(slope < 0.0))
-            throw Error(str("Newton: step ", state.step + 1, ": the direction is not a descent direction (∇Eᵀd = ", slope,
-                            "): the Hessian is indefinite; project the element Hessians"));
+        const Eigen::VectorXd u = state.u + time_step * v;
+        Eigen::VectorXd direction;
+        double slope = 0.0;
+        bool found = newton_direction(body, u, time_step, options_.hessian == HessianChoice::definite, gradient,
+                                      direction, slope, info.solver_iterations);
+        if (!found && options_.hessian == HessianChoice::exact_then_definite) {
+            ++definite_fallbacks_;
+            found = newton_direction(body, u, time_step, true, gradient, direction, slope, info.solver_iterations);
+        }
+        if (!found)
+            throw Error(str("Newton: step ", state.step + 1, ": the Hessian is not positive definite, so Newton has no ",
+                            "descent direction (∇Eᵀd = ", slope, "); use HessianChoice::exact_then_definite or definite"));
         Eigen::VectorXd d_full = Eigen::VectorXd::Zero(v.size());
         dofs.scatter(direction, d_full);
         // Backtracking: the largest α = shrinkᵏ with E(v + α d) ≤ E(v) + c α ∇Eᵀd.

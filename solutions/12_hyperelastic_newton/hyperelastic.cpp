@@ -11,27 +11,27 @@
 
 namespace fem::hyper {
 
-double element_energy(const Material& material, double volume, const Eigen::Matrix3d& F)
+double element_energy(const Material& material, double volume, const Eigen::Matrix3d& H)
 {
-    return volume * material.energy_density(F);
+    return volume * material.energy_density(H);
 }
 
-Vector12d element_forces(const Material& material, double volume, const tet::Jacobian& B, const Eigen::Matrix3d& F)
+Vector12d element_forces(const Material& material, double volume, const tet::Jacobian& B, const Eigen::Matrix3d& H)
 {
-    return -volume * (B.transpose() * flatten(material.first_piola(F)));
+    return -volume * (B.transpose() * flatten(material.first_piola(H)));
 }
 
-Matrix12d element_hessian(const Material& material, double volume, const tet::Jacobian& B, const Eigen::Matrix3d& F,
+Matrix12d element_hessian(const Material& material, double volume, const tet::Jacobian& B, const Eigen::Matrix3d& H,
                           std::optional<Projection> projection)
 {
-    Matrix9d dP = material.piola_derivative(F);
+    Matrix9d dP = material.piola_derivative(H);
     if (projection)
         dP = project_to_psd<9>(dP, *projection);
     return volume * (B.transpose() * dP * B);
 }
 
 HyperelasticElasticity::HyperelasticElasticity(const TetMesh& mesh, std::unique_ptr<Material> material,
-                                               std::optional<Projection> projection)
+                                               Projection projection)
     : mesh_(mesh), material_(std::move(material)), projection_(projection), volumes_(mesh.T.rows()), pattern_(mesh),
       K_csr_(pattern_.zero_matrix())
 {
@@ -47,27 +47,27 @@ HyperelasticElasticity::HyperelasticElasticity(const TetMesh& mesh, std::unique_
     }
 }
 
-MatrixX3d HyperelasticElasticity::positions(const Eigen::VectorXd& u) const
+MatrixX3d HyperelasticElasticity::displacement_rows(const Eigen::VectorXd& u) const
 {
     if (u.size() != 3 * mesh_.V.rows())
         throw Error(str("displacement has ", u.size(), " entries, expected 3n = ", 3 * mesh_.V.rows()));
-    return mesh_.V + io::vertex_rows(u);
+    return io::vertex_rows(u);
 }
 
-Eigen::Matrix3d HyperelasticElasticity::deformation_gradient(const MatrixX3d& x, Eigen::Index t) const
+Eigen::Matrix3d HyperelasticElasticity::displacement_gradient(const MatrixX3d& displacement, Eigen::Index t) const
 {
     Eigen::Matrix<double, 4, 3> corners;
     for (int i = 0; i < 4; ++i)
-        corners.row(i) = x.row(mesh_.T(t, i));
-    return corners.transpose() * gradients_[static_cast<std::size_t>(t)];  // F = Σᵢ xᵢ ∇φᵢᵀ
+        corners.row(i) = displacement.row(mesh_.T(t, i));
+    return corners.transpose() * gradients_[static_cast<std::size_t>(t)];  // H = Σᵢ uᵢ ∇φᵢᵀ
 }
 
 double HyperelasticElasticity::energy(const Eigen::VectorXd& u)
 {
-    const MatrixX3d x = positions(u);
+    const MatrixX3d x = displacement_rows(u);
     double total = 0.0;
     for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t) {
-        total += element_energy(*material_, volumes_[t], deformation_gradient(x, t));
+        total += element_energy(*material_, volumes_[t], displacement_gradient(x, t));
         if (!std::isfinite(total))
             return std::numeric_limits<double>::infinity();
     }
@@ -76,17 +76,17 @@ double HyperelasticElasticity::energy(const Eigen::VectorXd& u)
 
 double HyperelasticElasticity::evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& forces)
 {
-    const MatrixX3d x = positions(u);
+    const MatrixX3d x = displacement_rows(u);
     forces = Eigen::VectorXd::Zero(u.size());
     double total = 0.0;
     for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t) {
-        const Eigen::Matrix3d F = deformation_gradient(x, t);
-        const double e = element_energy(*material_, volumes_[t], F);
+        const Eigen::Matrix3d H = displacement_gradient(x, t);
+        const double e = element_energy(*material_, volumes_[t], H);
         if (!std::isfinite(e))
-            throw Error(str(material_->name(), ": tet ", t, " has det F = ", F.determinant(),
+            throw Error(str(material_->name(), ": tet ", t, " has det F = ", 1.0 + volume_change(H),
                             ", where the material is undefined (inverted)"));
         total += e;
-        const Vector12d f = element_forces(*material_, volumes_[t], B_[static_cast<std::size_t>(t)], F);
+        const Vector12d f = element_forces(*material_, volumes_[t], B_[static_cast<std::size_t>(t)], H);
         for (int i = 0; i < 4; ++i)
             forces.segment<3>(3 * mesh_.T(t, i)) += f.segment<3>(3 * i);
     }
@@ -95,12 +95,23 @@ double HyperelasticElasticity::evaluate(const Eigen::VectorXd& u, Eigen::VectorX
 
 const dynamics::SparseMatrix& HyperelasticElasticity::stiffness(const Eigen::VectorXd& u)
 {
-    const MatrixX3d x = positions(u);
+    return assemble_hessian(u, std::nullopt);
+}
+
+const dynamics::SparseMatrix& HyperelasticElasticity::definite_stiffness(const Eigen::VectorXd& u)
+{
+    return assemble_hessian(u, projection_);
+}
+
+const dynamics::SparseMatrix& HyperelasticElasticity::assemble_hessian(const Eigen::VectorXd& u,
+                                                                       std::optional<Projection> projection)
+{
+    const MatrixX3d x = displacement_rows(u);
     double* values = K_csr_.valuePtr();
     std::fill(values, values + K_csr_.nonZeros(), 0.0);
     for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t)
         pattern_.add_element(t, element_hessian(*material_, volumes_[t], B_[static_cast<std::size_t>(t)],
-                                                deformation_gradient(x, t), projection_),
+                                                displacement_gradient(x, t), projection),
                              values);
     K_ = assembly::csc_of_symmetric(K_csr_);
     return K_;
@@ -108,16 +119,17 @@ const dynamics::SparseMatrix& HyperelasticElasticity::stiffness(const Eigen::Vec
 
 Eigen::VectorXd HyperelasticElasticity::von_mises_stress(const Eigen::VectorXd& u) const
 {
-    const MatrixX3d x = positions(u);
+    const MatrixX3d x = displacement_rows(u);
     Eigen::VectorXd stress(mesh_.T.rows());
     for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t) {
-        const Eigen::Matrix3d F = deformation_gradient(x, t);
-        const double J = F.determinant();
+        const Eigen::Matrix3d H = displacement_gradient(x, t);
+        const double J = 1.0 + volume_change(H);
         if (!(J > 0.0) && !material_->defined_when_inverted()) {
             stress[t] = 0.0;
             continue;
         }
-        const Eigen::Matrix3d sigma = material_->first_piola(F) * F.transpose() / (J > 0.0 ? J : 1.0);
+        const Eigen::Matrix3d F = Eigen::Matrix3d::Identity() + H;
+        const Eigen::Matrix3d sigma = material_->first_piola(H) * F.transpose() / (J > 0.0 ? J : 1.0);
         const Eigen::Matrix3d deviator = sigma - sigma.trace() / 3.0 * Eigen::Matrix3d::Identity();
         stress[t] = std::sqrt(1.5 * deviator.squaredNorm());  // √(3/2 s:s), as chapter 05's von_mises
     }
@@ -126,10 +138,10 @@ Eigen::VectorXd HyperelasticElasticity::von_mises_stress(const Eigen::VectorXd& 
 
 double HyperelasticElasticity::smallest_volume_ratio(const Eigen::VectorXd& u) const
 {
-    const MatrixX3d x = positions(u);
+    const MatrixX3d x = displacement_rows(u);
     double smallest = std::numeric_limits<double>::infinity();
     for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t)
-        smallest = std::min(smallest, deformation_gradient(x, t).determinant());
+        smallest = std::min(smallest, 1.0 + volume_change(displacement_gradient(x, t)));
     return smallest;
 }
 

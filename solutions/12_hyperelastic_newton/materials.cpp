@@ -18,23 +18,45 @@ double levi_civita(int i, int j, int k)
     return 0.5 * double((j - i) * (k - i) * (k - j));
 }
 
-/// fem::Error unless F is finite.
-void require_finite(const Eigen::Matrix3d& F, std::string_view material)
+/// fem::Error unless H is finite.
+void require_finite(const Eigen::Matrix3d& H, std::string_view material)
 {
-    if (!F.allFinite())
-        throw Error(str(material, ": F has a non-finite entry"));
+    if (!H.allFinite())
+        throw Error(str(material, ": the displacement gradient H = F − I has a non-finite entry"));
 }
 
-/// G = F⁻ᵀ and ln J for the neo-Hookean material; fem::Error for J ≤ 0.
-Eigen::Matrix3d inverse_transpose(const Eigen::Matrix3d& F, double& log_J)
+/// ½(tr²H − tr(H²)) + det H = (J − 1) − tr H: the second- and third-order part of det(I + H) − 1.
+double higher_volume_change(const Eigen::Matrix3d& H)
 {
-    require_finite(F, "neo-hookean");
-    const double J = F.determinant();
+    const double trace = H.trace();
+    return 0.5 * (trace * trace - (H * H).trace()) + H.determinant();
+}
+
+/// x − ln(1 + x) (≥ 0, of order x²/2), by its series where the two terms would cancel.
+double x_minus_log1p(double x)
+{
+    if (std::abs(x) > 0.1)
+        return x - std::log1p(x);
+    double sum = 0.0, power = x;
+    for (int k = 2; k <= 40; ++k) {  // Σ_{k≥2} (−1)^k x^k / k; |x| ≤ 0.1: 40 terms reach round-off
+        power *= x;
+        sum += (k % 2 == 0 ? 1.0 : -1.0) * power / k;
+    }
+    return sum;
+}
+
+/// F⁻ᵀ − I = (cofactor_change(H) − (J − 1) I) / J for the neo-Hookean material, and ln J;
+/// fem::Error for J ≤ 0.
+Eigen::Matrix3d inverse_transpose_change(const Eigen::Matrix3d& H, double& J, double& log_J)
+{
+    require_finite(H, "neo-hookean");
+    const double change = volume_change(H);
+    J = 1.0 + change;
     if (!(J > 0.0))
         throw Error(str("neo-hookean: det F = ", J, " <= 0 (an inverted or flat element), where ln J is undefined; "
                         "use stable-neo-hookean, or a line search that rejects inverting steps"));
-    log_J = std::log(J);
-    return F.inverse().transpose();
+    log_J = std::log1p(change);
+    return (cofactor_change(H) - change * Eigen::Matrix3d::Identity()) / J;
 }
 
 }  // namespace
@@ -57,29 +79,52 @@ Eigen::Matrix3d cofactor(const Eigen::Matrix3d& F)
     return C;
 }
 
+double volume_change(const Eigen::Matrix3d& H)
+{
+    const double trace = H.trace();
+    return trace + 0.5 * (trace * trace - (H * H).trace()) + H.determinant();
+}
+
+Eigen::Matrix3d cofactor_change(const Eigen::Matrix3d& H)
+{
+    return H.trace() * Eigen::Matrix3d::Identity() - H.transpose() + cofactor(H);
+}
+
 // --- St. Venant–Kirchhoff -----------------------------------------------------------------------
 
-double StVenantKirchhoff::energy_density(const Eigen::Matrix3d& F) const
+namespace {
+
+/// E = ½(H + Hᵀ + HᵀH) (chapter 05's Green strain, written in H) and S = 2μE + λ tr(E) I.
+Eigen::Matrix3d second_piola(const elastic::Lame& lame, const Eigen::Matrix3d& H, Eigen::Matrix3d& E)
 {
-    require_finite(F, name());
-    const Eigen::Matrix3d E = elastic::green_strain(F);
+    E = 0.5 * (H + H.transpose() + H.transpose() * H);
+    return 2.0 * lame.mu * E + lame.lambda * E.trace() * Eigen::Matrix3d::Identity();
+}
+
+}  // namespace
+
+double StVenantKirchhoff::energy_density(const Eigen::Matrix3d& H) const
+{
+    require_finite(H, name());
+    const Eigen::Matrix3d E = 0.5 * (H + H.transpose() + H.transpose() * H);
     return lame().mu * E.squaredNorm() + 0.5 * lame().lambda * E.trace() * E.trace();
 }
 
-Eigen::Matrix3d StVenantKirchhoff::first_piola(const Eigen::Matrix3d& F) const
+Eigen::Matrix3d StVenantKirchhoff::first_piola(const Eigen::Matrix3d& H) const
 {
-    require_finite(F, name());
-    const Eigen::Matrix3d E = elastic::green_strain(F);
-    const Eigen::Matrix3d S = 2.0 * lame().mu * E + lame().lambda * E.trace() * Eigen::Matrix3d::Identity();
-    return F * S;
+    require_finite(H, name());
+    Eigen::Matrix3d E;
+    const Eigen::Matrix3d S = second_piola(lame(), H, E);
+    return (Eigen::Matrix3d::Identity() + H) * S;
 }
 
-Matrix9d StVenantKirchhoff::piola_derivative(const Eigen::Matrix3d& F) const
+Matrix9d StVenantKirchhoff::piola_derivative(const Eigen::Matrix3d& H) const
 {
-    require_finite(F, name());
+    require_finite(H, name());
     const double mu = lame().mu, lambda = lame().lambda;
-    const Eigen::Matrix3d E = elastic::green_strain(F);
-    const Eigen::Matrix3d S = 2.0 * mu * E + lambda * E.trace() * Eigen::Matrix3d::Identity();
+    Eigen::Matrix3d E;
+    const Eigen::Matrix3d S = second_piola(lame(), H, E);
+    const Eigen::Matrix3d F = Eigen::Matrix3d::Identity() + H;
     const Eigen::Matrix3d FFt = F * F.transpose();
     Matrix9d dP;
     for (int a = 0; a < 3; ++a)
@@ -94,27 +139,31 @@ Matrix9d StVenantKirchhoff::piola_derivative(const Eigen::Matrix3d& F) const
 
 // --- neo-Hookean ----------------------------------------------------------------------------------
 
-double NeoHookean::energy_density(const Eigen::Matrix3d& F) const
+double NeoHookean::energy_density(const Eigen::Matrix3d& H) const
 {
-    require_finite(F, name());
-    const double J = F.determinant();
-    if (!(J > 0.0))
+    require_finite(H, name());
+    const double change = volume_change(H);
+    if (!(change > -1.0))
         return std::numeric_limits<double>::infinity();
-    const double log_J = std::log(J);
-    return 0.5 * lame().mu * (F.squaredNorm() - 3.0) - lame().mu * log_J + 0.5 * lame().lambda * log_J * log_J;
+    const double log_J = std::log1p(change);
+    // (μ/2)(tr(FᵀF) − 3) − μ ln J = (μ/2)‖H‖² + μ(tr H − ln J), and tr H − ln J =
+    // (change − ln(1 + change)) − (change − tr H): first-order terms cancelled exactly.
+    const double first_order_free = x_minus_log1p(change) - higher_volume_change(H);
+    return 0.5 * lame().mu * H.squaredNorm() + lame().mu * first_order_free + 0.5 * lame().lambda * log_J * log_J;
 }
 
-Eigen::Matrix3d NeoHookean::first_piola(const Eigen::Matrix3d& F) const
+Eigen::Matrix3d NeoHookean::first_piola(const Eigen::Matrix3d& H) const
 {
-    double log_J = 0.0;
-    const Eigen::Matrix3d G = inverse_transpose(F, log_J);
-    return lame().mu * (F - G) + lame().lambda * log_J * G;
+    double J = 0.0, log_J = 0.0;
+    const Eigen::Matrix3d G_change = inverse_transpose_change(H, J, log_J);  // F⁻ᵀ − I
+    // μ(F − F⁻ᵀ) + λ ln J F⁻ᵀ with F − F⁻ᵀ = H − (F⁻ᵀ − I): no cancellation of terms of size μ.
+    return lame().mu * (H - G_change) + lame().lambda * log_J * (Eigen::Matrix3d::Identity() + G_change);
 }
 
-Matrix9d NeoHookean::piola_derivative(const Eigen::Matrix3d& F) const
+Matrix9d NeoHookean::piola_derivative(const Eigen::Matrix3d& H) const
 {
-    double log_J = 0.0;
-    const Eigen::Matrix3d G = inverse_transpose(F, log_J);
+    double J = 0.0, log_J = 0.0;
+    const Eigen::Matrix3d G = Eigen::Matrix3d::Identity() + inverse_transpose_change(H, J, log_J);
     const double mu = lame().mu, lambda = lame().lambda;
     Matrix9d dP;
     for (int a = 0; a < 3; ++a)
@@ -128,27 +177,31 @@ Matrix9d NeoHookean::piola_derivative(const Eigen::Matrix3d& F) const
 
 // --- stable neo-Hookean -------------------------------------------------------------------------
 
-double StableNeoHookean::energy_density(const Eigen::Matrix3d& F) const
+double StableNeoHookean::energy_density(const Eigen::Matrix3d& H) const
 {
-    require_finite(F, name());
-    const double lambda = lame().lambda + lame().mu, J = F.determinant();
-    return 0.5 * lame().mu * (F.squaredNorm() - 3.0) - lame().mu * (J - 1.0) + 0.5 * lambda * (J - 1.0) * (J - 1.0);
+    require_finite(H, name());
+    const double lambda = lame().lambda + lame().mu, change = volume_change(H);
+    // (μ/2)(tr(FᵀF) − 3) − μ(J − 1) = (μ/2)‖H‖² − μ(½(tr²H − tr H²) + det H): tr H cancelled exactly.
+    return 0.5 * lame().mu * H.squaredNorm() - lame().mu * higher_volume_change(H) + 0.5 * lambda * change * change;
 }
 
-Eigen::Matrix3d StableNeoHookean::first_piola(const Eigen::Matrix3d& F) const
+Eigen::Matrix3d StableNeoHookean::first_piola(const Eigen::Matrix3d& H) const
 {
-    require_finite(F, name());
-    const double lambda = lame().lambda + lame().mu, J = F.determinant();
-    return lame().mu * F + (lambda * (J - 1.0) - lame().mu) * cofactor(F);
+    require_finite(H, name());
+    const double lambda = lame().lambda + lame().mu, change = volume_change(H);
+    const Eigen::Matrix3d C_change = cofactor_change(H);
+    // μF + (λ̂(J − 1) − μ)C = μ(H − (C − I)) + λ̂(J − 1)C.
+    return lame().mu * (H - C_change) + lambda * change * (Eigen::Matrix3d::Identity() + C_change);
 }
 
-Matrix9d StableNeoHookean::piola_derivative(const Eigen::Matrix3d& F) const
+Matrix9d StableNeoHookean::piola_derivative(const Eigen::Matrix3d& H) const
 {
-    require_finite(F, name());
-    const double mu = lame().mu, lambda = lame().lambda + mu, J = F.determinant();
-    const Vector9d C = flatten(cofactor(F));
+    require_finite(H, name());
+    const double mu = lame().mu, lambda = lame().lambda + mu, change = volume_change(H);
+    const Eigen::Matrix3d F = Eigen::Matrix3d::Identity() + H;
+    const Vector9d C = flatten(Eigen::Matrix3d::Identity() + cofactor_change(H));
     Matrix9d dP = mu * Matrix9d::Identity() + lambda * C * C.transpose();
-    const double weight = lambda * (J - 1.0) - mu;
+    const double weight = lambda * change - mu;
     for (int a = 0; a < 3; ++a)
         for (int b = 0; b < 3; ++b)
             for (int c = 0; c < 3; ++c)
