@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
 
 using namespace fem;
 using namespace fem::hyper;
@@ -93,6 +94,64 @@ TEST_CASE("hyperelastic model: the affine patch test and rigid motions", "[ch12]
         CHECK(interior <= 1e-10 * scale);
         // The energy is V ψ(F) for the whole unit cube.
         CHECK(model.energy(u_vertex_major) == Approx(model.material().energy_density(F - Eigen::Matrix3d::Identity())).epsilon(1e-10));
+    }
+}
+
+namespace {
+
+/// The root of f on [low, high] by bisection (f(low), f(high) of opposite signs).
+template <typename Function>
+double bisect(Function f, double low, double high)
+{
+    for (int k = 0; k < 200; ++k) {
+        const double mid = 0.5 * (low + high);
+        ((f(low) < 0.0) == (f(mid) < 0.0) ? low : high) = mid;
+    }
+    return 0.5 * (low + high);
+}
+
+}  // namespace
+
+TEST_CASE("uniaxial stretch of a bar: the end force against the analytic curve of StVK and neo-Hookean", "[ch12]")
+{
+    // A bar L × a × a stretched by λ along x, free to contract laterally to l (where the lateral
+    // stress vanishes): the sum of the forces on its end face is P₁₁ a². Closed form for StVK
+    // (l² = 1 − ν(λ² − 1), P₁₁ = λ Y (λ² − 1)/2); a scalar root for neo-Hookean.
+    const double youngs = 1e5, poisson = 0.3, a = 0.1, L = 0.4;
+    const elastic::Lame lame = elastic::lame_parameters(youngs, poisson);
+    const TetMesh mesh = box_mesh(4, 1, 1, Eigen::Vector3d(L, a, a));
+    for (const double stretch : {0.8, 1.1, 1.5, 2.0}) {
+        const double stvk_lateral = std::sqrt(1.0 - poisson * (stretch * stretch - 1.0));
+        const double stvk_force = stretch * youngs * 0.5 * (stretch * stretch - 1.0) * a * a;
+        const auto neo_lateral_stress = [&](double l) {
+            return lame.mu * (l - 1.0 / l) + lame.lambda * std::log(stretch * l * l) / l;
+        };
+        const double neo_lateral = bisect(neo_lateral_stress, 0.2, 2.0);
+        const double neo_force =
+            (lame.mu * (stretch - 1.0 / stretch) + lame.lambda * std::log(stretch * neo_lateral * neo_lateral) / stretch) * a * a;
+        for (const auto& [name, lateral, expected] : {std::tuple{std::string("stvk"), stvk_lateral, stvk_force},
+                                                      std::tuple{std::string("neo-hookean"), neo_lateral, neo_force}}) {
+            HyperelasticElasticity model(mesh, make_material(name, youngs, poisson));
+            Eigen::VectorXd u(3 * mesh.V.rows()), f;
+            for (Eigen::Index v = 0; v < mesh.V.rows(); ++v)
+                u.segment<3>(3 * v) = Eigen::Vector3d((stretch - 1.0) * mesh.V(v, 0), (lateral - 1.0) * mesh.V(v, 1),
+                                                      (lateral - 1.0) * mesh.V(v, 2));
+            model.evaluate(u, f);
+            double end_force = 0.0, lateral_force = 0.0;
+            for (Eigen::Index v = 0; v < mesh.V.rows(); ++v) {
+                if (std::abs(mesh.V(v, 0) - L) < 1e-12)
+                    end_force -= f[3 * v];  // the load that holds the end face: minus the internal force
+                lateral_force += std::abs(f[3 * v + 1]) + std::abs(f[3 * v + 2]);
+            }
+            CAPTURE(name, stretch, end_force, expected, lateral_force);
+            CHECK(end_force == Approx(expected).epsilon(1e-10));
+            // Lateral faces carry no net traction: the y and z forces sum to zero per face.
+            double y_face = 0.0;
+            for (Eigen::Index v = 0; v < mesh.V.rows(); ++v)
+                if (std::abs(mesh.V(v, 1) - a) < 1e-12)
+                    y_face += f[3 * v + 1];
+            CHECK(std::abs(y_face) <= 1e-9 * std::abs(expected));
+        }
     }
 }
 
@@ -212,6 +271,33 @@ TEST_CASE("stable neo-Hookean: a tet squashed through inversion recovers, neo-Ho
     CHECK(stable.smallest_volume_ratio(state.u) > 0.0);  // every tet turned right side out again
     dynamics::Body neo(scene, std::make_unique<HyperelasticElasticity>(scene.mesh, make_material("neo-hookean", 1e5, 0.4)));
     CHECK_THROWS_WITH(dynamics::initial_state(neo, u0), Contains("det F"));
+}
+
+TEST_CASE("hard cases: Y = 1e7 at dt = 1/24 s stays stable, nu up to 0.499 converges every step", "[ch12]")
+{
+    for (const double poisson : {0.3, 0.45, 0.49, 0.499}) {
+        dynamics::Scene scene;
+        scene.mesh = beam_mesh(0.2, 0.02, 0.02, 10);
+        scene.material = {1e7, poisson, 1000.0};
+        scene.pinned = assembly::vertices_on_plane(scene.mesh, 0, 0.0);
+        scene.time_step = 1.0 / 24.0;
+        dynamics::Body body(scene, std::make_unique<HyperelasticElasticity>(
+                                       scene.mesh, make_material("neo-hookean", scene.material.youngs_modulus, poisson)));
+        NewtonBackwardEuler newton;
+        dynamics::Simulation simulation(body, newton, dynamics::initial_state(body), scene.time_step);
+        double h0 = 0.0, highest = -1e300;
+        int most_iterations = 0;
+        simulation.run(24, [&](const dynamics::State& state, const dynamics::StepRecord& record) {
+            if (state.step == 0)
+                h0 = record.energies.total();
+            highest = std::max(highest, record.energies.total());
+            most_iterations = std::max(most_iterations, record.newton_iterations);
+        });
+        CAPTURE(poisson, most_iterations, highest, h0);
+        CHECK(highest <= h0);  // backward Euler never adds energy
+        CHECK(simulation.state().u.allFinite());
+        CHECK(most_iterations <= 10);
+    }
 }
 
 TEST_CASE("Newton backward Euler: bad options are refused", "[ch12]")
