@@ -18,6 +18,7 @@
 
 #include <Eigen/Core>
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -67,6 +68,38 @@ Eigen::VectorXd backward_euler_gradient(dynamics::Body& body, const dynamics::St
 /// scale 0 and a zero gradient: it is converged at once.
 double momentum_scale(const dynamics::Body& body, const dynamics::State& state, double time_step);
 
+/// A minimisation problem for newton_minimize, on the free unknowns x (free dofs of a body).
+struct NewtonProblem {
+    std::function<double(const Eigen::VectorXd& x, double* magnitude)> objective;  ///< +∞ outside the
+                                                      ///< domain; magnitude: the size of its terms
+    std::function<Eigen::VectorXd(const Eigen::VectorXd& x)> gradient;
+    /// The Hessian at x, exact or made positive semi-definite (definite = true).
+    std::function<dynamics::SparseMatrix(const Eigen::VectorXd& x, bool definite)> hessian;
+    double scale = 0.0;   ///< converged when ‖gradient‖ ≤ relative_tolerance × scale
+    std::string what;     ///< names the problem in error messages, e.g. "step 12 (t = 0.2 s)"
+};
+
+/// What newton_minimize did.
+struct NewtonResult {
+    Eigen::VectorXd x;
+    int iterations = 0, solver_iterations = 0, definite_fallbacks = 0;
+    std::vector<double> gradient_history;  ///< ‖gradient‖ / scale at each iterate (the first: at x₀)
+    std::vector<double> step_lengths;      ///< the α the line search accepted
+};
+
+/// Newton's method with a backtracking (Armijo) line search from x₀ (where the objective must be
+/// finite): solve H d = −∇ with `solver`, the Hessian chosen as options.hessian says, take the
+/// largest α = shrinkᵏ with objective(x + αd) ≤ objective(x) + c α ∇ᵀd (+ its round-off), until
+/// ‖∇‖ ≤ tolerance × scale. fem::Error naming problem.what when the cap is reached, the line search
+/// fails, or no Hessian gives a descent direction. docs/12_hyperelastic_newton.md#newton-with-line-search
+NewtonResult newton_minimize(const NewtonProblem& problem, Eigen::VectorXd x0, const NewtonOptions& options,
+                             cg::LinearSolver& solver);
+
+/// The static equilibrium of a body under its loads: the minimiser of U(u) − f_extᵀu over the free
+/// dofs by newton_minimize from u = 0, the gradient measured against ‖f_ext‖. Returns u (3n).
+/// docs/12_hyperelastic_newton.md#statics
+Eigen::VectorXd solve_static(dynamics::Body& body, const NewtonOptions& options = {});
+
 /// Backward Euler by Newton's method with a backtracking (Armijo) line search, for any force model
 /// (chapter 10's linear one converges in one iteration). docs/12_hyperelastic_newton.md#newton-with-line-search
 class NewtonBackwardEuler final : public dynamics::Integrator {
@@ -83,23 +116,14 @@ public:
     /// indefinite Hessian: use a projection).
     dynamics::StepInfo step(dynamics::Body& body, double time_step, dynamics::State& state) override;
 
-    /// ‖∇E‖ / momentum scale at each iteration of the last step (the first entry: at v = q̇ᵗ).
-    const std::vector<double>& gradient_history() const { return gradient_history_; }
-    /// The step lengths α the line search accepted in the last step.
-    const std::vector<double>& step_lengths() const { return step_lengths_; }
-    /// How many iterations of the last step fell back to the definite Hessian.
-    int definite_fallbacks() const { return definite_fallbacks_; }
+    /// What the last step's Newton iterations did (gradient norms relative to the momentum scale,
+    /// step lengths, fallbacks to the definite Hessian).
+    const NewtonResult& last() const { return last_; }
 
 private:
     NewtonOptions options_;
     std::unique_ptr<cg::LinearSolver> solver_;
-    /// d with H d = −gradient for the chosen Hessian at u; slope = gradientᵀd. False if that Hessian
-    /// is not positive definite or d is no descent direction.
-    bool newton_direction(dynamics::Body& body, const Eigen::VectorXd& u, double time_step, bool definite,
-                          const Eigen::VectorXd& gradient, Eigen::VectorXd& direction, double& slope, int& iterations);
-
-    std::vector<double> gradient_history_, step_lengths_;
-    int definite_fallbacks_ = 0;
+    NewtonResult last_;
 };
 
 }  // namespace fem::hyper

@@ -67,23 +67,106 @@ NewtonBackwardEuler::NewtonBackwardEuler(NewtonOptions options)
         throw Error(str("Newton: the iteration cap must be >= 1, got ", options_.max_iterations));
 }
 
-bool NewtonBackwardEuler::newton_direction(dynamics::Body& body, const Eigen::VectorXd& u, double time_step,
-                                           bool definite, const Eigen::VectorXd& gradient, Eigen::VectorXd& direction,
-                                           double& slope, int& iterations)
+namespace {
+
+/// d with H d = −gradient for the exact or definite Hessian at x; slope = gradientᵀd. False if the
+/// exact Hessian is not positive definite or gives no descent direction.
+bool newton_direction(const NewtonProblem& problem, cg::LinearSolver& solver, const Eigen::VectorXd& x, bool definite,
+                      const Eigen::VectorXd& gradient, Eigen::VectorXd& direction, double& slope, int& iterations)
 {
-    dynamics::ForceModel& model = body.model();
-    const dynamics::SparseMatrix& K = definite ? model.definite_stiffness(u) : model.stiffness(u);
     try {
-        solver_->prepare(body.dofs().reduce(dynamics::step_matrix(body.mass_matrix(), K, dynamics::Damping{}, time_step, 1.0)));
-        direction = solver_->solve(-gradient);
+        solver.prepare(problem.hessian(x, definite));
+        direction = solver.solve(-gradient);
     } catch (const Error&) {
         if (definite)
             throw;  // a definite Hessian that fails to factor is a real error, not a choice
         return false;
     }
-    iterations += solver_->stats().iterations;
+    iterations += solver.stats().iterations;
     slope = gradient.dot(direction);
     return slope < 0.0;
+}
+
+}  // namespace
+
+NewtonResult newton_minimize(const NewtonProblem& problem, Eigen::VectorXd x0, const NewtonOptions& options,
+                             cg::LinearSolver& solver)
+{
+    NewtonResult result;
+    result.x = std::move(x0);
+    Eigen::VectorXd& x = result.x;
+    for (int iteration = 0;; ++iteration) {
+        const Eigen::VectorXd gradient = problem.gradient(x);
+        const double norm = gradient.norm();
+        result.gradient_history.push_back(problem.scale > 0.0 ? norm / problem.scale : norm);
+        if (norm <= options.relative_tolerance * problem.scale)
+            return result;
+        if (iteration == options.max_iterations)
+            throw Error(str("Newton: ", problem.what, " did not converge in ", options.max_iterations,
+                            " iterations: |gradient| / scale = ", norm / problem.scale, " (tolerance ",
+                            options.relative_tolerance, "); use a smaller dt or raise the cap"));
+        Eigen::VectorXd direction;
+        double slope = 0.0;
+        bool found = newton_direction(problem, solver, x, options.hessian == HessianChoice::definite, gradient, direction,
+                                      slope, result.solver_iterations);
+        if (!found && options.hessian == HessianChoice::exact_then_definite) {
+            ++result.definite_fallbacks;
+            found = newton_direction(problem, solver, x, true, gradient, direction, slope, result.solver_iterations);
+        }
+        if (!found)
+            throw Error(str("Newton: ", problem.what, ": the Hessian is not positive definite, so Newton has no ",
+                            "descent direction (gradientᵀd = ", slope, "); use HessianChoice::exact_then_definite or definite"));
+        // Backtracking: the largest α = shrinkᵏ with E(x + α d) ≤ E(x) + c α ∇ᵀd.
+        double alpha = 1.0;
+        if (options.line_search) {
+            double magnitude = 0.0;
+            const double start = problem.objective(x, &magnitude);
+            // E is a sum of terms that cancel; differences below its round-off carry no information.
+            const double noise = objective_round_off * magnitude;
+            while (!(problem.objective(x + alpha * direction, nullptr) <= start + options.armijo * alpha * slope + noise)) {
+                alpha *= options.shrink;
+                if (alpha < options.smallest_step)
+                    throw Error(str("Newton: ", problem.what, ": the line search found no decrease down to α = ",
+                                    options.smallest_step));
+            }
+        }
+        result.step_lengths.push_back(alpha);
+        x += alpha * direction;
+        ++result.iterations;
+    }
+}
+
+Eigen::VectorXd solve_static(dynamics::Body& body, const NewtonOptions& options)
+{
+    const dynamics::FreeDofs& dofs = body.dofs();
+    dynamics::ForceModel& model = body.model();
+    const Eigen::VectorXd& load = body.external_forces();
+    const auto full = [&](const Eigen::VectorXd& x) {
+        Eigen::VectorXd u = Eigen::VectorXd::Zero(dofs.full_size());
+        dofs.scatter(x, u);
+        return u;
+    };
+    NewtonProblem problem;
+    problem.objective = [&](const Eigen::VectorXd& x, double* magnitude) {
+        const Eigen::VectorXd u = full(x);
+        const double elastic = model.energy(u), work = load.dot(u);
+        if (magnitude != nullptr)
+            *magnitude = std::abs(elastic) + std::abs(work);
+        return std::isfinite(elastic) ? elastic - work : std::numeric_limits<double>::infinity();
+    };
+    problem.gradient = [&](const Eigen::VectorXd& x) {
+        Eigen::VectorXd forces;
+        model.evaluate(full(x), forces);
+        return Eigen::VectorXd(dofs.gather(-forces - load));
+    };
+    problem.hessian = [&](const Eigen::VectorXd& x, bool definite) {
+        const Eigen::VectorXd u = full(x);
+        return dofs.reduce(definite ? model.definite_stiffness(u) : model.stiffness(u));
+    };
+    problem.scale = dofs.gather(load).norm();
+    problem.what = "the static solve";
+    const std::unique_ptr<cg::LinearSolver> solver = cg::make_solver(options.solver);
+    return full(newton_minimize(problem, Eigen::VectorXd::Zero(dofs.size()), options, *solver).x);
 }
 
 dynamics::StepInfo NewtonBackwardEuler::step(dynamics::Body& body, double time_step, dynamics::State& state)
@@ -93,61 +176,36 @@ dynamics::StepInfo NewtonBackwardEuler::step(dynamics::Body& body, double time_s
     if (damping.alpha != 0.0 || damping.beta != 0.0)
         throw Error("Newton backward Euler: Rayleigh damping is not part of its objective yet; set alpha = beta = 0");
     const dynamics::FreeDofs& dofs = body.dofs();
-    const double scale = momentum_scale(body, state, time_step);
-    gradient_history_.clear();
-    step_lengths_.clear();
-    definite_fallbacks_ = 0;
-    dynamics::StepInfo info;
+    const auto full = [&](const Eigen::VectorXd& x) {
+        Eigen::VectorXd v = Eigen::VectorXd::Zero(dofs.full_size());
+        dofs.scatter(x, v);
+        return v;
+    };
+    NewtonProblem problem;
+    problem.objective = [&](const Eigen::VectorXd& x, double* magnitude) {
+        return backward_euler_objective(body, state, time_step, full(x), magnitude);
+    };
+    problem.gradient = [&](const Eigen::VectorXd& x) {
+        return Eigen::VectorXd(dofs.gather(backward_euler_gradient(body, state, time_step, full(x))));
+    };
+    problem.hessian = [&](const Eigen::VectorXd& x, bool definite) {
+        const Eigen::VectorXd u = state.u + time_step * full(x);
+        const dynamics::SparseMatrix& K = definite ? body.model().definite_stiffness(u) : body.model().stiffness(u);
+        return dofs.reduce(dynamics::step_matrix(body.mass_matrix(), K, dynamics::Damping{}, time_step, 1.0));
+    };
+    problem.scale = momentum_scale(body, state, time_step);
+    problem.what = str("step ", state.step + 1, " (t = ", state.time + time_step, " s)");
     // The start: the last velocity, unless it already leaves the material's domain (a neo-Hookean
     // tet inverted by qᵗ + Δt q̇ᵗ); then v = 0, which keeps qᵗ, where E is finite.
-    Eigen::VectorXd v = state.v;
-    if (!std::isfinite(backward_euler_objective(body, state, time_step, v)))
-        v.setZero();
-    for (int iteration = 0;; ++iteration) {
-        const Eigen::VectorXd gradient = dofs.gather(backward_euler_gradient(body, state, time_step, v));
-        const double norm = gradient.norm();
-        gradient_history_.push_back(scale > 0.0 ? norm / scale : norm);
-        if (norm <= options_.relative_tolerance * scale)
-            break;
-        if (iteration == options_.max_iterations)
-            throw Error(str("Newton: step ", state.step + 1, " (t = ", state.time + time_step, " s) did not converge in ",
-                            options_.max_iterations, " iterations: |grad E| / scale = ", norm / scale,
-                            " (tolerance ", options_.relative_tolerance, "); use a smaller dt or raise the cap"));
-        // The Newton direction: H d = −∇E on the free dofs, H = M + Δt² K(qᵗ + Δt v).
-        const Eigen::VectorXd u = state.u + time_step * v;
-        Eigen::VectorXd direction;
-        double slope = 0.0;
-        bool found = newton_direction(body, u, time_step, options_.hessian == HessianChoice::definite, gradient,
-                                      direction, slope, info.solver_iterations);
-        if (!found && options_.hessian == HessianChoice::exact_then_definite) {
-            ++definite_fallbacks_;
-            found = newton_direction(body, u, time_step, true, gradient, direction, slope, info.solver_iterations);
-        }
-        if (!found)
-            throw Error(str("Newton: step ", state.step + 1, ": the Hessian is not positive definite, so Newton has no ",
-                            "descent direction (∇Eᵀd = ", slope, "); use HessianChoice::exact_then_definite or definite"));
-        Eigen::VectorXd d_full = Eigen::VectorXd::Zero(v.size());
-        dofs.scatter(direction, d_full);
-        // Backtracking: the largest α = shrinkᵏ with E(v + α d) ≤ E(v) + c α ∇Eᵀd.
-        double alpha = 1.0;
-        if (options_.line_search) {
-            double magnitude = 0.0;
-            const double start = backward_euler_objective(body, state, time_step, v, &magnitude);
-            // E is a sum of terms that cancel; differences below its round-off carry no information.
-            const double noise = objective_round_off * magnitude;
-            while (!(backward_euler_objective(body, state, time_step, v + alpha * d_full) <=
-                     start + options_.armijo * alpha * slope + noise)) {
-                alpha *= options_.shrink;
-                if (alpha < options_.smallest_step)
-                    throw Error(str("Newton: step ", state.step + 1, ": the line search found no decrease down to α = ",
-                                    options_.smallest_step));
-            }
-        }
-        step_lengths_.push_back(alpha);
-        v += alpha * d_full;
-        ++info.newton_iterations;
-    }
-    info.prepared = info.newton_iterations > 0;
+    Eigen::VectorXd start = dofs.gather(state.v);
+    if (!std::isfinite(problem.objective(start, nullptr)))
+        start.setZero();
+    last_ = newton_minimize(problem, std::move(start), options_, *solver_);
+    dynamics::StepInfo info;
+    info.newton_iterations = last_.iterations;
+    info.solver_iterations = last_.solver_iterations;
+    info.prepared = last_.iterations > 0;
+    const Eigen::VectorXd v = full(last_.x);
     dynamics::commit_step(body.model(), time_step, state.u + time_step * v, v, state);
     return info;
 }

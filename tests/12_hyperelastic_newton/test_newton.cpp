@@ -199,7 +199,7 @@ TEST_CASE("Newton backward Euler: the gradient and Hessian of E by finite differ
     NewtonBackwardEuler newton(options);
     dynamics::State stepped = dynamics::initial_state(exact_body);
     newton.step(exact_body, dt, stepped);
-    const std::vector<double>& g = newton.gradient_history();
+    const std::vector<double>& g = newton.last().gradient_history;
     CAPTURE(g);
     REQUIRE(g.size() >= 4);
     // Near the solution the gradient falls quadratically: g_{k+1} ≤ C g_k² with a modest C, on the
@@ -211,7 +211,7 @@ TEST_CASE("Newton backward Euler: the gradient and Hessian of E by finite differ
     CHECK(g[k] < 1e-2);
     CHECK(g[k + 1] <= 100.0 * g[k] * g[k]);
     CHECK(g.back() <= 1e-8);
-    for (const double alpha : newton.step_lengths())
+    for (const double alpha : newton.last().step_lengths)
         CHECK(alpha > 0.0);
 }
 
@@ -271,6 +271,28 @@ TEST_CASE("stable neo-Hookean: a tet squashed through inversion recovers, neo-Ho
     CHECK(stable.smallest_volume_ratio(state.u) > 0.0);  // every tet turned right side out again
     dynamics::Body neo(scene, std::make_unique<HyperelasticElasticity>(scene.mesh, make_material("neo-hookean", 1e5, 0.4)));
     CHECK_THROWS_WITH(dynamics::initial_state(neo, u0), Contains("det F"));
+}
+
+TEST_CASE("statics: the hyperelastic sag tends to chapter 10's linear one as the load goes to zero, at rate 1",
+          "[ch12]")
+{
+    std::vector<double> gaps;
+    for (const double g : {1.0, 0.5, 0.25, 0.125}) {  // sags of 6 % of the length and less: the asymptotic range
+        dynamics::Scene scene;
+        scene.mesh = beam_mesh(0.2, 0.02, 0.02, 8);
+        scene.material = {1e5, 0.3, 1000.0};
+        scene.pinned = assembly::vertices_on_plane(scene.mesh, 0, 0.0);
+        scene.gravity = Eigen::Vector3d(0.0, 0.0, -g);
+        dynamics::Body hyper(scene, std::make_unique<HyperelasticElasticity>(scene.mesh, make_material("neo-hookean", 1e5, 0.3)));
+        dynamics::Body linear(scene);
+        NewtonOptions options;
+        options.relative_tolerance = 1e-10;
+        const Eigen::VectorXd u = solve_static(hyper, options), u_linear = solve_static(linear, options);
+        gaps.push_back((u - u_linear).norm() / u_linear.norm());
+    }
+    CAPTURE(gaps[0], gaps[1], gaps[2], gaps[3]);
+    for (std::size_t k = 1; k < gaps.size(); ++k)
+        CHECK(std::log2(gaps[k - 1] / gaps[k]) == Approx(1.0).margin(0.15));
 }
 
 TEST_CASE("hard cases: Y = 1e7 at dt = 1/24 s stays stable, nu up to 0.499 converges every step", "[ch12]")
