@@ -20,16 +20,22 @@ double element_energy(const Material& material, double volume, const Eigen::Matr
 
 Vector12d element_forces(const Material& material, double volume, const tet::Jacobian& B, const Eigen::Matrix3d& H)
 {
-    return -volume * (B.transpose() * flatten(material.first_piola(H)));
+    Vector12d forces;
+    // EXERCISE 12.4 (element_forces): see docs/12_hyperelastic_newton.md#element-forces-and-hessians
+    // HINT: f_e = −V Bᵀ vec(P): material.first_piola(H), flattened row-major (flatten).
+    throw fem::NotImplemented("12.4", "element_forces", "docs/12_hyperelastic_newton.md#element-forces-and-hessians");
+    return forces;
 }
 
 Matrix12d element_hessian(const Material& material, double volume, const tet::Jacobian& B, const Eigen::Matrix3d& H,
                           std::optional<Projection> projection)
 {
-    Matrix9d dP = material.piola_derivative(H);
-    if (projection)
-        dP = project_to_psd<9>(dP, *projection);
-    return volume * (B.transpose() * dP * B);
+    Matrix12d hessian;
+    // EXERCISE 12.5 (element_hessian): see docs/12_hyperelastic_newton.md#element-forces-and-hessians
+    // HINT: dP = material.piola_derivative(H), made PSD by project_to_psd<9> when projection is set;
+    // HINT: then V Bᵀ dP B.
+    throw fem::NotImplemented("12.5", "element_hessian", "docs/12_hyperelastic_newton.md#element-forces-and-hessians");
+    return hessian;
 }
 
 HyperelasticElasticity::HyperelasticElasticity(const TetMesh& mesh, std::unique_ptr<Material> material,

@@ -28,9 +28,11 @@ double backward_euler_objective(dynamics::Body& body, const dynamics::State& sta
     const double elastic = body.model().energy(state.u + time_step * v);
     if (!std::isfinite(elastic))
         return std::numeric_limits<double>::infinity();
-    const Eigen::VectorXd change = v - state.v;
-    const double kinetic = 0.5 * change.dot(body.mass_matrix() * change);
-    const double work = time_step * v.dot(body.external_forces());
+    double kinetic = 0.0, work = 0.0;
+    // EXERCISE 12.7 (objective): see docs/12_hyperelastic_newton.md#backward-euler-as-minimisation
+    // HINT: kinetic = ½ (v − q̇ᵗ)ᵀ M (v − q̇ᵗ) (state.v is q̇ᵗ; the notes' qᵗ here is a slip);
+    // HINT: work = Δt vᵀ f_ext. E = kinetic + U(qᵗ + Δt v) − work.
+    throw fem::NotImplemented("12.7", "objective", "docs/12_hyperelastic_newton.md#backward-euler-as-minimisation");
     if (magnitude != nullptr)
         *magnitude = std::abs(kinetic) + std::abs(elastic) + std::abs(work);
     return kinetic + elastic - work;
@@ -40,9 +42,12 @@ Eigen::VectorXd backward_euler_gradient(dynamics::Body& body, const dynamics::St
                                         const Eigen::VectorXd& v)
 {
     require_sizes(body, state, time_step, v);
-    Eigen::VectorXd forces;
+    Eigen::VectorXd forces, gradient;
     body.model().evaluate(state.u + time_step * v, forces);
-    return body.mass_matrix() * (v - state.v) - time_step * (forces + body.external_forces());
+    // EXERCISE 12.8 (gradient): see docs/12_hyperelastic_newton.md#backward-euler-as-minimisation
+    // HINT: ∇E = M (v − q̇ᵗ) − Δt (f(qᵗ + Δt v) + f_ext), with forces = f(qᵗ + Δt v) above.
+    throw fem::NotImplemented("12.8", "gradient", "docs/12_hyperelastic_newton.md#backward-euler-as-minimisation");
+    return gradient;
 }
 
 double momentum_scale(const dynamics::Body& body, const dynamics::State& state, double time_step)
@@ -123,12 +128,11 @@ NewtonResult newton_minimize(const NewtonProblem& problem, Eigen::VectorXd x0, c
             const double start = problem.objective(x, &magnitude);
             // E is a sum of terms that cancel; differences below its round-off carry no information.
             const double noise = objective_round_off * magnitude;
-            while (!(problem.objective(x + alpha * direction, nullptr) <= start + options.armijo * alpha * slope + noise)) {
-                alpha *= options.shrink;
-                if (alpha < options.smallest_step)
-                    throw Error(str("Newton: ", problem.what, ": the line search found no decrease down to α = ",
-                                    options.smallest_step));
-            }
+            // EXERCISE 12.9 (line_search): see docs/12_hyperelastic_newton.md#newton-with-line-search
+            // HINT: while problem.objective(x + α d, nullptr) > start + c α slope + noise (c is
+            // HINT: options.armijo; +∞ never passes): α ← shrink · α, and throw fem::Error once α falls
+            // HINT: below options.smallest_step.
+            throw fem::NotImplemented("12.9", "line_search", "docs/12_hyperelastic_newton.md#newton-with-line-search");
         }
         result.step_lengths.push_back(alpha);
         x += alpha * direction;

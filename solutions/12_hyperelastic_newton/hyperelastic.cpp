@@ -18,16 +18,27 @@ double element_energy(const Material& material, double volume, const Eigen::Matr
 
 Vector12d element_forces(const Material& material, double volume, const tet::Jacobian& B, const Eigen::Matrix3d& H)
 {
-    return -volume * (B.transpose() * flatten(material.first_piola(H)));
+    Vector12d forces;
+    // BEGIN EXERCISE 12.4 element_forces #element-forces-and-hessians
+    // HINT: f_e = −V Bᵀ vec(P): material.first_piola(H), flattened row-major (flatten).
+    forces = -volume * (B.transpose() * flatten(material.first_piola(H)));
+    // END EXERCISE
+    return forces;
 }
 
 Matrix12d element_hessian(const Material& material, double volume, const tet::Jacobian& B, const Eigen::Matrix3d& H,
                           std::optional<Projection> projection)
 {
+    Matrix12d hessian;
+    // BEGIN EXERCISE 12.5 element_hessian #element-forces-and-hessians
+    // HINT: dP = material.piola_derivative(H), made PSD by project_to_psd<9> when projection is set;
+    // HINT: then V Bᵀ dP B.
     Matrix9d dP = material.piola_derivative(H);
     if (projection)
         dP = project_to_psd<9>(dP, *projection);
-    return volume * (B.transpose() * dP * B);
+    hessian = volume * (B.transpose() * dP * B);
+    // END EXERCISE
+    return hessian;
 }
 
 HyperelasticElasticity::HyperelasticElasticity(const TetMesh& mesh, std::unique_ptr<Material> material,

@@ -97,8 +97,14 @@ namespace {
 /// E = ½(H + Hᵀ + HᵀH) (chapter 05's Green strain, written in H) and S = 2μE + λ tr(E) I.
 Eigen::Matrix3d second_piola(const elastic::Lame& lame, const Eigen::Matrix3d& H, Eigen::Matrix3d& E)
 {
+    Eigen::Matrix3d S;
+    // BEGIN EXERCISE 12.1 stvk_stress #st-venantkirchhoff
+    // HINT: the Green strain in H: E = ½(H + Hᵀ + HᵀH) (= ½(FᵀF − I) with F = I + H);
+    // HINT: then S = 2μE + λ tr(E) I.
     E = 0.5 * (H + H.transpose() + H.transpose() * H);
-    return 2.0 * lame.mu * E + lame.lambda * E.trace() * Eigen::Matrix3d::Identity();
+    S = 2.0 * lame.mu * E + lame.lambda * E.trace() * Eigen::Matrix3d::Identity();
+    // END EXERCISE
+    return S;
 }
 
 }  // namespace
@@ -156,8 +162,13 @@ Eigen::Matrix3d NeoHookean::first_piola(const Eigen::Matrix3d& H) const
 {
     double J = 0.0, log_J = 0.0;
     const Eigen::Matrix3d G_change = inverse_transpose_change(H, J, log_J);  // F⁻ᵀ − I
-    // μ(F − F⁻ᵀ) + λ ln J F⁻ᵀ with F − F⁻ᵀ = H − (F⁻ᵀ − I): no cancellation of terms of size μ.
-    return lame().mu * (H - G_change) + lame().lambda * log_J * (Eigen::Matrix3d::Identity() + G_change);
+    Eigen::Matrix3d P;
+    // BEGIN EXERCISE 12.2 neo_hookean_stress #neo-hookean
+    // HINT: P = μ(F − F⁻ᵀ) + λ ln J F⁻ᵀ. Write F − F⁻ᵀ as H − (F⁻ᵀ − I) = H − G_change and
+    // HINT: F⁻ᵀ as I + G_change, so that no two terms of size μ cancel near rest.
+    P = lame().mu * (H - G_change) + lame().lambda * log_J * (Eigen::Matrix3d::Identity() + G_change);
+    // END EXERCISE
+    return P;
 }
 
 Matrix9d NeoHookean::piola_derivative(const Eigen::Matrix3d& H) const
@@ -202,6 +213,9 @@ Matrix9d StableNeoHookean::piola_derivative(const Eigen::Matrix3d& H) const
     const Vector9d C = flatten(Eigen::Matrix3d::Identity() + cofactor_change(H));
     Matrix9d dP = mu * Matrix9d::Identity() + lambda * C * C.transpose();
     const double weight = lambda * change - mu;
+    // BEGIN EXERCISE 12.3 stable_neo_hookean_derivative #stable-neo-hookean
+    // HINT: add (λ̂(J − 1) − μ) ∂²J/∂F² to dP, entry (3a + b, 3c + d), where
+    // HINT: ∂²J/∂F_ab∂F_cd = Σ_kl ε_ack ε_bdl F_kl (levi_civita(i, j, k) is ε_ijk).
     for (int a = 0; a < 3; ++a)
         for (int b = 0; b < 3; ++b)
             for (int c = 0; c < 3; ++c)
@@ -212,6 +226,7 @@ Matrix9d StableNeoHookean::piola_derivative(const Eigen::Matrix3d& H) const
                             hessian_of_J += levi_civita(a, c, k) * levi_civita(b, d, l) * F(k, l);
                     dP(3 * a + b, 3 * c + d) += weight * hessian_of_J;
                 }
+    // END EXERCISE
     return dP;
 }
 
@@ -242,10 +257,16 @@ Eigen::Matrix<double, N, N> project_to_psd(const Eigen::Matrix<double, N, N>& A,
         throw Error("project_to_psd: the matrix has a non-finite entry");
     const Eigen::SelfAdjointEigenSolver<Matrix> eigen(Matrix(0.5 * (A + A.transpose())));
     Eigen::Matrix<double, N, 1> values = eigen.eigenvalues();
+    Matrix projected;
+    // BEGIN EXERCISE 12.6 psd_projection #definiteness
+    // HINT: A = Q Λ Qᵀ (eigen.eigenvectors(), values): replace each negative eigenvalue by 0 (clamp)
+    // HINT: or by its absolute value (absolute), then rebuild Q Λ' Qᵀ.
     for (int i = 0; i < N; ++i)
         if (values[i] < 0.0)
             values[i] = projection == Projection::clamp ? 0.0 : -values[i];
-    return eigen.eigenvectors() * values.asDiagonal() * eigen.eigenvectors().transpose();
+    projected = eigen.eigenvectors() * values.asDiagonal() * eigen.eigenvectors().transpose();
+    // END EXERCISE
+    return projected;
 }
 
 template Eigen::Matrix<double, 9, 9> project_to_psd<9>(const Eigen::Matrix<double, 9, 9>&, Projection);

@@ -42,7 +42,7 @@ dynamics::Scene cube_scene(double youngs, double poisson)
 
 }  // namespace
 
-TEST_CASE("hyperelastic model: forces are -dU/du and K is df/du (finite differences), for every material", "[ch12]")
+TEST_CASE("hyperelastic model: forces are -dU/du and K is df/du (finite differences), for every material", "[ex12.5]")
 {
     const TetMesh mesh = box_mesh(2, 1, 1, Eigen::Vector3d(0.2, 0.1, 0.1));
     const Eigen::VectorXd u = 0.01 * fem::random_vector(3 * mesh.V.rows(), 3);
@@ -68,7 +68,7 @@ TEST_CASE("hyperelastic model: forces are -dU/du and K is df/du (finite differen
     }
 }
 
-TEST_CASE("hyperelastic model: the affine patch test and rigid motions", "[ch12]")
+TEST_CASE("hyperelastic model: the affine patch test and rigid motions", "[ex12.4]")
 {
     const TetMesh mesh = box_mesh(3, 3, 3);
     Eigen::Matrix3d F;
@@ -112,7 +112,7 @@ double bisect(Function f, double low, double high)
 
 }  // namespace
 
-TEST_CASE("uniaxial stretch of a bar: the end force against the analytic curve of StVK and neo-Hookean", "[ch12]")
+TEST_CASE("uniaxial stretch of a bar: the end force against the analytic curve of StVK and neo-Hookean", "[ex12.4]")
 {
     // A bar L × a × a stretched by λ along x, free to contract laterally to l (where the lateral
     // stress vanishes): the sum of the forces on its end face is P₁₁ a². Closed form for StVK
@@ -155,7 +155,50 @@ TEST_CASE("uniaxial stretch of a bar: the end force against the analytic curve o
     }
 }
 
-TEST_CASE("Newton backward Euler: one iteration and chapter 10's step for a linear body", "[ch12]")
+TEST_CASE("the backward Euler objective: its terms, and its minimum at chapter 10's step for a linear body", "[ex12.7]")
+{
+    dynamics::Scene scene = cube_scene(1e5, 0.3);
+    dynamics::Body body(scene);
+    dynamics::State state = dynamics::initial_state(body);
+    state.v = 0.1 * fem::random_vector(state.v.size(), 21).cwiseProduct(body.dofs().free_mask());
+    const double dt = scene.time_step;
+    const Eigen::VectorXd v = 0.2 * fem::random_vector(state.v.size(), 22).cwiseProduct(body.dofs().free_mask());
+    // E(v) written out: ½ΔvᵀMΔv + ½ uᵀKu (linear U) − Δt vᵀ f_ext.
+    const Eigen::VectorXd u = state.u + dt * v, change = v - state.v;
+    Eigen::VectorXd forces;
+    const double elastic = body.model().evaluate(u, forces);
+    CHECK(backward_euler_objective(body, state, dt, v) ==
+          Approx(0.5 * change.dot(body.mass_matrix() * change) + elastic - dt * v.dot(body.external_forces())).epsilon(1e-12));
+    // Chapter 10's backward Euler step lands on the minimum: E grows in every direction from it.
+    dynamics::ThetaMethod theta(1.0);
+    dynamics::State stepped = state;
+    theta.step(body, dt, stepped);
+    const double at_step = backward_euler_objective(body, state, dt, stepped.v);
+    for (unsigned seed = 30; seed < 35; ++seed) {
+        const Eigen::VectorXd nudge = 1e-3 * fem::random_vector(v.size(), seed).cwiseProduct(body.dofs().free_mask());
+        CHECK(backward_euler_objective(body, state, dt, stepped.v + nudge) > at_step);
+    }
+}
+
+TEST_CASE("the backward Euler gradient: the objective's by finite differences, zero at chapter 10's step", "[ex12.8]")
+{
+    dynamics::Scene scene = cube_scene(1e5, 0.3);
+    dynamics::Body body(scene);
+    dynamics::State state = dynamics::initial_state(body);
+    const double dt = scene.time_step;
+    const Eigen::VectorXd v = 0.2 * fem::random_vector(state.v.size(), 23).cwiseProduct(body.dofs().free_mask());
+    const Eigen::VectorXd direction = fem::random_vector(v.size(), 24).cwiseProduct(body.dofs().free_mask());
+    CHECK(best(test::central_difference_errors(
+              [&](double h) { return Eigen::VectorXd::Constant(1, backward_euler_objective(body, state, dt, v + h * direction)); },
+              Eigen::VectorXd::Constant(1, backward_euler_gradient(body, state, dt, v).dot(direction)), 0.1)) < 1e-6);
+    dynamics::ThetaMethod theta(1.0);
+    dynamics::State stepped = state;
+    theta.step(body, dt, stepped);
+    const Eigen::VectorXd at_step = body.dofs().gather(backward_euler_gradient(body, state, dt, stepped.v));
+    CHECK(at_step.norm() <= 1e-10 * momentum_scale(body, state, dt));
+}
+
+TEST_CASE("Newton backward Euler: one iteration and chapter 10's step for a linear body", "[ex12.9]")
 {
     dynamics::Scene scene = cube_scene(1e5, 0.3);
     dynamics::Body newton_body(scene), theta_body(scene);
@@ -172,7 +215,7 @@ TEST_CASE("Newton backward Euler: one iteration and chapter 10's step for a line
 }
 
 TEST_CASE("Newton backward Euler: the gradient and Hessian of E by finite differences, quadratic convergence",
-          "[ch12]")
+          "[ex12.9]")
 {
     dynamics::Scene scene = cube_scene(1e5, 0.4);
     scene.gravity = Eigen::Vector3d(0.0, 0.0, -200.0);  // a large sag: a nonlinear step
@@ -216,7 +259,7 @@ TEST_CASE("Newton backward Euler: the gradient and Hessian of E by finite differ
 }
 
 TEST_CASE("Newton backward Euler: the line search keeps neo-Hookean tets uninverted where plain Newton fails",
-          "[ch12]")
+          "[ex12.9]")
 {
     // A soft cube pinned at its base, its top slammed down at 40 m/s: one step of 1/24 s would move
     // the top by sixteen times the cube's height.
@@ -246,7 +289,7 @@ TEST_CASE("Newton backward Euler: the line search keeps neo-Hookean tets uninver
     CHECK(ratio > 0.0);  // every tet still positively oriented
 }
 
-TEST_CASE("stable neo-Hookean: a tet squashed through inversion recovers, neo-Hookean refuses to start", "[ch12]")
+TEST_CASE("stable neo-Hookean: a tet squashed through inversion recovers, neo-Hookean refuses to start", "[ex12.9]")
 {
     dynamics::Scene scene;
     scene.mesh = box_mesh(1, 1, 1, Eigen::Vector3d(0.1, 0.1, 0.1));
@@ -274,7 +317,7 @@ TEST_CASE("stable neo-Hookean: a tet squashed through inversion recovers, neo-Ho
 }
 
 TEST_CASE("statics: the hyperelastic sag tends to chapter 10's linear one as the load goes to zero, at rate 1",
-          "[ch12]")
+          "[ex12.9]")
 {
     std::vector<double> gaps;
     for (const double g : {1.0, 0.5, 0.25, 0.125}) {  // sags of 6 % of the length and less: the asymptotic range
@@ -295,7 +338,7 @@ TEST_CASE("statics: the hyperelastic sag tends to chapter 10's linear one as the
         CHECK(std::log2(gaps[k - 1] / gaps[k]) == Approx(1.0).margin(0.15));
 }
 
-TEST_CASE("hard cases: Y = 1e7 at dt = 1/24 s stays stable, nu up to 0.499 converges every step", "[ch12]")
+TEST_CASE("hard cases: Y = 1e7 at dt = 1/24 s stays stable, nu up to 0.499 converges every step", "[ex12.9]")
 {
     for (const double poisson : {0.3, 0.45, 0.49, 0.499}) {
         dynamics::Scene scene;
