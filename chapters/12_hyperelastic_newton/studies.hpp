@@ -1,0 +1,50 @@
+#pragma once
+// The studies of ch12_hyperelastic_newton, one file each (study_*.cpp), called in order by main.cpp.
+// Not part of the chapter's library: only the executable uses them.
+
+#include "12_hyperelastic_newton/hyperelastic.hpp"
+#include "12_hyperelastic_newton/newton.hpp"
+
+#include "10_linear_dynamics/body.hpp"
+
+#include "common/cli.hpp"
+#include "common/vtk_io.hpp"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace fem::hyper::study {
+
+/// The executable's options (main.cpp checks them before any study runs).
+struct Settings {
+    dynamics::Material soft{2e5, 0.45, 1100.0};    ///< the swinging beam (chapter 11's)
+    double duration = 1.5;                         ///< length of the swing [s]
+    int swing_cells = 20;                          ///< cells along the swinging beam
+    std::vector<int> cost_cells{20, 40, 100};      ///< cells along the beams of the cost study
+    double seconds = 0.2;                          ///< measuring time per timed kernel [s]
+};
+
+/// Chapter 11's soft cantilever, 0.2 × 0.02 × 0.02 m, clamped at x = 0, released from the horizontal
+/// under gravity, undamped, Δt = 1/60 s.
+dynamics::Scene beam_scene(const dynamics::Material& material, int cells_along, double duration);
+
+/// The tip: the vertex at the free end's top corner.
+int beam_tip(const TetMesh& mesh);
+
+/// The models compared: "linear" (chapter 10), "corotational" (chapter 11), "stvk", "neo-hookean",
+/// "stable-neo-hookean".
+const std::vector<std::string>& model_names();
+
+/// The force model called `name` for a scene's mesh and material.
+std::unique_ptr<dynamics::ForceModel> force_model(const std::string& name, const dynamics::Scene& scene);
+
+/// One frame of a body for the .pvd: rest positions, displacement, velocity, von Mises stress.
+io::MeshData frame(const dynamics::Body& body, const dynamics::State& state);
+
+void materials_study(const RunContext& run, const Settings& settings);
+void newton_study(const RunContext& run, const Settings& settings);
+void swing_study(const RunContext& run, const Settings& settings);
+void cost_study(const RunContext& run, const Settings& settings);
+
+}  // namespace fem::hyper::study

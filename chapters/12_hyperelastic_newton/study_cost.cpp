@@ -1,0 +1,76 @@
+// Study 4 of ch12_hyperelastic_newton: what a Newton iteration costs — ψ and P per element, the
+// exact and the projected Hessian into the fixed pattern, the step matrix, the solve — on beams up
+// to 36k dofs; a 10 000-vertex neo-Hookean step against Vega's StVK. docs/12_hyperelastic_newton.md#cost
+#include "12_hyperelastic_newton/studies.hpp"
+
+#include "10_linear_dynamics/time_integration.hpp"
+
+#include "06_assembly/assembly.hpp"
+
+#include "common/error.hpp"
+#include "common/table.hpp"
+#include "common/timer.hpp"
+
+#include <iostream>
+
+namespace fem::hyper::study {
+
+void cost_study(const RunContext& run, const Settings& settings)
+{
+    std::cout << "\n== 4. Cost of a Newton iteration (neo-Hookean, backward Euler at dt = 1/60 s)\n\n";
+    Table parts("The parts of one Newton iteration at a sagging state",
+                {{"free dofs", Format::integer}, {"tets", Format::integer}, {"energy and forces [s]", Format::scientific, 2},
+                 {"exact Hessian [s]", Format::scientific, 2}, {"projected Hessian [s]", Format::scientific, 2},
+                 {"step matrix [s]", Format::scientific, 2}, {"factor and solve [s]", Format::scientific, 2}});
+    for (int cells : settings.cost_cells) {
+        dynamics::Scene scene = beam_scene(dynamics::Material{1e6, 0.45, 1100.0}, cells, 1.0);
+        dynamics::Body body(scene, force_model("neo-hookean", scene));
+        NewtonBackwardEuler newton;
+        dynamics::State state = dynamics::initial_state(body);
+        for (int k = 0; k < 3; ++k)
+            newton.step(body, scene.time_step, state);
+        auto& model = dynamic_cast<HyperelasticElasticity&>(body.model());
+        Eigen::VectorXd forces;
+        const double evaluate = best_time([&] { model.evaluate(state.u, forces); }, settings.seconds);
+        const double exact = best_time([&] { (void)model.stiffness(state.u); }, settings.seconds);
+        const double projected = best_time([&] { (void)model.definite_stiffness(state.u); }, settings.seconds);
+        const dynamics::SparseMatrix K = model.stiffness(state.u);
+        dynamics::SparseMatrix A;
+        const double matrix = best_time([&] {
+            A = body.dofs().reduce(dynamics::step_matrix(body.mass_matrix(), K, scene.damping, scene.time_step, 1.0));
+        }, settings.seconds);
+        const auto solver = cg::make_solver("default");
+        const Eigen::VectorXd b = Eigen::VectorXd::Ones(A.rows());
+        const double solve = best_time([&] {
+            solver->prepare(A);
+            (void)solver->solve(b);
+        }, settings.seconds);
+        parts.add_row({double(body.dofs().size()), double(scene.mesh.T.rows()), evaluate, exact, projected, matrix, solve});
+    }
+    parts.print(std::cout);
+    parts.write_csv(run.file("parts_table.csv"));
+
+    // Why: a published reference point. Vega runs StVK on a 9 875-vertex mesh at 2 steps per second.
+    dynamics::Scene vega = beam_scene(dynamics::Material{1e6, 0.45, 1100.0}, 2, 1.0);
+    vega.mesh = box_mesh(60, 12, 12, Eigen::Vector3d(0.2, 0.04, 0.04));  // 61 × 13 × 13 = 10 309 vertices
+    vega.pinned = assembly::vertices_on_plane(vega.mesh, 0, 0.0);
+    dynamics::Body body(vega, force_model("neo-hookean", vega));
+    NewtonBackwardEuler newton;
+    dynamics::State state = dynamics::initial_state(body);
+    newton.step(body, vega.time_step, state);
+    const int steps = run.quick ? 2 : 5;
+    int iterations = 0;
+    Timer clock;
+    for (int k = 0; k < steps; ++k)
+        iterations += newton.step(body, vega.time_step, state).newton_iterations;
+    const double ours = clock.seconds() / steps;
+    Table goal("A 10,000-vertex neo-Hookean backward Euler step, converged (relative tolerance 1e-6), one core",
+               {{"vertices", Format::integer}, {"free dofs", Format::integer}, {"Newton iterations per step", Format::fixed, 1},
+                {"our step [s]", Format::scientific, 2}, {"Vega's StVK step (published) (s)", Format::fixed, 2},
+                {"speed-up [measured]", Format::fixed, 1}});
+    goal.add_row({double(vega.mesh.V.rows()), double(body.dofs().size()), double(iterations) / steps, ours, 0.5, 0.5 / ours});
+    goal.print(std::cout);
+    goal.write_csv(run.file("vega_table.csv"));
+}
+
+}  // namespace fem::hyper::study

@@ -1,0 +1,153 @@
+// Study 2 of ch12_hyperelastic_newton: Newton's method itself — the gradient norm per iteration
+// (quadratic convergence), which Hessian to solve with (exact, projected by clamping or mirroring,
+// exact with a projected fallback), the line search against plain Newton on a slammed cube, and
+// the tolerance against the error it leaves. docs/12_hyperelastic_newton.md#newton-in-practice
+#include "12_hyperelastic_newton/studies.hpp"
+
+#include "06_assembly/assembly.hpp"
+
+#include "common/error.hpp"
+#include "common/figures.hpp"
+#include "common/table.hpp"
+#include "common/timer.hpp"
+
+#include <cmath>
+#include <iostream>
+
+namespace fem::hyper::study {
+namespace {
+
+/// A neo-Hookean cube 10 cm, pinned at its base, its top slammed down at 40 m/s (dt = 1/24 s): one
+/// step would move the top sixteen heights down, through the base.
+struct SlammedCube {
+    dynamics::Scene scene;
+    Eigen::VectorXd v0;
+};
+
+SlammedCube slammed_cube()
+{
+    SlammedCube cube;
+    cube.scene.mesh = box_mesh(2, 2, 2, Eigen::Vector3d(0.1, 0.1, 0.1));
+    cube.scene.material = {1e4, 0.4, 1000.0};
+    cube.scene.gravity.setZero();
+    cube.scene.pinned = assembly::vertices_on_plane(cube.scene.mesh, 2, 0.0);
+    cube.scene.time_step = 1.0 / 24.0;
+    cube.v0 = Eigen::VectorXd::Zero(3 * cube.scene.mesh.V.rows());
+    for (Eigen::Index v = 0; v < cube.scene.mesh.V.rows(); ++v)
+        cube.v0[3 * v + 2] = -400.0 * cube.scene.mesh.V(v, 2);
+    return cube;
+}
+
+}  // namespace
+
+void newton_study(const RunContext& run, const Settings& settings)
+{
+    std::cout << "\n== 2. Newton's method: convergence, the Hessian, the line search, the tolerance\n\n";
+    const dynamics::Scene swing = beam_scene(settings.soft, run.quick ? 10 : settings.swing_cells, settings.duration);
+
+    // Why: quadratic convergence is Newton's promise; the gradient norms of a few steps show it.
+    fig::LineChart history;
+    history.title = "Newton on the swing (stable neo-Hookean, dt = 1/60 s): |grad E| per iteration";
+    history.x_label = "Newton iteration";
+    history.y_label = "|grad E| / momentum scale";
+    history.log_y = true;
+    {
+        dynamics::Body body(swing, force_model("stable-neo-hookean", swing));
+        NewtonOptions options;
+        options.relative_tolerance = 1e-12;
+        NewtonBackwardEuler newton(options);
+        dynamics::State state = dynamics::initial_state(body);
+        for (int step = 1; step <= 40; ++step) {
+            newton.step(body, swing.time_step, state);
+            if (step == 1 || step == 15 || step == 40) {
+                fig::Series series{str("step ", step), {}, newton.last().gradient_history};
+                for (std::size_t k = 0; k < series.y.size(); ++k)
+                    series.x.push_back(double(k));
+                history.series.push_back(series);
+            }
+        }
+    }
+    history.legend = fig::Corner::top_right;
+    fig::save_chart(history, run.file("newton_history"), run.figures);
+
+    // Why: the exact Hessian converges quadratically but can be indefinite; projecting every element
+    // Hessian is always safe but slows convergence where it changed K. The slammed cube shows both.
+    const SlammedCube cube = slammed_cube();
+    Table hessians("The slammed neo-Hookean cube, one step of 1/24 s: which Hessian, and the line search",
+                   {{"Hessian", Format::text}, {"line search", Format::text}, {"outcome", Format::text},
+                    {"Newton iterations", Format::integer}, {"fallbacks to the projected Hessian", Format::integer},
+                    {"smallest det F", Format::fixed, 3}});
+    struct Choice {
+        std::string name;
+        HessianChoice hessian;
+        Projection projection;
+        bool line_search;
+    };
+    for (const Choice& choice : {Choice{"exact, projected where needed (clamp)", HessianChoice::exact_then_definite, Projection::clamp, true},
+                                 Choice{"projected (clamp)", HessianChoice::definite, Projection::clamp, true},
+                                 Choice{"projected (absolute)", HessianChoice::definite, Projection::absolute, true},
+                                 Choice{"exact", HessianChoice::exact, Projection::clamp, true},
+                                 Choice{"exact, projected where needed (clamp)", HessianChoice::exact_then_definite, Projection::clamp, false}}) {
+        auto model = std::make_unique<HyperelasticElasticity>(cube.scene.mesh, make_material("neo-hookean", 1e4, 0.4),
+                                                              choice.projection);
+        const HyperelasticElasticity& view = *model;
+        dynamics::Body body(cube.scene, std::move(model));
+        NewtonOptions options;
+        options.hessian = choice.hessian;
+        options.line_search = choice.line_search;
+        options.max_iterations = 200;
+        NewtonBackwardEuler newton(options);
+        dynamics::State state = dynamics::initial_state(body, {}, cube.v0);
+        std::string outcome = "converged";
+        try {
+            newton.step(body, cube.scene.time_step, state);
+        } catch (const Error& e) {
+            const std::string what = e.what();
+            outcome = what.find("det F") != std::string::npos        ? "failed: a tet inverted"
+                      : what.find("positive definite") != std::string::npos ? "failed: indefinite Hessian"
+                                                                            : "failed: no convergence";
+        }
+        hessians.add_row({choice.name, std::string(choice.line_search ? "Armijo" : "none (plain Newton)"), outcome,
+                          double(newton.last().iterations), double(newton.last().definite_fallbacks),
+                          outcome == "converged" ? view.smallest_volume_ratio(state.u) : 0.0});
+    }
+    hessians.print(std::cout);
+    hessians.write_csv(run.file("hessian_table.csv"));
+
+    // Why: the tolerance decides what a step costs and how far it is from the exact backward Euler
+    // step; the tip error against a 1e-10 run at the same Δt says where it stops mattering.
+    Table tolerances("The tolerance on the swing (stable neo-Hookean, dt = 1/60 s): error left and time",
+                     {{"relative tolerance", Format::scientific, 0}, {"Newton iterations per step", Format::fixed, 2},
+                      {"max tip difference to tolerance 1e-10 [m]", Format::scientific, 2}, {"time per step [s]", Format::scientific, 2}});
+    const auto tip_path = [&](double tolerance, double& iterations, double& seconds) {
+        dynamics::Body body(swing, force_model("stable-neo-hookean", swing));
+        NewtonOptions options;
+        options.relative_tolerance = tolerance;
+        NewtonBackwardEuler newton(options);
+        dynamics::Simulation simulation(body, newton, dynamics::initial_state(body), swing.time_step);
+        const int tip = beam_tip(swing.mesh), steps = dynamics::step_count(swing.duration, swing.time_step);
+        std::vector<Eigen::Vector3d> path;
+        iterations = 0.0;
+        Timer clock;
+        simulation.run(steps, [&](const dynamics::State& state, const dynamics::StepRecord& record) {
+            path.push_back(body.positions(state.u).row(tip).transpose());
+            iterations += record.newton_iterations;
+        });
+        seconds = clock.seconds() / steps;
+        iterations /= steps;
+        return path;
+    };
+    double iterations = 0.0, seconds = 0.0;
+    const std::vector<Eigen::Vector3d> tight = tip_path(1e-10, iterations, seconds);
+    for (const double tolerance : {1e-1, 1e-2, 1e-3, 1e-4, 1e-6, 1e-8}) {
+        const std::vector<Eigen::Vector3d> path = tip_path(tolerance, iterations, seconds);
+        double difference = 0.0;
+        for (std::size_t k = 0; k < path.size(); ++k)
+            difference = std::max(difference, (path[k] - tight[k]).norm());
+        tolerances.add_row({tolerance, iterations, difference, seconds});
+    }
+    tolerances.print(std::cout);
+    tolerances.write_csv(run.file("tolerance_table.csv"));
+}
+
+}  // namespace fem::hyper::study
