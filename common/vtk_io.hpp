@@ -75,7 +75,11 @@ void validate(const ImageGrid& grid);
 /// Writes mesh as a .vtu file (binary, compressed) with vtkXMLUnstructuredGridWriter.
 void write_vtu(const std::filesystem::path& path, const MeshData& mesh);
 
-/// Reads a .vtu file written by write_vtu or ParaView (cells of one type among the four above).
+/// Reads a .vtu file written by write_vtu or ParaView (cells of one type among the four above), with
+/// VTK's XML reader, and checks what it read (detail::from_vtk in common/vtk_convert.hpp): fem::Error
+/// naming the file for a file VTK cannot read, another or a mixed cell type, a point out of range, a
+/// non-finite value. VTK 9.1's reader itself is not guarded yet: a corrupted binary or compressed
+/// file can crash it (fuzz/known_vtk_crashes/).
 MeshData read_vtu(const std::filesystem::path& path);
 
 /// Writes mesh (cells: lines or triangles) as a .vtp surface with vtkXMLPolyDataWriter.
