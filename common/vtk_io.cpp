@@ -1,5 +1,6 @@
 #include "common/vtk_io.hpp"
 #include "common/vtk_convert.hpp"
+#include "common/vtu_check.hpp"
 
 #include "common/error.hpp"
 #include "common/files.hpp"
@@ -262,6 +263,7 @@ MeshData read_vtu(const std::filesystem::path& path)
 {
     if (!std::filesystem::is_regular_file(path))
         throw Error(str("cannot read '", path.string(), "': no such file"));
+    detail::check_vtu_layout(path);  // VTK's reader trusts the file's counts and block headers
     vtkNew<vtkXMLUnstructuredGridReader> reader;
     reader->SetFileName(path.c_str());
     reader->Update();
