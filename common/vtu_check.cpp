@@ -396,6 +396,9 @@ private:
         for (std::uint64_t b = 0; b < blocks; ++b) {
             const std::uint64_t stored_size = word(header, 3 + b, header_bytes_);
             const std::uint64_t plain = (b + 1 == blocks && last != 0) ? last : block_size;
+            if (stored_size > text_.size())  // before any sum or product of it can overflow
+                fail(str("DataArray '", array.name, "': compressed block ", b, " announces ", stored_size,
+                         " bytes in a file of ", text_.size()));
             if (plain > max_zlib_ratio * stored_size + 64)
                 fail(str("DataArray '", array.name, "': compressed block ", b, " of ", stored_size,
                          " bytes claims ", plain, " bytes, more than zlib can compress into it"));
