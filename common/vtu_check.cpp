@@ -43,8 +43,10 @@ struct Array {
     bool empty = false;       // an inline array written <DataArray .../>
 };
 
+/// One .vtu file, read into memory, and what its checks have learnt of it so far.
 class VtuLayout {
 public:
+    /// Reads the whole file (fem::Error if it cannot be read).
     explicit VtuLayout(const std::filesystem::path& path) : name_(path.string())
     {
         std::ifstream in(path, std::ios::binary);
@@ -53,8 +55,10 @@ public:
         text_.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
     }
 
+    /// fem::Error naming the file and what is wrong with it.
     [[noreturn]] void fail(const std::string& what) const { throw Error(str("'", name_, "': ", what)); }
 
+    /// Walks the XML elements in order, checking each (check_vtu_layout's contract).
     void check()
     {
         // The XML ends where the appended data begins (raw bytes may hold anything).
@@ -154,6 +158,7 @@ private:
         return tag;
     }
 
+    /// The value of attribute `key`, or `fallback` when the tag has none.
     std::string attribute(const Tag& tag, std::string_view key, std::string_view fallback) const
     {
         const auto found = tag.attributes.find(key);
@@ -174,6 +179,8 @@ private:
         return value;
     }
 
+    /// Checks an opening tag inside `parent` (empty for the root): the file's settings, the piece's
+    /// counts, a data array.
     void start_element(const Tag& tag, const std::string& parent)
     {
         if (tag.name == "VTKFile") {
@@ -268,6 +275,7 @@ private:
 
     // --- where the values are ---------------------------------------------------------------
 
+    /// Reads the <AppendedData> tag at `tag_at`: its encoding, and where its bytes begin (after '_').
     void find_appended_data(std::size_t tag_at)
     {
         const Tag tag = read_tag(tag_at);
@@ -317,6 +325,7 @@ private:
     /// Reads encoded bytes of an array: base64 text (inline, or appended base64) or raw appended bytes.
     class Reader {
     public:
+        /// Starts at the array's first byte: after its tag (inline) or at its offset (appended).
         Reader(const VtuLayout& file, const Array& array) : file_(file), array_(array)
         {
             if (array.format == "binary") {
