@@ -689,8 +689,11 @@ bool save_chart(const LineChart& chart, const std::filesystem::path& stem, bool 
     for (Corner c : {Corner::top_right, Corner::top_left, Corner::bottom_right, Corner::bottom_left})
         if (c != chart.legend)
             corners.push_back(c);
-    const auto free_corner = std::find_if(corners.begin(), corners.end(), [&](Corner c) {
-        return !layout.covers(layout.legend_box(c, legend_width, legend_height));
+    // (The sizes are captured by value: clang 14, which builds the fuzz targets, cannot capture a
+    // structured binding by reference.)
+    const auto free_corner = std::find_if(corners.begin(), corners.end(),
+                                          [&, width = legend_width, height = legend_height](Corner c) {
+        return !layout.covers(layout.legend_box(c, width, height));
     });
     Corner corner = chart.legend;
     if (free_corner != corners.end()) {

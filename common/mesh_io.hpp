@@ -27,8 +27,9 @@ namespace fem::io {
 /// Reads a triangle surface by its extension:
 ///  - .obj: `v x y z` and `f i j k ...` records (indices 1-based or negative, `i/t/n` forms), other
 ///    records (vt, vn, g, o, s, usemtl, l, ...) ignored; read by a line-aware parser;
-///  - .stl: ASCII or binary, read with vtkSTLReader; the corners STL repeats for every facet are
-///    merged into shared vertices with vtkCleanPolyData (exactly equal positions only);
+///  - .stl: ASCII or binary (the binary size checked against its facet count), read by a hand-written
+///    parser; the corners STL repeats for every facet are merged into shared vertices (exactly equal
+///    positions only);
 ///  - .ply: ASCII or binary (either byte order), element `vertex` with x, y, z and element `face`
 ///    with the list `vertex_indices` (or `vertex_index`); other elements and properties skipped;
 ///  - .vtu: an unstructured grid of triangles (fem::io::read_vtu).

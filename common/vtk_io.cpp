@@ -1,5 +1,6 @@
 #include "common/vtk_io.hpp"
 #include "common/vtk_convert.hpp"
+#include "common/vtu_check.hpp"
 
 #include "common/error.hpp"
 #include "common/files.hpp"
@@ -262,13 +263,20 @@ MeshData read_vtu(const std::filesystem::path& path)
 {
     if (!std::filesystem::is_regular_file(path))
         throw Error(str("cannot read '", path.string(), "': no such file"));
+    detail::check_vtu_layout(path);  // VTK's reader trusts the file's counts and block headers
     vtkNew<vtkXMLUnstructuredGridReader> reader;
     reader->SetFileName(path.c_str());
     reader->Update();
     vtkUnstructuredGrid* grid = reader->GetOutput();
     if (reader->GetErrorCode() != 0 || grid == nullptr || grid->GetPoints() == nullptr)
         throw Error(str("cannot read '", path.string(), "' as a VTK unstructured grid (.vtu)"));
+    return detail::from_vtk(grid, path.string());
+}
 
+namespace detail {
+
+MeshData from_vtk(vtkUnstructuredGrid* grid, const std::string& file)
+{
     MeshData mesh;
     mesh.points.resize(grid->GetNumberOfPoints(), 3);
     for (vtkIdType i = 0; i < grid->GetNumberOfPoints(); ++i) {
@@ -289,7 +297,7 @@ MeshData read_vtu(const std::filesystem::path& path)
         case VTK_TRIANGLE: per_cell = 3; break;
         case VTK_TETRA: per_cell = 4; break;
         default:
-            throw Error(str("'", path.string(), "': cell 0 has VTK cell type ", type, "; the course reads vertices (",
+            throw Error(str("'", file, "': cell 0 has VTK cell type ", type, "; the course reads vertices (",
                             VTK_VERTEX, "), lines (", VTK_LINE, "), triangles (", VTK_TRIANGLE, ") and tetrahedra (",
                             VTK_TETRA, ")"));
         }
@@ -297,16 +305,16 @@ MeshData read_vtu(const std::filesystem::path& path)
         vtkNew<vtkIdList> ids;
         for (vtkIdType e = 0; e < cell_count; ++e) {
             if (grid->GetCellType(e) != type)
-                throw Error(str("'", path.string(), "': cell ", e, " has VTK cell type ", grid->GetCellType(e),
+                throw Error(str("'", file, "': cell ", e, " has VTK cell type ", grid->GetCellType(e),
                                 ", cell 0 has ", type, "; mixed cell types are not supported"));
             grid->GetCellPoints(e, ids);
             if (ids->GetNumberOfIds() != per_cell)
-                throw Error(str("'", path.string(), "': cell ", e, " has ", ids->GetNumberOfIds(), " points; its type ",
+                throw Error(str("'", file, "': cell ", e, " has ", ids->GetNumberOfIds(), " points; its type ",
                                 type, " has ", per_cell));
             for (vtkIdType k = 0; k < per_cell; ++k) {
                 const vtkIdType id = ids->GetId(k);
                 if (id < 0 || id >= grid->GetNumberOfPoints())
-                    throw Error(str("'", path.string(), "': cell ", e, " refers to point ", id, ", the file has ",
+                    throw Error(str("'", file, "': cell ", e, " refers to point ", id, ", the file has ",
                                     grid->GetNumberOfPoints(), " points"));
                 mesh.cells(e, k) = static_cast<int>(id);
             }
@@ -318,8 +326,15 @@ MeshData read_vtu(const std::filesystem::path& path)
     for (int a = 0; a < grid->GetCellData()->GetNumberOfArrays(); ++a)
         if (vtkDataArray* array = grid->GetCellData()->GetArray(a))
             mesh.cell_data.push_back(from_vtk_array(array));
+    try {
+        validate(mesh);
+    } catch (const Error& error) {
+        throw Error(str("'", file, "': ", error.what()));
+    }
     return mesh;
 }
+
+}  // namespace detail
 
 namespace detail {
 

@@ -75,7 +75,12 @@ void validate(const ImageGrid& grid);
 /// Writes mesh as a .vtu file (binary, compressed) with vtkXMLUnstructuredGridWriter.
 void write_vtu(const std::filesystem::path& path, const MeshData& mesh);
 
-/// Reads a .vtu file written by write_vtu or ParaView (cells of one type among the four above).
+/// Reads a .vtu file written by write_vtu or ParaView (cells of one type among the four above), with
+/// VTK's XML reader, and checks what it read (detail::from_vtk in common/vtk_convert.hpp): fem::Error
+/// naming the file for a file VTK cannot read, another or a mixed cell type, a point out of range, a
+/// non-finite value. Before VTK reads the file, its counts and data blocks are checked against what
+/// it holds (detail::check_vtu_layout in common/vtu_check.hpp): VTK 9.1's reader trusts them, and a
+/// corrupted file crashed it.
 MeshData read_vtu(const std::filesystem::path& path);
 
 /// Writes mesh (cells: lines or triangles) as a .vtp surface with vtkXMLPolyDataWriter.

@@ -7,10 +7,12 @@ packages=(
   g++ cmake ninja-build python3           # toolchain
   libeigen3-dev catch2 libcli11-dev       # linear algebra, tests, command lines
   libvtk9-dev libx11-dev xvfb xauth       # VTK files and figures; a virtual display
+  zlib1g-dev                              # .vtu data blocks checked before VTK reads them
   fonts-dejavu-core                       # the figures' font (common/figures.cpp)
   libsuitesparse-dev libopenblas0-pthread # CHOLMOD, the speed reference of chapters 08-09
   tetgen                                  # tetrahedral meshes from surfaces
   libspectra-dev                          # sparse eigenvalues (chapter 10: modes)
+  clang-14 libclang-rt-14-dev             # the readers' fuzz targets (libFuzzer; tools/fuzz.sh)
 )
 
 missing=()

@@ -7,6 +7,8 @@
 #   4. release   every test passes on the reference solutions: unit tests, the layout and
 #                exercise-sync checks, each executable's --quick run against stored numbers, and
 #                each chapter's docs against its executable
+#   5. fuzz      every file reader's libFuzzer target runs 25 s from its seed corpus without a
+#                finding (tools/fuzz.sh; clang, ASan + UBSan)
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 cd "$FEM_ROOT"
@@ -17,21 +19,24 @@ export ASAN_OPTIONS="detect_leaks=0:abort_on_error=1" UBSAN_OPTIONS="print_stack
 step "exercises/ in sync with solutions/"
 python3 tools/exercises.py check
 
-step "1/4 grading build: every exercise fails its tests as a stub and needs only what it builds on"
+step "1/5 grading build: every exercise fails its tests as a stub and needs only what it builds on"
 cmake --preset grading -DFEM_WERROR=ON >/dev/null
 cmake --build --preset grading -j "$JOBS"
 with_display python3 tools/exercises.py grade --build build/grading
 
-step "2/4 every chapter library compiles from exercises/"
+step "2/5 every chapter library compiles from exercises/"
 cmake --preset exercises -DFEM_WERROR=ON >/dev/null
 cmake --build --preset exercises -j "$JOBS"
 
-step "3/4 unit tests under AddressSanitizer + UndefinedBehaviorSanitizer"
+step "3/5 unit tests under AddressSanitizer + UndefinedBehaviorSanitizer"
 cmake --preset asan -DFEM_WERROR=ON >/dev/null
 cmake --build --preset asan -j "$JOBS" --target fem_tests
 with_display ctest --preset asan
 
-step "4/4 release: all tests on the reference solutions"
+step "4/5 release: all tests on the reference solutions"
 cmake --preset release -DFEM_WERROR=ON >/dev/null
 cmake --build --preset release -j "$JOBS"
 with_display ctest --preset release
+
+step "5/5 the file readers fuzzed: each libFuzzer target 25 s from its seeds, no crash, sanitizer report, stray exception or runaway allocation"
+tools/fuzz.sh --seconds 25

@@ -1,15 +1,20 @@
 // Regression tests for bad files that crashed, hung or were silently misread (issue 10's
-// reproducers): each must now be an fem::Error naming the file and what is wrong.
+// reproducers): each must now be an fem::Error naming the file and what is wrong. The corpus under
+// tests/common/bad_files/ (the fuzzers' findings among them) is replayed file by file.
 #include "common/error.hpp"
 #include "common/mesh_io.hpp"
 #include "common/test_support.hpp"
 #include "common/vtk_io.hpp"
+#include "fuzz/read_by_extension.hpp"
 
 #include <catch2/catch.hpp>
 
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
 #include <string>
 
 using Catch::Matchers::Contains;
@@ -37,7 +42,48 @@ std::string vtu(int points, int cells, const std::string& coordinates, const std
            "</DataArray></Cells></Piece></UnstructuredGrid></VTKFile>";
 }
 
+/// The corpus's table tests/common/bad_files/errors.txt: file name -> what its error must contain.
+std::map<std::string, std::string> expected_errors(const std::filesystem::path& table)
+{
+    std::ifstream in(table);
+    REQUIRE(in);
+    std::map<std::string, std::string> expected;
+    for (std::string line; std::getline(in, line);) {
+        if (line.empty() || line.front() == '#')
+            continue;
+        std::istringstream fields(line);
+        std::string name, text;
+        fields >> name >> std::ws;
+        std::getline(fields, text);
+        REQUIRE_FALSE(text.empty());
+        expected[name] = text;
+    }
+    return expected;
+}
+
 }  // namespace
+
+TEST_CASE("the corpus of bad files: each is an fem::Error naming the file and saying what is wrong", "[common][mesh_io]")
+{
+    const std::filesystem::path dir = FEM_BAD_FILES_DIR;
+    const auto expected = expected_errors(dir / "errors.txt");
+    std::set<std::string> listed;
+    for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+        const std::filesystem::path& path = entry.path();
+        if (path.filename() == "errors.txt" || path.extension() == ".ele")
+            continue;  // the table, and the second file of a TetGen pair (read with its .node)
+        const std::string name = path.filename().string();
+        INFO(name);
+        REQUIRE(expected.count(name) == 1);
+        listed.insert(name);
+        CHECK_THROWS_WITH(fem::fuzz::read_by_extension(path),
+                          Contains(path.stem().string()) && Contains(expected.at(name)));
+    }
+    for (const auto& [name, text] : expected) {
+        INFO("errors.txt lists " << name << ", which is not in " << dir.string());
+        CHECK(listed.count(name) == 1);
+    }
+}
 
 TEST_CASE(".vtu: unknown, mixed and out-of-range cells are refused, never dereferenced", "[common][mesh_io]")
 {

@@ -407,7 +407,12 @@ TEST_CASE("bad STL files are refused, naming the facet", "[common][mesh_io]")
                            "endsolid s\n"),
                       Contains("bad.stl, facet 1") && Contains("zero area"));
     CHECK_THROWS_WITH(read("solid s\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n"),
-                      Contains("bad.stl") && Contains("STL reader failed"));
+                      Contains("bad.stl") && Contains("ends inside facet 0") && Contains("vertex x y z"));
+    CHECK_THROWS_WITH(read("solid s\n" + facet("0 0 0", "1 0 0", "0 1 0") + "endsolid s\n" +
+                           facet("1 0 0", "1 1 0", "0 1 0")),
+                      Contains("bad.stl, line 10") && Contains("expected 'solid [name]'"));
+    CHECK_THROWS_WITH(read("solid s\n" + facet("0 0 0", "1 0 0", "0 1 0")),
+                      Contains("bad.stl") && Contains("ends before 'endsolid'"));
 
     const fem::TriMesh bunny = fem::io::read_tri_mesh(fem::data_path("bunny.obj"));
     fem::io::write_tri_mesh(dir / "bunny.stl", bunny);

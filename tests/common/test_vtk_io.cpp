@@ -1,9 +1,12 @@
 // VTK files round-trip through VTK's own readers, and bad data is refused before anything is written.
 #include "common/error.hpp"
 #include "common/test_support.hpp"
+#include "common/vtk_convert.hpp"
 #include "common/vtk_io.hpp"
 
 #include <catch2/catch.hpp>
+#include <vtkNew.h>
+#include <vtkXMLUnstructuredGridWriter.h>
 
 #include <cmath>
 #include <fstream>
@@ -45,6 +48,37 @@ TEST_CASE("a .vtu file reads back exactly what was written", "[common][vtk]")
     CHECK(back.field("velocity").values == mesh.field("velocity").values);
     CHECK(back.field("F").values == mesh.field("F").values);
     CHECK(back.field("volume").values == mesh.field("volume").values);
+}
+
+TEST_CASE("a .vtu in any data mode of VTK's writer passes the checks made before VTK reads it", "[common][vtk]")
+{
+    // ParaView and VTK write ASCII, inline base64 or appended (raw or base64) data, compressed or not,
+    // with 32- or 64-bit block headers, in either byte order: check_vtu_layout must take them all.
+    const auto dir = fem::test::fresh_output_dir("vtu_modes");
+    const auto mesh = two_tets();
+    int written = 0;
+    for (int mode : {vtkXMLWriter::Ascii, vtkXMLWriter::Binary, vtkXMLWriter::Appended})
+        for (bool compressed : {false, true})
+            for (bool header64 : {false, true})
+                for (bool encode : {false, true})
+                    for (bool big_endian : {false, true}) {
+                        vtkNew<vtkXMLUnstructuredGridWriter> writer;
+                        writer->SetInputData(fem::io::detail::to_vtk(mesh));
+                        writer->SetDataMode(mode);
+                        writer->SetCompressorType(compressed ? vtkXMLWriter::ZLIB : vtkXMLWriter::NONE);
+                        writer->SetHeaderType(header64 ? vtkXMLWriter::UInt64 : vtkXMLWriter::UInt32);
+                        writer->SetEncodeAppendedData(encode);
+                        writer->SetByteOrder(big_endian ? vtkXMLWriter::BigEndian : vtkXMLWriter::LittleEndian);
+                        const auto path = dir / fem::str("mode", written++, ".vtu");
+                        writer->SetFileName(path.c_str());
+                        REQUIRE(writer->Write() == 1);
+                        INFO(path.string());
+                        const auto back = fem::io::read_vtu(path);
+                        CHECK(back.points == mesh.points);
+                        CHECK(back.cells == mesh.cells);
+                        CHECK(back.field("velocity").values == mesh.field("velocity").values);
+                        CHECK(back.field("F").values == mesh.field("F").values);
+                    }
 }
 
 TEST_CASE("lines and triangles are written as .vtu and .vtp", "[common][vtk]")

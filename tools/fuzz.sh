@@ -1,0 +1,57 @@
+#!/usr/bin/env bash
+# Fuzzes the course's file readers: builds the fuzz preset (clang, libFuzzer + ASan + UBSan; common/
+# and fuzz/ only) and runs each reader's target from its seed corpus (fuzz/corpus/<target>/) for a
+# bounded time, one target after the other. Exits 1 at the first finding, naming the input that
+# caused it. New inputs that reach new code are kept in build/fuzz/corpus/<target>/ for the next run.
+#
+#   tools/fuzz.sh                         every target, 25 s each (the CI stage of tools/test.sh)
+#   tools/fuzz.sh --seconds 3600 ply      one target for an hour
+#   tools/fuzz.sh --runs 1000000 obj stl  until a million inputs each
+#
+# Targets: obj ply stl tetgen pvd vtu (whole files: the checks before VTK, VTK's XML reader, the
+# checks after it) and vtu_grid (the checks after VTK, on any grid VTK could return).
+# Limits: an input may take 10 s and allocate 512 MB at once (2 GB in all); a reader must refuse a
+# huge count with an fem::Error before it reserves memory for it. Leaks are not reported: VTK's XML
+# reader leaks on some errors.
+set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
+cd "$FEM_ROOT"
+export ASAN_OPTIONS="detect_leaks=0"
+
+seconds=25
+runs=-1
+formats=()
+while [ $# -gt 0 ]; do
+    case "$1" in
+        --seconds) seconds="$2"; shift 2 ;;
+        --runs) runs="$2"; seconds=0; shift 2 ;;
+        -h|--help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        -*) echo "error: unknown option '$1'; allowed: --seconds N, --runs N, formats" >&2; exit 1 ;;
+        *) formats+=("$1"); shift ;;
+    esac
+done
+[ ${#formats[@]} -eq 0 ] && formats=(obj ply stl tetgen pvd vtu vtu_grid)
+for format in "${formats[@]}"; do
+    [ -d "fuzz/corpus/$format" ] || { echo "error: no fuzz target '$format'; allowed: $(ls fuzz/corpus | xargs)" >&2; exit 1; }
+done
+
+cmake --preset fuzz -DFEM_WERROR=ON >/dev/null
+cmake --build --preset fuzz -j "$JOBS"
+
+printf '\n%-8s %12s %10s %8s\n' target executions "exec/s" seconds
+for format in "${formats[@]}"; do
+    work="build/fuzz/corpus/$format" findings="build/fuzz/findings/$format"
+    mkdir -p "$work" "$findings"
+    log="build/fuzz/fuzz_$format.log"
+    start=$SECONDS
+    if ! "build/fuzz/bin/fuzz_$format" -max_total_time="$seconds" -runs="$runs" -timeout=10 \
+            -rss_limit_mb=2048 -malloc_limit_mb=512 -detect_leaks=0 -max_len=8192 -print_final_stats=1 \
+            -artifact_prefix="$findings/" "$work" "fuzz/corpus/$format" >"$log" 2>&1; then
+        tail -n 40 "$log" >&2
+        echo "error: fuzz_$format found a bug; the input is in $findings/ (full log: $log)" >&2
+        exit 1
+    fi
+    executions=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log")
+    rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log")
+    printf '%-8s %12s %10s %8s\n' "$format" "$executions" "$rate" $((SECONDS - start))
+done
