@@ -15,6 +15,9 @@
 #                       quotes the numbers the executable prints (label chNN, docs).
 #   chNN_test_target    ctest: building test_chNN alone builds no later chapter (label chNN, layout),
 #                       the student's one-chapter loop (README, "Student workflow").
+#   chNN_bad_options    ctest, when tests/NN_name/bad_options.txt exists: the executable refuses each
+#                       bad command line of that table before it computes or writes anything
+#                       (tools/check_bad_options.py says the table's form; label chNN, run).
 # DEPENDS lists earlier chapters whose headers this chapter includes; a later one is an error.
 
 set(FEM_ALL_CHAPTERS "" CACHE INTERNAL "registered chapters")
@@ -134,6 +137,12 @@ function(fem_add_chapter number name)
              COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/check_targets.py --build ${CMAKE_BINARY_DIR}
                      --chapter ${id})
     set_tests_properties(ch${number}_test_target PROPERTIES LABELS "ch${number};layout")
+    if(EXISTS ${FEM_ROOT}/tests/${id}/bad_options.txt)
+      add_test(NAME ch${number}_bad_options
+               COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/check_bad_options.py
+                       --exe $<TARGET_FILE:${exe}> --table ${FEM_ROOT}/tests/${id}/bad_options.txt)
+      set_tests_properties(ch${number}_bad_options PROPERTIES LABELS "ch${number};run")
+    endif()
   endif()
 
   # A chapter's own additions to the build (e.g. an optional reference library for its

@@ -3,9 +3,103 @@
 #include "common/error.hpp"
 #include "common/files.hpp"
 
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
 #include <iostream>
 
 namespace fem {
+
+namespace check {
+namespace {
+
+/// A number as C++ writes it: "0.5", "-1e-3", "inf" and "nan" included (refused by the checks).
+bool parse_real(const std::string& text, double& value)
+{
+    if (text.empty() || std::isspace(static_cast<unsigned char>(text.front())))
+        return false;
+    char* end = nullptr;
+    errno = 0;
+    value = std::strtod(text.c_str(), &end);
+    return end == text.c_str() + text.size() && errno != ERANGE;
+}
+
+std::string interval_text(double low, double high, Ends ends)
+{
+    const bool low_in = ends == Ends::closed || ends == Ends::closed_open;
+    const bool high_in = ends == Ends::closed || ends == Ends::open_closed;
+    if (std::isinf(low) && std::isinf(high))
+        return "a finite number";
+    if (std::isinf(high))
+        return str("a finite number ", low_in ? ">= " : "> ", low);
+    if (std::isinf(low))
+        return str("a finite number ", high_in ? "<= " : "< ", high);
+    return str("a number in ", low_in ? "[" : "(", low, ", ", high, high_in ? "]" : ")");
+}
+
+}  // namespace
+
+CLI::Validator real(double low, double high, Ends ends)
+{
+    const std::string allowed = interval_text(low, high, ends);
+    const bool low_in = ends == Ends::closed || ends == Ends::closed_open;
+    const bool high_in = ends == Ends::closed || ends == Ends::open_closed;
+    return CLI::Validator(
+        [=](std::string& text) {
+            double x = 0.0;
+            const bool inside = parse_real(text, x) && std::isfinite(x) && (low_in ? x >= low : x > low) &&
+                                (high_in ? x <= high : x < high);
+            return inside ? std::string() : str("must be ", allowed, ", got '", text, "'");
+        },
+        "(" + allowed + ")");
+}
+
+CLI::Validator positive() { return real(0.0, std::numeric_limits<double>::infinity(), Ends::open); }
+
+CLI::Validator non_negative() { return real(0.0, std::numeric_limits<double>::infinity(), Ends::closed_open); }
+
+CLI::Validator finite()
+{
+    constexpr double unbounded = std::numeric_limits<double>::infinity();
+    return real(-unbounded, unbounded, Ends::open);
+}
+
+CLI::Validator integer(long long low, long long high)
+{
+    // The upper end of an option's type (at_least) is named after the lower one.
+    const std::string allowed = high >= std::numeric_limits<int>::max()
+                                    ? str("an integer >= ", low, " (at most ", high, ")")
+                                    : str("an integer in [", low, ", ", high, "]");
+    return CLI::Validator(
+        [=](std::string& text) {
+            const char* begin = text.c_str();
+            char* end = nullptr;
+            errno = 0;
+            const long long n = std::strtoll(begin, &end, 10);
+            const bool digits = !text.empty() && !std::isspace(static_cast<unsigned char>(text.front())) &&
+                                end == begin + text.size() && errno != ERANGE;
+            return digits && n >= low && n <= high ? std::string() : str("must be ", allowed, ", got '", text, "'");
+        },
+        "(" + allowed + ")");
+}
+
+CLI::Validator accepted_by(std::function<void(const std::string&)> parse)
+{
+    return CLI::Validator(
+        [parse = std::move(parse)](std::string& text) {
+            try {
+                parse(text);
+                return std::string();
+            } catch (const Error& e) {
+                return std::string(e.what());
+            }
+        },
+        "");
+}
+
+}  // namespace check
+
 
 ChapterCli::ChapterCli(const std::string& executable, const std::string& chapter,
                        const std::string& description)
@@ -22,6 +116,8 @@ ChapterCli::ChapterCli(const std::string& executable, const std::string& chapter
     });
 }
 
+void ChapterCli::check_options(std::function<void()> check) { check_ = std::move(check); }
+
 int ChapterCli::run(int argc, char** argv, const std::function<void(const RunContext&)>& body)
 {
     try {
@@ -29,6 +125,13 @@ int ChapterCli::run(int argc, char** argv, const std::function<void(const RunCon
     } catch (const CLI::ParseError& e) {
         // --help prints the options and exits with 0; anything else is a bad command line.
         return app.exit(e) == 0 ? 0 : 1;
+    }
+    try {
+        if (check_)
+            check_();
+    } catch (const Error& e) {
+        std::cerr << "error: " << e.what() << "\nrun with --help to see the options\n";
+        return 1;
     }
     try {
         context_.out_dir = out_text_;

@@ -1,14 +1,56 @@
 #pragma once
 // The command line every chapter executable shares (CLI11), and the guard around its main():
 // options --out DIR, --quick, --no-figures, --help; fem::Error becomes "error: ..." and exit 1.
+// Every option is checked before anything is computed or written: its values by a check of
+// fem::check (given to CLI11's ->check()), what depends on several options by
+// ChapterCli::check_options.
 
 #include <CLI/CLI.hpp>
 
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <string>
+#include <vector>
 
 namespace fem {
+
+/// Checks of an option's values for CLI11's Option::check(), run while the command line is parsed.
+/// Each one refuses text that is not a number, NaN and ±inf, and says what is allowed; CLI11 puts
+/// the option's name in front: "error: --points: must be an integer >= 3, got '2'".
+namespace check {
+
+/// Which ends of an interval belong to it.
+enum class Ends { open, closed, open_closed, closed_open };
+
+/// A finite real number in the interval from low to high (±infinity: unbounded on that side),
+/// with the ends given: real(-1, 0.5, Ends::open) is "a number in (-1, 0.5)".
+CLI::Validator real(double low, double high, Ends ends);
+
+/// A finite real number > 0.
+CLI::Validator positive();
+
+/// A finite real number >= 0.
+CLI::Validator non_negative();
+
+/// A finite real number (any sign).
+CLI::Validator finite();
+
+/// An integer in [low, high] (both included), written in decimal digits with an optional sign.
+CLI::Validator integer(long long low, long long high);
+
+/// An integer >= low that fits the option's type T (e.g. int): at_least<int>(3).
+template <typename T>
+CLI::Validator at_least(T low)
+{
+    return integer(static_cast<long long>(low), static_cast<long long>(std::numeric_limits<T>::max()));
+}
+
+/// A text that parse accepts: parse throws fem::Error for any other, and its message becomes the
+/// option's error (e.g. check::accepted_by([](const std::string& s) { parse_scheme(s); })).
+CLI::Validator accepted_by(std::function<void(const std::string&)> parse);
+
+}  // namespace check
 
 /// What a chapter's run needs to know about its invocation.
 struct RunContext {
@@ -30,13 +72,20 @@ public:
 
     CLI::App app;
 
-    /// Parses argv, creates the output folder and calls body. Returns the process exit code:
+    /// Sets the check of what no single option's check can see (options that depend on each other, a
+    /// file an option names): run() calls it after parsing, before the output folder is touched,
+    /// and an fem::Error it throws is a bad command line (exit 1, nothing written).
+    void check_options(std::function<void()> check);
+
+    /// Parses argv (running every option's check), runs the check of check_options(), creates the
+    /// output folder and calls body. Returns the process exit code:
     /// 0 on success (and after --help); 1 after printing "error: <message>" for fem::Error, an
     /// unfinished exercise, a bad command line (an unknown option, a value that does not parse)
     /// or any other failure.
     int run(int argc, char** argv, const std::function<void(const RunContext&)>& body);
 
 private:
+    std::function<void()> check_;
     RunContext context_;
     std::string out_text_;
     bool no_figures_ = false;

@@ -38,6 +38,8 @@ struct Settings {
     double t_end = 0.05;    // final time of the convergence study and the time series
 };
 
+constexpr double max_steps = 1e8;  // of the time series: beyond it the run takes hours
+
 // 1. Stencils: error against h for f = sin at x = 1.
 void derivative_study(const RunContext& run)
 {
@@ -246,17 +248,30 @@ int main(int argc, char** argv)
     ChapterCli cli("ch01_finite_differences", "01_finite_differences",
                    "Chapter 01: finite difference stencils and the 1D heat equation (FTCS)");
     Settings settings;
-    cli.app.add_option("--c", settings.c, "Diffusivity c of the rod (> 0)")->capture_default_str();
-    cli.app.add_option("--points", settings.points, "Grid points of the time series (>= 3)")
-        ->capture_default_str();
+    cli.app.add_option("--c", settings.c, "Diffusivity c of the rod")->check(check::positive())->capture_default_str();
+    cli.app.add_option("--points", settings.points, "Grid points of the time series")
+        ->check(check::integer(3, 100000))->capture_default_str();
     cli.app.add_option("--ratio", settings.ratio,
                        "Time step of the time series as a fraction of the stability limit")
-        ->capture_default_str();
-    cli.app.add_option("--t-end", settings.t_end, "Final time (> 0)")->capture_default_str();
+        ->check(check::positive())->capture_default_str();
+    cli.app.add_option("--t-end", settings.t_end, "Final time")->check(check::positive())->capture_default_str();
+    cli.check_options([&] {
+        // The longest runs: the time series, the finest grid of the convergence study (641 points at
+        // 0.9 × the limit) and the slowest of the stability study (51 points, 0.5 × the limit, t = 0.1).
+        const auto steps = [&](int points, double ratio, double t_end) {
+            HeatRod rod;
+            rod.points = points;
+            rod.c = settings.c;
+            return t_end / (ratio * explicit_stability_limit(rod.h(), rod.c));
+        };
+        const double most = std::max({steps(settings.points, settings.ratio, settings.t_end),
+                                      steps(641, 0.9, settings.t_end), steps(51, 0.5, 0.1)});
+        if (!(most <= max_steps))
+            throw Error(str("--c ", settings.c, ", --t-end ", settings.t_end, ", --ratio ", settings.ratio,
+                            " and --points ", settings.points, " ask for ", most, " time steps in one run; at most ",
+                            max_steps, " are allowed (a smaller --c or --t-end, or a larger --ratio, take fewer)"));
+    });
     return cli.run(argc, argv, [&](const RunContext& run) {
-        require_positive(settings.c, "--c");
-        require_positive(settings.ratio, "--ratio");
-        require_positive(settings.t_end, "--t-end");
         derivative_study(run);
         heat_convergence_study(run, settings);
         stability_study(run, settings);

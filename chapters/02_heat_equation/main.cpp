@@ -356,22 +356,18 @@ int main(int argc, char** argv)
     ChapterCli cli("ch02_heat_equation", "02_heat_equation",
                    "Chapter 02: the 2D heat equation with explicit Euler, implicit Euler and Crank-Nicolson");
     Settings settings;
-    cli.app.add_option("--c", settings.c, "Diffusivity c (> 0), every study")->capture_default_str();
-    auto* n_option = cli.app.add_option("--n", settings.n, "Hot-square series: unknowns per direction (>= 1)")
-                         ->capture_default_str();
-    cli.app.add_option("--dt", settings.dt, "Hot-square series: time step (> 0)")->capture_default_str();
-    auto* steps_option = cli.app.add_option("--steps", settings.steps, "Hot-square series: steps (>= 1)")
-                             ->capture_default_str();
+    cli.app.add_option("--c", settings.c, "Diffusivity c, every study")
+        ->check(check::real(0.0, 100.0, check::Ends::open_closed))->capture_default_str();
+    auto* n_option = cli.app.add_option("--n", settings.n, "Hot-square series: unknowns per direction")
+                         ->check(check::integer(1, 4000))->capture_default_str();
+    cli.app.add_option("--dt", settings.dt, "Hot-square series: time step")->check(check::positive())
+        ->capture_default_str();
+    auto* steps_option = cli.app.add_option("--steps", settings.steps, "Hot-square series: steps")
+                             ->check(check::integer(1, 1000000))->capture_default_str();
     cli.app.add_option("--method", settings.method,
                        "Hot-square series: explicit, implicit or crank-nicolson (cn)")
-        ->capture_default_str();
+        ->check(check::accepted_by([](const std::string& name) { parse_scheme(name); }))->capture_default_str();
     return cli.run(argc, argv, [&](const RunContext& run) {
-        require_positive(settings.c, "--c");
-        require_positive(settings.dt, "--dt");
-        if (settings.steps < 1)
-            throw Error(str("--steps must be ≥ 1, got ", settings.steps));
-        parse_scheme(settings.method);  // reject a bad name before the long studies
-        validate(Grid{settings.n});
         if (run.quick) {  // a small series unless asked otherwise
             if (n_option->count() == 0)
                 settings.n = 32;

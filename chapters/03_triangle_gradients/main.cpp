@@ -48,6 +48,7 @@ struct Settings {
     double t_end = 0.05;         // final time of the heat runs on the square
     std::string mesh;            // the surface of the heat demo (default: data/bunny.obj)
     double heat_time = 10.0;     // final time of the heat demo on the surface
+    TriMesh surface;             // read from `mesh` while the options are checked
 };
 
 // The manufactured solution on the unit square: u = sin(πx) sin(πy), −Δu = 2π² u, u = 0 on the boundary.
@@ -73,11 +74,6 @@ Eigen::VectorXd sample(const TriMesh& mesh, const std::function<double(const Vec
     return values;
 }
 
-TriMesh load_surface(const Settings& settings)
-{
-    return io::read_tri_mesh(settings.mesh.empty() ? data_path("bunny.obj") : std::filesystem::path(settings.mesh));
-}
-
 std::string surface_name(const Settings& settings)
 {
     return settings.mesh.empty() ? "bunny" : std::filesystem::path(settings.mesh).stem().string();
@@ -98,7 +94,7 @@ void mesh_study(const RunContext& run, const Settings& settings)
     const std::vector<std::pair<std::string, TriMesh>> meshes = {
         {str("square ", n, "x", n), square_mesh(n)},
         {str("square ", n, "x", n, " jittered"), square_mesh(n, settings.jitter, settings.seed)},
-        {surface_name(settings), load_surface(settings)}};
+        {surface_name(settings), settings.surface}};
     for (const auto& [name, mesh] : meshes) {
         const TriQuality quality = mesh_quality(mesh);
         SparseMatrix L, L_cot;
@@ -267,7 +263,7 @@ void heat_study(const RunContext& run, const Settings& settings)
 // 4. Heat on a closed surface (no boundary: nothing is fixed, heat is conserved), as a time series.
 void surface_heat(const RunContext& run, const Settings& settings)
 {
-    const TriMesh mesh = load_surface(settings);
+    const TriMesh& mesh = settings.surface;
     const SparseMatrix L = fem_laplacian(mesh.V, mesh.F);
     const Eigen::VectorXd mass = lumped_mass(mesh.V, mesh.F);
     const std::vector<int> boundary = boundary_vertices(mesh.F, static_cast<int>(mesh.V.rows()));
@@ -317,22 +313,27 @@ int main(int argc, char** argv)
     ChapterCli cli("ch03_triangle_gradients", "03_triangle_gradients",
                    "Chapter 03: gradients on triangle meshes, the cotangent Laplacian, Poisson and heat");
     Settings settings;
-    cli.app.add_option("--jitter", settings.jitter, "Jitter of the unstructured meshes, in [0, 0.24] of a cell")
+    cli.app.add_option("--jitter", settings.jitter, "Jitter of the unstructured meshes, a fraction of a cell "
+                       "(the regular mesh is always run beside the jittered one)")
+        ->check(check::real(0.0, 0.24, check::Ends::open_closed))->capture_default_str();
+    cli.app.add_option("--seed", settings.seed, "Random seed of the jitter")->check(check::at_least(0u))
         ->capture_default_str();
-    cli.app.add_option("--seed", settings.seed, "Random seed of the jitter")->capture_default_str();
-    cli.app.add_option("--c", settings.c, "Diffusivity of the heat runs (> 0)")->capture_default_str();
-    cli.app.add_option("--t-end", settings.t_end, "Final time of the heat runs on the square (> 0)")
-        ->capture_default_str();
+    cli.app.add_option("--c", settings.c, "Diffusivity of the heat runs")
+        ->check(check::real(0.0, 100.0, check::Ends::open_closed))->capture_default_str();
+    cli.app.add_option("--t-end", settings.t_end, "Final time of the heat runs on the square")
+        ->check(check::real(0.0, 10.0, check::Ends::open_closed))->capture_default_str();
     cli.app.add_option("--mesh", settings.mesh, "Surface of the heat demo: .obj, .stl, .ply or .vtu (default: the bunny)");
-    cli.app.add_option("--heat-time", settings.heat_time, "Final time of the heat demo on the surface (> 0)")
-        ->capture_default_str();
+    cli.app.add_option("--heat-time", settings.heat_time, "Final time of the heat demo on the surface")
+        ->check(check::positive())->capture_default_str();
+    cli.check_options([&] {  // the surface is read (and checked) once, before any study runs
+        try {
+            settings.surface = io::read_tri_mesh(settings.mesh.empty() ? data_path("bunny.obj")
+                                                              : std::filesystem::path(settings.mesh));
+        } catch (const Error& e) {
+            throw Error(str("--mesh: ", e.what()));
+        }
+    });
     return cli.run(argc, argv, [&](const RunContext& run) {
-        if (!(settings.jitter > 0.0 && settings.jitter <= 0.24))
-            throw Error(str("--jitter must lie in (0, 0.24], got ", settings.jitter,
-                            " (the regular mesh is always run beside the jittered one)"));
-        require_positive(settings.c, "--c");
-        require_positive(settings.t_end, "--t-end");
-        require_positive(settings.heat_time, "--heat-time");
         mesh_study(run, settings);
         poisson_study(run, settings);
         heat_study(run, settings);

@@ -252,19 +252,16 @@ int main(int argc, char** argv)
     ChapterCli cli("ch04_tet_jacobians", "04_tet_jacobians",
                    "Chapter 04: tet shape functions, the deformation gradient F, J_e and B");
     Settings settings;
-    cli.app.add_option("--cells", settings.cells, "Cells along the beam (>= 1)")->capture_default_str();
-    cli.app.add_option("--stretch", settings.stretch, "Stretch factor along x (> 0)")->capture_default_str();
-    cli.app.add_option("--shear", settings.shear, "Shear x += shear * y")->capture_default_str();
-    cli.app.add_option("--twist", settings.twist, "Total twist of the beam [degrees]")->capture_default_str();
-    cli.app.add_option("--pinch", settings.pinch, "Pinch depth (> 1 inverts tets near the middle)")
+    cli.app.add_option("--cells", settings.cells, "Cells along the beam")->check(check::integer(1, 400))
         ->capture_default_str();
+    cli.app.add_option("--stretch", settings.stretch, "Stretch factor along x")->check(check::positive())
+        ->capture_default_str();
+    cli.app.add_option("--shear", settings.shear, "Shear x += shear * y")->check(check::finite())->capture_default_str();
+    cli.app.add_option("--twist", settings.twist, "Total twist of the beam [degrees]")->check(check::finite())
+        ->capture_default_str();
+    cli.app.add_option("--pinch", settings.pinch, "Pinch depth (> 1 inverts tets near the middle)")
+        ->check(check::finite())->capture_default_str();
     return cli.run(argc, argv, [&](const RunContext& run) {
-        if (settings.cells < 1)
-            throw Error(str("--cells must be >= 1, got ", settings.cells));
-        require_positive(settings.stretch, "--stretch");
-        require_finite(settings.shear, "--shear");
-        require_finite(settings.twist, "--twist");
-        require_finite(settings.pinch, "--pinch");
         field_study(run, settings);
         twist_convergence_study(run, settings);
         locate_study(run, settings);

@@ -331,15 +331,16 @@ int main(int argc, char** argv)
     ChapterCli cli("ch05_strain_stress", "05_strain_stress",
                    "Chapter 05: strain, stress, Lame parameters and the element stiffness K_e");
     Settings settings;
-    cli.app.add_option("--youngs", settings.youngs, "Young's modulus Y [Pa] (> 0)")->capture_default_str();
-    cli.app.add_option("--poisson", settings.poisson, "Poisson's ratio nu, in (-1, 0.5)")->capture_default_str();
-    cli.app.add_option("--twist", settings.twist, "Twist of the beam in the pictures [degrees]")->capture_default_str();
-    cli.app.add_option("--cells", settings.cells, "Cells along the beam (>= 1)")->capture_default_str();
+    cli.app.add_option("--youngs", settings.youngs, "Young's modulus Y [Pa]")->check(check::positive())
+        ->capture_default_str();
+    cli.app.add_option("--poisson", settings.poisson, "Poisson's ratio nu")
+        ->check(check::real(-1.0, 0.5, check::Ends::open))->capture_default_str();
+    cli.app.add_option("--twist", settings.twist, "Twist of the beam in the pictures [degrees]")
+        ->check(check::finite())->capture_default_str();
+    cli.app.add_option("--cells", settings.cells, "Cells along the beam")->check(check::integer(1, 400))
+        ->capture_default_str();
     return cli.run(argc, argv, [&](const RunContext& run) {
         const Lame material = lame_parameters(settings.youngs, settings.poisson);
-        require_finite(settings.twist, "--twist");
-        if (settings.cells < 1)
-            throw Error(str("--cells must be >= 1, got ", settings.cells));
         std::cout << "material: Y = " << settings.youngs << " Pa, nu = " << settings.poisson
                   << ": lambda = " << material.lambda << " Pa, mu = " << material.mu << " Pa\n\n";
         voigt_study(run, material);

@@ -483,20 +483,19 @@ int main(int argc, char** argv)
     ChapterCli cli("ch06_assembly", "06_assembly",
                    "Chapter 06: assembling K three ways, masses, damping, gravity, pinned vertices");
     Settings settings;
-    cli.app.add_option("--youngs", settings.youngs, "Young's modulus Y [Pa] (> 0)")->capture_default_str();
-    cli.app.add_option("--poisson", settings.poisson, "Poisson's ratio nu, in (-1, 0.5)")->capture_default_str();
-    cli.app.add_option("--density", settings.density, "Density rho [kg/m^3] (> 0)")->capture_default_str();
-    cli.app.add_option("--cells", settings.cells, "Cells along the beam of the files (>= 1)")->capture_default_str();
+    cli.app.add_option("--youngs", settings.youngs, "Young's modulus Y [Pa]")->check(check::positive())
+        ->capture_default_str();
+    cli.app.add_option("--poisson", settings.poisson, "Poisson's ratio nu")
+        ->check(check::real(-1.0, 0.5, check::Ends::open))->capture_default_str();
+    cli.app.add_option("--density", settings.density, "Density rho [kg/m^3]")->check(check::positive())
+        ->capture_default_str();
+    cli.app.add_option("--cells", settings.cells, "Cells along the beam of the files")
+        ->check(check::integer(1, 400))->capture_default_str();
     cli.app.add_option("--largest", settings.largest,
                        "The throughput study stops at the first mesh with at least this many tets")
-        ->capture_default_str();
+        ->check(check::integer(1, 100000000))->capture_default_str();
     return cli.run(argc, argv, [&](const RunContext& run) {
         const elastic::Lame material = elastic::lame_parameters(settings.youngs, settings.poisson);
-        require_positive(settings.density, "--density");
-        if (settings.cells < 1)
-            throw Error(str("--cells ", settings.cells, " must be >= 1"));
-        if (settings.largest < 1)
-            throw Error(str("--largest ", settings.largest, " must be >= 1"));
         checks(run, material, settings.density);
         std::vector<Measured> measured;
         throughput(run, material, settings, measured);

@@ -383,27 +383,20 @@ int main(int argc, char** argv)
     ChapterCli cli("ch07_sparse_storage", "07_sparse_storage",
                    "Chapter 07: COO, CSR and CSC by hand; SpMV and conversions against Eigen");
     Settings settings;
-    cli.app.add_option("--cells", settings.cells, "Cubes per side of the box meshes whose K is timed (>= 1)")
-        ->capture_default_str();
+    cli.app.add_option("--cells", settings.cells, "Cubes per side of the box meshes whose K is timed")
+        ->check(check::integer(1, 120))->capture_default_str();
     cli.app.add_option("--convert-max-cells", settings.convert_max_cells,
                        "Time the conversions only for boxes up to this many cubes a side (their triplets "
                        "take 2.3 kB per cube)")
-        ->capture_default_str();
-    cli.app.add_option("--seconds", settings.seconds, "Measuring time per kernel in seconds (> 0)")
-        ->capture_default_str();
+        ->check(check::integer(1, 120))->capture_default_str();
+    cli.app.add_option("--seconds", settings.seconds, "Measuring time per kernel in seconds")
+        ->check(check::real(0.0, 60.0, check::Ends::open_closed))->capture_default_str();
     return cli.run(argc, argv, [&](const RunContext& run) {
         if (run.quick) {
             settings.cells = {3, 6};
             settings.convert_max_cells = 6;
             settings.seconds = 0.02;
         }
-        require_positive(settings.seconds, "--seconds");
-        if (settings.cells.empty())
-            throw Error("--cells needs at least one size");
-        for (int cells : settings.cells)
-            if (cells < 1)
-                throw Error(str("--cells: every size must be ≥ 1 cube a side, got ", cells));
-
         lecture_example(run);
         pattern_figure(run);
 

@@ -792,14 +792,14 @@ int main(int argc, char** argv)
                    "Chapter 08: dense LU and Cholesky, orderings, sparse Cholesky against Eigen and CHOLMOD");
     Settings settings;
     cli.app.add_option("--max-unknowns", settings.max_unknowns, "Skip sparse matrices with more unknowns")
-        ->capture_default_str();
+        ->check(check::integer(1, 100000000))->capture_default_str();
     cli.app.add_option("--simplicial-flops", settings.simplicial_flops,
                        "Run the scalar factorizations (ours up-looking, Eigen SimplicialLLT) only below this many flops")
-        ->capture_default_str();
+        ->check(check::non_negative())->capture_default_str();
     int blas_threads = 1;
     cli.app.add_option("--blas-threads", blas_threads,
                        "Threads of CHOLMOD's BLAS (1: one core against our one core)")
-        ->check(CLI::Range(1, 256))->capture_default_str();
+        ->check(check::integer(1, 256))->capture_default_str();
     return cli.run(argc, argv, [&](const RunContext& run) {
 #ifdef FEM_HAVE_CHOLMOD
         set_blas_threads(blas_threads);

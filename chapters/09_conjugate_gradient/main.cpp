@@ -860,43 +860,33 @@ int main(int argc, char** argv)
                    "Chapter 09: conjugate gradients, preconditioning, and iterative against direct solvers");
     Settings settings;
     cli.app.add_option("--lap2", settings.lap2, "2D Laplacian sizes n (n^2 unknowns) of the speed study")
-        ->capture_default_str();
+        ->check(check::integer(2, 2000))->capture_default_str();
     cli.app.add_option("--lap3", settings.lap3, "3D Laplacian sizes n (n^3 unknowns) of the speed study")
-        ->capture_default_str();
+        ->check(check::integer(2, 120))->capture_default_str();
     cli.app.add_option("--cells", settings.cells, "Elastic boxes: cubes a side (3 c (c+1)^2 unknowns)")
-        ->capture_default_str();
+        ->check(check::integer(1, 60))->capture_default_str();
     cli.app.add_option("--tolerances", settings.tolerances, "Relative residual tolerances of the speed study")
-        ->capture_default_str();
+        ->check(check::real(0.0, 1.0, check::Ends::open))->capture_default_str();
     cli.app.add_option("--llt-max-3d", settings.llt_max_3d,
-                       "Largest 3D problem (unknowns) given to Eigen's SimplicialLLT")
-        ->capture_default_str();
+                       "Largest 3D problem (unknowns) given to Eigen's SimplicialLLT (0: none)")
+        ->check(check::at_least(0))->capture_default_str();
     cli.app.add_option("--ours-max-3d", settings.ours_max_3d,
-                       "Largest 3D problem (unknowns) given to our sparse Cholesky when CHOLMOD is there")
-        ->capture_default_str();
+                       "Largest 3D problem (unknowns) given to our sparse Cholesky when CHOLMOD is there (0: none)")
+        ->check(check::at_least(0))->capture_default_str();
     cli.app.add_option("--eigen-sweep-max", settings.eigen_sweep_max,
-                       "Largest problem (unknowns) on which Eigen's CG runs every tolerance")
+                       "Largest problem (unknowns) on which Eigen's CG runs every tolerance (0: none)")
+        ->check(check::at_least(0))->capture_default_str();
+    cli.app.add_option("--youngs", settings.youngs, "Young's modulus of the box [Pa]")->check(check::positive())
         ->capture_default_str();
-    cli.app.add_option("--youngs", settings.youngs, "Young's modulus of the box [Pa]")->capture_default_str();
-    cli.app.add_option("--poisson", settings.poisson, "Poisson's ratio of the box")->capture_default_str();
-    cli.app.add_option("--seconds", settings.seconds, "Measuring time per timed run [s]")->capture_default_str();
+    cli.app.add_option("--poisson", settings.poisson, "Poisson's ratio of the box")
+        ->check(check::real(-1.0, 0.5, check::Ends::open))->capture_default_str();
+    cli.app.add_option("--seconds", settings.seconds, "Measuring time per timed run [s]")
+        ->check(check::real(0.0, 60.0, check::Ends::open_closed))->capture_default_str();
     int blas_threads = 1;
     cli.app.add_option("--blas-threads", blas_threads,
                        "Threads of CHOLMOD's BLAS (1: one core against our one core)")
-        ->check(CLI::Range(1, 256))->capture_default_str();
+        ->check(check::integer(1, 256))->capture_default_str();
     return cli.run(argc, argv, [&](const RunContext& run) {
-        for (double tau : settings.tolerances)
-            if (!(tau > 0.0 && tau < 1.0))
-                throw Error(str("--tolerances: every tolerance must lie in (0, 1), got ", tau));
-        for (int n : settings.lap2)
-            if (n < 2 || n > 2000)
-                throw Error(str("--lap2: sizes must lie in [2, 2000], got ", n));
-        for (int n : settings.lap3)
-            if (n < 2 || n > 120)
-                throw Error(str("--lap3: sizes must lie in [2, 120], got ", n));
-        for (int c : settings.cells)
-            if (c < 1 || c > 60)
-                throw Error(str("--cells: sizes must lie in [1, 60], got ", c));
-        require_positive(settings.seconds, "--seconds");
         // One core against one core by default: CHOLMOD's BLAS would otherwise use every core.
         const bool limited = set_blas_threads(blas_threads);
         std::cout << "CHOLMOD: " << (cholmod_available() ? "available" : "not in this build")

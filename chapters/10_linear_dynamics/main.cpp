@@ -44,35 +44,24 @@ int main(int argc, char** argv)
     ChapterCli cli("ch10_linear_dynamics", "10_linear_dynamics",
                    "Chapter 10: implicit time stepping of a pinned elastic body, checked against its modes");
     study::Settings settings;
-    cli.app.add_option("--youngs", settings.beam.youngs_modulus, "Young's modulus Y of the beam [Pa] (> 0)")
+    cli.app.add_option("--youngs", settings.beam.youngs_modulus, "Young's modulus Y of the beam [Pa]")
+        ->check(check::positive())->capture_default_str();
+    cli.app.add_option("--poisson", settings.beam.poisson_ratio, "Poisson's ratio of the beam (0.5 is incompressible)")
+        ->check(check::real(-1.0, 0.5, check::Ends::open))->capture_default_str();
+    cli.app.add_option("--density", settings.beam.density, "Density of the beam [kg/m^3]")->check(check::positive())
         ->capture_default_str();
-    cli.app.add_option("--poisson", settings.beam.poisson_ratio, "Poisson's ratio of the beam, in (-1, 0.5)")
-        ->capture_default_str();
-    cli.app.add_option("--density", settings.beam.density, "Density of the beam [kg/m^3] (> 0)")->capture_default_str();
-    cli.app.add_option("--duration", settings.duration, "Accuracy horizon and demo length [s] (> 0, <= 10)")
-        ->capture_default_str();
+    cli.app.add_option("--duration", settings.duration, "Accuracy horizon and demo length [s]")
+        ->check(check::real(0.0, 10.0, check::Ends::open_closed))->capture_default_str();
     cli.app.add_option("--accuracy-cells", settings.accuracy_cells,
-                       "Cells along the beam of the accuracy study (2 to 40: the reference is dense)")
-        ->capture_default_str();
-    cli.app.add_option("--cost-cells", settings.cost_cells, "Cells along the beams of the cost study (10 to 200)")
-        ->capture_default_str();
-    cli.app.add_option("--seconds", settings.seconds, "Measuring time per timed kernel [s] (> 0)")->capture_default_str();
+                       "Cells along the beam of the accuracy study (the reference is dense)")
+        ->check(check::integer(2, 40))->capture_default_str();
+    cli.app.add_option("--cost-cells", settings.cost_cells, "Cells along the beams of the cost study")
+        ->check(check::integer(10, 200))->capture_default_str();
+    cli.app.add_option("--seconds", settings.seconds, "Measuring time per timed kernel [s]")
+        ->check(check::real(0.0, 60.0, check::Ends::open_closed))->capture_default_str();
+    // The beam's scene as a whole (its mass, its stiffness, its time step) is checked once more.
+    cli.check_options([&] { validate(study::beam_scene(settings.beam, 2)); });
     return cli.run(argc, argv, [&](const RunContext& run) {
-        // Every option is checked before anything is computed.
-        require_positive(settings.beam.youngs_modulus, "--youngs");
-        if (!(settings.beam.poisson_ratio > -1.0 && settings.beam.poisson_ratio < 0.5))
-            throw Error(str("--poisson must lie in (-1, 0.5) (0.5 is incompressible), got ", settings.beam.poisson_ratio));
-        require_positive(settings.beam.density, "--density");
-        validate(study::beam_scene(settings.beam, 2));
-        require_positive(settings.duration, "--duration");
-        if (settings.duration > 10.0)
-            throw Error(str("--duration: at most 10 s, got ", settings.duration));
-        if (settings.accuracy_cells < 2 || settings.accuracy_cells > 40)
-            throw Error(str("--accuracy-cells must lie in [2, 40], got ", settings.accuracy_cells));
-        for (int cells : settings.cost_cells)
-            if (cells < 10 || cells > 200)
-                throw Error(str("--cost-cells: every count must lie in [10, 200], got ", cells));
-        require_positive(settings.seconds, "--seconds");
         if (run.quick) {
             settings.accuracy_cells = std::min(settings.accuracy_cells, 10);
             settings.cost_cells = {10, 20};

@@ -1,13 +1,17 @@
 // The shared command line of the chapter executables (a bad option is "error: …" and exit 1) and
 // the entry-by-entry matrix matcher of test_support.hpp (it names the entry that differs).
 #include "common/cli.hpp"
+#include "common/error.hpp"
 #include "common/test_support.hpp"
 
 #include <catch2/catch.hpp>
 
 #include <Eigen/SparseCore>
 
+#include <filesystem>
+#include <functional>
 #include <iostream>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -25,11 +29,16 @@ struct CliRun {
     bool body_ran = false;
 };
 
-CliRun run_cli(std::vector<std::string> args)
+/// check_options: the chapter's check of options together (none when empty).
+CliRun run_cli(std::vector<std::string> args, const std::function<void()>& check_options = {})
 {
     fem::ChapterCli cli("ch00_test", "00_test", "A test of the shared command line");
     double c = 1.0;
+    int n = 3;
     cli.app.add_option("--c", c, "A chapter option")->capture_default_str();
+    cli.app.add_option("--n", n, "A checked chapter option")->check(fem::check::integer(1, 10));
+    if (check_options)
+        cli.check_options(check_options);
     args.insert(args.begin(), "ch00_test");
     std::vector<char*> argv;
     for (std::string& arg : args)
@@ -60,6 +69,77 @@ TEST_CASE("an unknown option is 'error: …' naming it, and exit code 1", "[cli]
     const CliRun bad_value = run_cli({"--c", "hot"});
     CHECK(bad_value.code == 1);
     CHECK_THAT(bad_value.err, Contains("error: ") && Contains("--c"));
+}
+
+namespace {
+
+/// The message of `check` for `text`: empty when it accepts it.
+std::string refusal(const CLI::Validator& check, std::string text) { return check(text); }
+
+}  // namespace
+
+TEST_CASE("the option checks refuse non-numbers, NaN, infinity and values out of range, saying what is allowed", "[cli]")
+{
+    using namespace fem::check;
+    constexpr double unbounded = std::numeric_limits<double>::infinity();
+    CHECK(refusal(positive(), "0.5").empty());
+    CHECK(refusal(positive(), "1e-300").empty());
+    for (const char* bad : {"0", "-1", "nan", "inf", "1e999", "hot", "", " 1", "1x"})
+        CHECK_THAT(refusal(positive(), bad), Contains("must be a finite number > 0, got '" + std::string(bad) + "'"));
+    CHECK(refusal(non_negative(), "0").empty());
+    CHECK_FALSE(refusal(non_negative(), "-0.1").empty());
+    CHECK(refusal(finite(), "-1e300").empty());
+    CHECK_THAT(refusal(finite(), "-inf"), Contains("must be a finite number, got '-inf'"));
+
+    const CLI::Validator poisson = real(-1.0, 0.5, Ends::open);
+    CHECK(refusal(poisson, "0.49").empty());
+    CHECK_THAT(refusal(poisson, "0.5"), Contains("must be a number in (-1, 0.5)"));
+    CHECK_FALSE(refusal(poisson, "-1").empty());
+    CHECK(refusal(real(0.0, 0.24, Ends::open_closed), "0.24").empty());
+    CHECK_THAT(refusal(real(0.0, 0.24, Ends::open_closed), "0"), Contains("a number in (0, 0.24]"));
+    CHECK(refusal(real(0.0, unbounded, Ends::closed_open), "0").empty());
+    CHECK(refusal(real(-unbounded, 2.0, Ends::closed), "2").empty());
+    CHECK_THAT(refusal(real(-unbounded, 2.0, Ends::closed), "3"), Contains("a finite number <= 2"));
+
+    CHECK(refusal(integer(3, 10), "3").empty());
+    CHECK(refusal(integer(3, 10), "+10").empty());
+    for (const char* bad : {"2", "11", "-1", "3.0", "1e1", "three", "", "99999999999999999999"})
+        CHECK_THAT(refusal(integer(3, 10), bad), Contains("must be an integer in [3, 10], got"));
+    CHECK_THAT(refusal(at_least(0u), "-1"), Contains("must be an integer >= 0 (at most 4294967295)"));
+    CHECK_FALSE(refusal(at_least(0u), "4294967296").empty());
+    CHECK(refusal(at_least(0u), "4294967295").empty());
+
+    const CLI::Validator word = accepted_by([](const std::string& text) {
+        if (text != "cn")
+            throw fem::Error("use cn");
+    });
+    CHECK(refusal(word, "cn").empty());
+    CHECK(refusal(word, "rk4") == "use cn");
+}
+
+TEST_CASE("a checked option out of range is 'error: …' naming it, and nothing runs", "[cli]")
+{
+    const CliRun run = run_cli({"--n", "0"});
+    CHECK(run.code == 1);
+    CHECK_FALSE(run.body_ran);
+    CHECK_THAT(run.err, Contains("error: --n: must be an integer in [1, 10], got '0'"));
+    CHECK(run.out.empty());
+}
+
+TEST_CASE("an fem::Error of the chapter's check_options is 'error: …' and exit 1, before the body runs", "[cli]")
+{
+    const std::string out_dir = fem::test::fresh_output_dir("cli_check_options").string();
+    const CliRun refused = run_cli({"--no-figures", "--out", out_dir + "/out"},
+                                   [] { throw fem::Error("--c and --n do not go together"); });
+    CHECK(refused.code == 1);
+    CHECK_FALSE(refused.body_ran);
+    CHECK_THAT(refused.err, Contains("error: --c and --n do not go together"));
+    CHECK_FALSE(std::filesystem::exists(out_dir + "/out"));  // the output folder was not created
+    bool checked = false;
+    const CliRun accepted = run_cli({"--no-figures", "--out", out_dir + "/out"}, [&] { checked = true; });
+    CHECK(accepted.code == 0);
+    CHECK(checked);
+    CHECK(accepted.body_ran);
 }
 
 TEST_CASE("the option --help lists the options without CLI11's default-value markup, and exits with 0", "[cli]")
