@@ -3,11 +3,15 @@
 #include "common/error.hpp"
 #include "common/files.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
+#include <csignal>
 #include <cstdlib>
+#include <fstream>
 #include <iostream>
+#include <optional>
 
 namespace fem {
 
@@ -116,6 +120,23 @@ ChapterCli::ChapterCli(const std::string& executable, const std::string& chapter
     });
 }
 
+namespace {
+
+/// The list of the files a run wrote, kept in its output folder for the next run.
+constexpr const char* run_manifest = ".fem-run-files";
+
+/// The names the previous run in `out` wrote (none when there was none).
+std::vector<std::string> previous_run_files(const std::filesystem::path& out)
+{
+    std::vector<std::string> names;
+    std::ifstream file(out / run_manifest);
+    for (std::string name; std::getline(file, name);)
+        names.push_back(name);
+    return names;
+}
+
+}  // namespace
+
 void ChapterCli::check_options(std::function<void()> check) { check_ = std::move(check); }
 
 int ChapterCli::run(int argc, char** argv, const std::function<void(const RunContext&)>& body)
@@ -133,21 +154,47 @@ int ChapterCli::run(int argc, char** argv, const std::function<void(const RunCon
         std::cerr << "error: " << e.what() << "\nrun with --help to see the options\n";
         return 1;
     }
+    const std::filesystem::path out = out_text_;
+    std::string message;
     try {
-        context_.out_dir = out_text_;
+        // A file size limit (ulimit -f) makes a write fail with EFBIG, like a full disk, instead
+        // of killing the run before it can clean up.
+        std::signal(SIGXFSZ, SIG_IGN);
+        std::optional<StagedFiles> staged;
+        try {
+            staged.emplace(out);
+        } catch (const Error& e) {
+            throw Error(str("--out: ", e.what()));
+        }
+        context_.out_dir = staged->staging();
         context_.figures = !no_figures_;
-        ensure_directory(context_.out_dir);
         body(context_);
-        std::cout << "\nwrote " << std::filesystem::absolute(context_.out_dir).lexically_normal().string()
-                  << '\n';
+        // The run's files appear together; those of the previous run that this one did not
+        // write again leave in the same step (a run's folder never mixes two runs).
+        std::vector<std::string> written;
+        for (const auto& entry : std::filesystem::directory_iterator(context_.out_dir))
+            written.push_back(entry.path().filename().string());
+        std::sort(written.begin(), written.end());
+        std::string manifest;
+        for (const std::string& name : written)
+            manifest += name + '\n';
+        write_file(context_.file(run_manifest), manifest);
+        staged->publish(previous_run_files(out));
+        std::cout << "\nwrote " << std::filesystem::absolute(out).lexically_normal().string() << '\n';
         return 0;
     } catch (const Error& e) {
-        std::cerr << "error: " << e.what() << '\n';
+        message = e.what();
     } catch (const NotImplemented& e) {
-        std::cerr << "error: " << e.what() << '\n';
+        message = e.what();
     } catch (const std::exception& e) {
-        std::cerr << "error: unexpected failure: " << e.what() << '\n';
+        message = str("unexpected failure: ", e.what());
     }
+    // The staging folder is gone: name the files where they would have appeared.
+    const std::string staging = context_.out_dir.string();
+    for (std::size_t at = staging.empty() ? std::string::npos : message.find(staging); at != std::string::npos;
+         at = message.find(staging, at))
+        message.replace(at, staging.size(), out.string());
+    std::cerr << "error: " << message << '\n';
     return 1;
 }
 

@@ -54,7 +54,9 @@ CLI::Validator accepted_by(std::function<void(const std::string&)> parse);
 
 /// What a chapter's run needs to know about its invocation.
 struct RunContext {
-    std::filesystem::path out_dir;  ///< where every file of this run goes (created)
+    /// Where every file of this run goes: a staging folder inside --out, whose files appear in
+    /// --out together when the run succeeds (see ChapterCli::run).
+    std::filesystem::path out_dir;
     bool quick = false;             ///< a small, fast run (ctest uses it)
     bool figures = true;            ///< write PNG figures (needs a display; see figures.hpp)
 
@@ -77,8 +79,11 @@ public:
     /// and an fem::Error it throws is a bad command line (exit 1, nothing written).
     void check_options(std::function<void()> check);
 
-    /// Parses argv (running every option's check), runs the check of check_options(), creates the
-    /// output folder and calls body. Returns the process exit code:
+    /// Parses argv (running every option's check), runs the check of check_options(), and calls
+    /// body, which writes into a staging folder (fem::StagedFiles) inside --out. Only when body
+    /// returns do its files appear in --out, together, replacing the previous run's (whose files
+    /// this run did not write again are removed; other files are left alone). A run that fails
+    /// leaves --out as it was. Returns the process exit code:
     /// 0 on success (and after --help); 1 after printing "error: <message>" for fem::Error, an
     /// unfinished exercise, a bad command line (an unknown option, a value that does not parse)
     /// or any other failure.

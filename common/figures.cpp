@@ -23,6 +23,7 @@
 #include <vtkLookupTable.h>
 #include <vtkNew.h>
 #include <vtkPNGWriter.h>
+#include <vtkUnsignedCharArray.h>
 #include <vtkPen.h>
 #include <vtkPlot.h>
 #include <vtkPlotPoints.h>
@@ -46,7 +47,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <limits>
@@ -99,14 +99,16 @@ void write_png(vtkRenderWindow* window, const std::filesystem::path& path)
     capture->SetInput(window);
     capture->ReadFrontBufferOff();
     capture->Update();
-    write_atomically(path, [&](const std::filesystem::path& temporary) {
-        vtkNew<vtkPNGWriter> writer;
-        writer->SetFileName(temporary.c_str());
-        writer->SetInputConnection(capture->GetOutputPort());
-        writer->Write();
-        if (writer->GetErrorCode() != 0)
-            throw Error(str("VTK could not write '", path.string(), "'"));
-    });
+    // Encoded in memory, written by write_file (a full disk is a clear error, not VTK's).
+    vtkNew<vtkPNGWriter> writer;
+    writer->WriteToMemoryOn();
+    writer->SetInputConnection(capture->GetOutputPort());
+    writer->Write();
+    vtkUnsignedCharArray* png = writer->GetResult();
+    if (writer->GetErrorCode() != 0 || png == nullptr)
+        throw Error(str("VTK could not encode the PNG '", path.string(), "'"));
+    write_file(path, std::string_view(reinterpret_cast<const char*>(png->GetPointer(0)),
+                                      static_cast<std::size_t>(png->GetNumberOfValues())));
 }
 
 // Line colours of successive series (Tableau 10), as RGB bytes.
@@ -558,21 +560,17 @@ bool save_chart(const LineChart& chart, const std::filesystem::path& stem, bool 
 {
     std::filesystem::path csv_path = stem;
     csv_path += ".csv";
-    write_atomically(csv_path, [&](const std::filesystem::path& temporary) {
-        std::ofstream file(temporary);
-        file << "series," << csv_field(chart.x_label) << ',' << csv_field(chart.y_label) << '\n';
-        file.precision(17);
-        for (const Series& s : chart.series) {
-            if (s.x.size() != s.y.size())
-                throw Error(str("chart '", chart.title, "', series '", s.name, "': ", s.x.size(),
-                                " x values but ", s.y.size(), " y values"));
-            for (std::size_t i = 0; i < s.x.size(); ++i)
-                file << csv_field(s.name) << ',' << s.x[i] << ',' << s.y[i] << '\n';
-        }
-        file.close();
-        if (!file)
-            throw Error(str("cannot write '", csv_path.string(), "'"));
-    });
+    std::ostringstream file;
+    file << "series," << csv_field(chart.x_label) << ',' << csv_field(chart.y_label) << '\n';
+    file.precision(17);
+    for (const Series& s : chart.series) {
+        if (s.x.size() != s.y.size())
+            throw Error(str("chart '", chart.title, "', series '", s.name, "': ", s.x.size(),
+                            " x values but ", s.y.size(), " y values"));
+        for (std::size_t i = 0; i < s.x.size(); ++i)
+            file << csv_field(s.name) << ',' << s.x[i] << ',' << s.y[i] << '\n';
+    }
+    write_file(csv_path, file.str());
     if (!can_draw(figures))
         return false;
 

@@ -2,17 +2,9 @@
 
 #include "common/error.hpp"
 #include "common/files.hpp"
-#include "common/vtk_convert.hpp"
 #include "common/vtk_io.hpp"
 
-#include <vtkAlgorithm.h>
-#include <vtkCallbackCommand.h>
-#include <vtkCommand.h>
-#include <vtkExecutive.h>
-#include <vtkNew.h>
-#include <vtkOBJWriter.h>
-#include <vtkPLYWriter.h>
-#include <vtkSTLWriter.h>
+#include <Eigen/Geometry>
 
 #include <algorithm>
 #include <array>
@@ -26,6 +18,7 @@
 #include <iomanip>
 #include <limits>
 #include <map>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -230,44 +223,6 @@ TriMesh read_obj(const fs::path& path)
     validate(mesh, line_origin(file.name(), vertex_lines, triangle_lines));
     return mesh;
 }
-
-// ---------------------------------------------------------------------------------------------
-// VTK writers report errors through events; catch them instead of printing them.
-
-class VtkErrors {
-public:
-    explicit VtkErrors(vtkAlgorithm* algorithm)
-    {
-        own_->SetCallback(&VtkErrors::record);
-        own_->SetClientData(&text_);
-        pipeline_->SetCallback(&VtkErrors::record);
-        pipeline_->SetClientData(&pipeline_text_);
-        algorithm->AddObserver(vtkCommand::ErrorEvent, own_);
-        algorithm->AddObserver(vtkCommand::WarningEvent, own_);
-        algorithm->GetExecutive()->AddObserver(vtkCommand::ErrorEvent, pipeline_);
-    }
-
-    bool any() const { return !text_.empty() || !pipeline_text_.empty(); }
-    /// The algorithm's own messages; the pipeline's ("returned failure") only when it has none.
-    const std::string& text() const { return text_.empty() ? pipeline_text_ : text_; }
-
-private:
-    static void record(vtkObject*, unsigned long, void* client, void* call)
-    {
-        auto* text = static_cast<std::string*>(client);
-        std::string message = call ? static_cast<const char*>(call) : "unknown error";
-        // "ERROR: In file.cxx, line N\nvtkSTLWriter (0x...): what\n..." -> "what" (its first line)
-        if (const auto at = message.find("): "); at != std::string::npos)
-            message = message.substr(at + 3);
-        message = message.substr(0, message.find('\n'));
-        if (!text->empty())
-            *text += "; ";
-        *text += message;
-    }
-
-    vtkNew<vtkCallbackCommand> own_, pipeline_;
-    std::string text_, pipeline_text_;
-};
 
 // ---------------------------------------------------------------------------------------------
 // STL (hand-written: VTK 9.1's STL reader asks for gigabytes on a damaged ASCII file, and a binary
@@ -873,47 +828,92 @@ TetMesh read_tetgen(const TetGenPaths& paths, Inverted inverted)
 
 void write_text_file(const fs::path& path, const std::function<void(std::ostream&)>& write)
 {
-    write_atomically(path, [&](const fs::path& temporary) {
-        std::ofstream out(temporary);
-        if (!out)
-            throw Error(str("cannot open '", path.string(), "' for writing"));
-        out << std::setprecision(17);
-        write(out);
-        out.close();
-        if (!out)
-            throw Error(str("writing '", path.string(), "' failed"));
-    });
+    std::ostringstream out;
+    out << std::setprecision(17);
+    write(out);
+    write_file(path, out.str());
 }
 
 void write_tetgen(const TetGenPaths& paths, const TetMesh& mesh)
 {
-    write_text_file(paths.node, [&](std::ostream& out) {
+    // The two files appear together: a new .node never sits beside an old .ele.
+    const fs::path folder = paths.node.parent_path();
+    if (paths.ele.parent_path() != folder)
+        throw Error(str("the TetGen files '", paths.node.string(), "' and '", paths.ele.string(),
+                        "' must be in one folder"));
+    StagedFiles staged(folder);
+    write_text_file(staged.staging() / paths.node.filename(), [&](std::ostream& out) {
         out << "# " << mesh.V.rows() << " points, dimension 3, no attributes, no boundary markers "
             << "(written by fem-course)\n"
             << mesh.V.rows() << " 3 0 0\n";
         for (Eigen::Index v = 0; v < mesh.V.rows(); ++v)
             out << v << ' ' << mesh.V(v, 0) << ' ' << mesh.V(v, 1) << ' ' << mesh.V(v, 2) << '\n';
     });
-    write_text_file(paths.ele, [&](std::ostream& out) {
+    write_text_file(staged.staging() / paths.ele.filename(), [&](std::ostream& out) {
         out << "# " << mesh.T.rows() << " tetrahedra, 4 nodes each (numbered from 0), no attributes\n"
             << mesh.T.rows() << " 4 0\n";
         for (Eigen::Index t = 0; t < mesh.T.rows(); ++t)
             out << t << ' ' << mesh.T(t, 0) << ' ' << mesh.T(t, 1) << ' ' << mesh.T(t, 2) << ' '
                 << mesh.T(t, 3) << '\n';
     });
+    staged.publish();
 }
 
-/// Runs a configured VTK file writer into a temporary file and moves it into place.
-template <typename Writer>
-void run_vtk_writer(Writer* writer, const fs::path& path)
+/// A Wavefront .obj: "v x y z" lines (17 significant digits), then "f a b c" (numbered from 1).
+void write_obj(const fs::path& path, const TriMesh& mesh)
 {
-    write_atomically(path, [&](const fs::path& temporary) {
-        writer->SetFileName(temporary.c_str());
-        VtkErrors errors(writer);
-        if (writer->Write() != 1 || errors.any())
-            throw Error(str("VTK could not write '", path.string(), "'",
-                            errors.any() ? str(": ", errors.text()) : std::string()));
+    write_text_file(path, [&](std::ostream& out) {
+        out << "# " << mesh.V.rows() << " vertices, " << mesh.F.rows() << " triangles (written by fem-course)\n";
+        for (Eigen::Index v = 0; v < mesh.V.rows(); ++v)
+            out << "v " << mesh.V(v, 0) << ' ' << mesh.V(v, 1) << ' ' << mesh.V(v, 2) << '\n';
+        for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
+            out << "f " << mesh.F(f, 0) + 1 << ' ' << mesh.F(f, 1) + 1 << ' ' << mesh.F(f, 2) + 1 << '\n';
     });
+}
+
+/// Appends the bytes of a number as they are in memory (little-endian on the machines we build on).
+template <typename Number>
+void append_bytes(std::string& bytes, Number value)
+{
+    static_assert(std::endian::native == std::endian::little, "the binary formats written are little-endian");
+    bytes.append(reinterpret_cast<const char*>(&value), sizeof value);
+}
+
+/// A binary little-endian PLY: the vertices as 32-bit floats x, y, z, the faces as a list of
+/// 32-bit vertex indices after a one-byte count (3), as VTK's PLY writer writes them.
+void write_binary_ply(const fs::path& path, const TriMesh& mesh)
+{
+    std::string bytes = str("ply\nformat binary_little_endian 1.0\ncomment written by fem-course\nelement vertex ",
+                            mesh.V.rows(), "\nproperty float x\nproperty float y\nproperty float z\nelement face ",
+                            mesh.F.rows(), "\nproperty list uchar int vertex_indices\nend_header\n");
+    for (Eigen::Index v = 0; v < mesh.V.rows(); ++v)
+        for (int k = 0; k < 3; ++k)
+            append_bytes(bytes, static_cast<float>(mesh.V(v, k)));
+    for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
+        append_bytes(bytes, std::uint8_t{3});
+        for (int k = 0; k < 3; ++k)
+            append_bytes(bytes, static_cast<std::int32_t>(mesh.F(f, k)));
+    }
+    write_file(path, bytes);
+}
+
+/// A binary STL: an 80-byte header (not starting with "solid"), the facet count, and per facet its
+/// unit normal and three corners as little-endian 32-bit floats, and two zero bytes.
+void write_binary_stl(const fs::path& path, const TriMesh& mesh)
+{
+    std::string bytes(80, ' ');
+    bytes.replace(0, 24, "binary STL by fem-course");
+    append_bytes(bytes, static_cast<std::uint32_t>(mesh.F.rows()));
+    for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
+        const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)), c = mesh.V.row(mesh.F(f, 2));
+        const Eigen::Vector3f normal = (b - a).cross(c - a).normalized().cast<float>();
+        for (const Eigen::Vector3f& v : {normal, Eigen::Vector3f(a.cast<float>()), Eigen::Vector3f(b.cast<float>()),
+                                         Eigen::Vector3f(c.cast<float>())})
+            for (int k = 0; k < 3; ++k)
+                append_bytes(bytes, v[k]);
+        append_bytes(bytes, std::uint16_t{0});
+    }
+    write_file(path, bytes);
 }
 
 [[noreturn]] void unknown_extension(const fs::path& path, const char* allowed)
@@ -955,19 +955,11 @@ void write_tri_mesh(const fs::path& path, const TriMesh& mesh)
     if (extension == ".vtu") {
         write_vtu(path, data);
     } else if (extension == ".obj") {
-        vtkNew<vtkOBJWriter> writer;
-        writer->SetInputData(detail::to_vtk_polydata(data));
-        run_vtk_writer(writer.Get(), path);
+        write_obj(path, mesh);
     } else if (extension == ".stl") {
-        vtkNew<vtkSTLWriter> writer;
-        writer->SetInputData(detail::to_vtk_polydata(data));
-        writer->SetFileTypeToBinary();
-        run_vtk_writer(writer.Get(), path);
+        write_binary_stl(path, mesh);
     } else if (extension == ".ply") {
-        vtkNew<vtkPLYWriter> writer;
-        writer->SetInputData(detail::to_vtk_polydata(data));
-        writer->SetFileTypeToBinary();
-        run_vtk_writer(writer.Get(), path);
+        write_binary_ply(path, mesh);
     } else {
         unknown_extension(path, ".obj, .stl, .ply, .vtu");
     }

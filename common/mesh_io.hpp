@@ -13,10 +13,14 @@
 // Messages name vertices and elements by their 0-based position in the mesh that was read.
 //
 // Precision: .obj (17 significant digits), .node/.ele (17 digits) and .vtu (binary doubles) keep
-// every bit of a double. STL stores 32-bit floats by definition, and VTK's PLY writer writes 32-bit
-// floats: a mesh written to .stl or .ply reads back rounded to float precision (about 6e-8 relative).
+// every bit of a double. STL stores 32-bit floats by definition, and the PLY writer writes 32-bit
+// floats (binary little-endian, like VTK's): a mesh written to .stl or .ply reads back rounded to
+// float precision (about 6e-8 relative). .obj, .stl and .ply are written here, not by VTK, whose
+// writers of these formats report no error when the disk is full.
 //
-// Every write is atomic (fem::write_atomically): a failed write leaves no half-written file.
+// Every write is atomic (fem::write_atomically): a failed write leaves no half-written file, and the
+// message gives the system's reason (e.g. "No space left on device"). The .node and .ele files of
+// a TetGen pair appear together (fem::StagedFiles): a failure leaves both old files as they were.
 
 #include "common/mesh.hpp"
 
@@ -51,7 +55,8 @@ void write_tri_mesh(const std::filesystem::path& path, const TriMesh& mesh);
 TetMesh read_tet_mesh(const std::filesystem::path& path, Inverted inverted = Inverted::reject);
 
 /// Writes a tetrahedral mesh: .node or .ele (both files are written, with the same stem, numbered
-/// from 0, 17 significant digits) or .vtu. Validates the mesh first (inverted tets are an error).
+/// from 0, 17 significant digits, appearing together) or .vtu. Validates the mesh first (inverted
+/// tets are an error).
 void write_tet_mesh(const std::filesystem::path& path, const TetMesh& mesh);
 
 }  // namespace fem::io

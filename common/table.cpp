@@ -5,7 +5,7 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <fstream>
+#include <sstream>
 #include <ostream>
 
 namespace fem {
@@ -108,28 +108,24 @@ void Table::print(std::ostream& out) const
 
 void Table::write_csv(const std::filesystem::path& path) const
 {
-    write_atomically(path, [&](const std::filesystem::path& temporary) {
-        std::ofstream file(temporary);
-        for (std::size_t c = 0; c < columns_.size(); ++c)
-            file << (c ? "," : "") << csv_field(columns_[c].name);
-        file << '\n';
-        char buffer[64];
-        for (const auto& row : rows_) {
-            for (std::size_t c = 0; c < row.size(); ++c) {
-                file << (c ? "," : "");
-                if (const auto* number = std::get_if<double>(&row[c])) {
-                    std::snprintf(buffer, sizeof buffer, "%.17g", *number);
-                    file << buffer;
-                } else {
-                    file << csv_field(std::get<std::string>(row[c]));
-                }
+    std::ostringstream file;
+    for (std::size_t c = 0; c < columns_.size(); ++c)
+        file << (c ? "," : "") << csv_field(columns_[c].name);
+    file << '\n';
+    char buffer[64];
+    for (const auto& row : rows_) {
+        for (std::size_t c = 0; c < row.size(); ++c) {
+            file << (c ? "," : "");
+            if (const auto* number = std::get_if<double>(&row[c])) {
+                std::snprintf(buffer, sizeof buffer, "%.17g", *number);
+                file << buffer;
+            } else {
+                file << csv_field(std::get<std::string>(row[c]));
             }
-            file << '\n';
         }
-        file.close();
-        if (!file)
-            throw Error(str("cannot write CSV file ", temporary.string()));
-    });
+        file << '\n';
+    }
+    write_file(path, file.str());
 }
 
 }  // namespace fem

@@ -122,16 +122,17 @@ void attach_fields(vtkDataSet* data, const std::vector<Field>& point_data,
         data->GetCellData()->SetActiveScalars(cell_data.front().name.c_str());
 }
 
-/// Runs a configured VTK XML writer into a temporary file and moves it into place.
+/// Runs a configured VTK XML writer into memory and writes the file from there (atomically).
+/// VTK 9.1's XML writers free invalid pointers when a write to a file fails (a full disk): they
+/// never touch a file here.
 template <typename Writer>
 void run_writer(Writer* writer, const std::filesystem::path& path)
 {
-    write_atomically(path, [&](const std::filesystem::path& temporary) {
-        writer->SetFileName(temporary.c_str());
-        writer->SetDataModeToBinary();
-        if (writer->Write() != 1 || writer->GetErrorCode() != 0)
-            throw Error(str("VTK could not write '", path.string(), "'"));
-    });
+    writer->WriteToOutputStringOn();
+    writer->SetDataModeToBinary();
+    if (writer->Write() != 1 || writer->GetErrorCode() != 0)
+        throw Error(str("VTK could not write '", path.string(), "'"));
+    write_file(path, writer->GetOutputString());
 }
 
 std::string xml_escape(const std::string& text)
@@ -406,22 +407,18 @@ void PvdSeries::record(double time, const std::filesystem::path& frame_path)
 {
     require_finite(time, "the time of a frame");
     entries_.emplace_back(time, frame_path.lexically_relative(pvd_path_.parent_path()).generic_string());
-    write_atomically(pvd_path_, [&](const std::filesystem::path& temporary) {
-        std::ofstream file(temporary);
-        file << "<?xml version=\"1.0\"?>\n"
-             << "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
-             << "  <Collection>\n";
-        char time_text[64];
-        for (const auto& [t, name] : entries_) {
-            std::snprintf(time_text, sizeof time_text, "%.17g", t);
-            file << "    <DataSet timestep=\"" << time_text << "\" part=\"0\" file=\""
-                 << xml_escape(name) << "\"/>\n";
-        }
-        file << "  </Collection>\n</VTKFile>\n";
-        file.close();
-        if (!file)
-            throw Error(str("cannot write '", pvd_path_.string(), "'"));
-    });
+    std::ostringstream file;
+    file << "<?xml version=\"1.0\"?>\n"
+         << "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+         << "  <Collection>\n";
+    char time_text[64];
+    for (const auto& [t, name] : entries_) {
+        std::snprintf(time_text, sizeof time_text, "%.17g", t);
+        file << "    <DataSet timestep=\"" << time_text << "\" part=\"0\" file=\""
+             << xml_escape(name) << "\"/>\n";
+    }
+    file << "  </Collection>\n</VTKFile>\n";
+    write_file(pvd_path_, file.str());
 }
 
 std::vector<std::pair<double, std::string>> read_pvd(const std::filesystem::path& path)

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Runs a chapter executable in --quick mode and checks what it leaves behind (a ctest test).
 
-Checks: the exit code is 0; nothing printed is NaN or inf; every file listed in
+Checks: the exit code is 0; nothing printed is NaN or inf; no staging folder or temporary file is
+left behind; every file listed in
 <expected>/files.txt exists and is not empty (PNGs only when the run had a display); every .pvd
 names frames that exist; every CSV stored in <expected>/ is reproduced (see csv_compare.py: the
 measured columns are skipped, the rest must agree to --rtol).
@@ -73,7 +74,12 @@ def main():
     if problems:
         return report(problems)
 
-    produced = sorted(p.name for p in args.out.iterdir() if p.is_file())
+    # Hidden entries are the run's bookkeeping (.fem-run-files): not results. A staging folder or
+    # temporary file left behind is a bug (common/files.hpp: the run's files appear together).
+    produced = sorted(p.name for p in args.out.iterdir() if p.is_file() and not p.name.startswith("."))
+    for leftover in sorted(args.out.rglob("*")):
+        if leftover.name.startswith(".staging-") or ".tmp-" in leftover.name:
+            problems.append(f"{leftover.relative_to(args.out)} was left behind")
     if args.update:
         args.expected.mkdir(parents=True, exist_ok=True)
         for old in args.expected.glob("*.csv"):
