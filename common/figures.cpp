@@ -4,6 +4,7 @@
 #include "common/files.hpp"
 #include "common/table.hpp"
 #include "common/vtk_convert.hpp"
+#include "common/vtk_errors.hpp"
 
 #include <X11/Xlib.h>
 
@@ -64,6 +65,7 @@ namespace {
 Display* shared_display()
 {
     static Display* const display = [] {
+        io::detail::route_vtk_output();  // VTK's messages while drawing: one line each, not a log block
         const char* name = std::getenv("DISPLAY");
         if (name == nullptr || *name == '\0')
             return static_cast<Display*>(nullptr);
@@ -103,10 +105,11 @@ void write_png(vtkRenderWindow* window, const std::filesystem::path& path)
     vtkNew<vtkPNGWriter> writer;
     writer->WriteToMemoryOn();
     writer->SetInputConnection(capture->GetOutputPort());
+    const io::detail::VtkErrors errors(writer);
     writer->Write();
     vtkUnsignedCharArray* png = writer->GetResult();
-    if (writer->GetErrorCode() != 0 || png == nullptr)
-        throw Error(str("VTK could not encode the PNG '", path.string(), "'"));
+    if (writer->GetErrorCode() != 0 || errors.any() || png == nullptr)
+        throw Error(str("VTK could not encode the PNG '", path.string(), "'", errors.any() ? ": " + errors.text() : ""));
     write_file(path, std::string_view(reinterpret_cast<const char*>(png->GetPointer(0)),
                                       static_cast<std::size_t>(png->GetNumberOfValues())));
 }

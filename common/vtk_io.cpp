@@ -1,5 +1,6 @@
 #include "common/vtk_io.hpp"
 #include "common/vtk_convert.hpp"
+#include "common/vtk_errors.hpp"
 #include "common/vtu_check.hpp"
 
 #include "common/error.hpp"
@@ -130,8 +131,9 @@ void run_writer(Writer* writer, const std::filesystem::path& path)
 {
     writer->WriteToOutputStringOn();
     writer->SetDataModeToBinary();
-    if (writer->Write() != 1 || writer->GetErrorCode() != 0)
-        throw Error(str("VTK could not write '", path.string(), "'"));
+    const detail::VtkErrors errors(writer);
+    if (writer->Write() != 1 || writer->GetErrorCode() != 0 || errors.any())
+        throw Error(str("VTK could not write '", path.string(), "'", errors.any() ? ": " + errors.text() : ""));
     write_file(path, writer->GetOutputString());
 }
 
@@ -267,10 +269,12 @@ MeshData read_vtu(const std::filesystem::path& path)
     detail::check_vtu_layout(path);  // VTK's reader trusts the file's counts and block headers
     vtkNew<vtkXMLUnstructuredGridReader> reader;
     reader->SetFileName(path.c_str());
+    const detail::VtkErrors errors(reader);
     reader->Update();
     vtkUnstructuredGrid* grid = reader->GetOutput();
-    if (reader->GetErrorCode() != 0 || grid == nullptr || grid->GetPoints() == nullptr)
-        throw Error(str("cannot read '", path.string(), "' as a VTK unstructured grid (.vtu)"));
+    if (reader->GetErrorCode() != 0 || errors.any() || grid == nullptr || grid->GetPoints() == nullptr)
+        throw Error(str("cannot read '", path.string(), "' as a VTK unstructured grid (.vtu)",
+                        errors.any() ? ": " + errors.text() : ""));
     return detail::from_vtk(grid, path.string());
 }
 

@@ -4,14 +4,17 @@ before doing anything (a ctest test, chNN_bad_options, registered by cmake/FemCh
 every chapter with a tests/NN_name/bad_options.txt).
 
 The table: one bad command line a line, the option its error must name first, then the arguments
-(shell words; '#' starts a comment):
+(shell words; '#' starts a comment; {here} stands for the table's folder, for bad input files
+kept beside it):
 
-    --points    --points 2          # out of range
-    --points    --quick --points x  # not a number
-    --colour    --colour red        # no such option
+    --points    --points 2                  # out of range
+    --points    --quick --points x          # not a number
+    --colour    --colour red                # no such option
+    --mesh      --mesh {here}/corrupt.vtu   # a file that cannot be read
 
 Each line runs in an empty temporary folder as `exe --out <tmp>/out <arguments>` and must:
-exit with code 1; print a line starting with 'error:' that names the option on stderr; print
+exit with code 1; print on stderr a line starting with 'error:' that names the option, and nothing
+else but "run with --help to see the options" (no log of a library, no second message); print
 nothing on stdout (no study ran); and write nothing (no <tmp>/out, or an empty one, and nothing
 else in <tmp>, the working folder).
 
@@ -27,13 +30,14 @@ import tempfile
 from pathlib import Path
 
 TIMEOUT = 60  # seconds: a run that is still going has accepted the option
+HELP_HINT = "run with --help to see the options"  # what may follow the error line
 
 
 def read_table(path):
     """[(line number, option, arguments)] of the table, or raises ValueError."""
     rows = []
     for number, line in enumerate(path.read_text().splitlines(), start=1):
-        words = shlex.split(line, comments=True)
+        words = [w.replace("{here}", str(path.parent.resolve())) for w in shlex.split(line, comments=True)]
         if not words:
             continue
         option, arguments = words[0], words[1:]
@@ -61,6 +65,10 @@ def check_line(exe, option, arguments):
         errors = [line for line in result.stderr.splitlines() if line.startswith("error:")]
         if not any(option in line for line in errors):
             problems.append(f"no 'error: ...' line naming {option} on stderr")
+        others = [line for line in result.stderr.splitlines() if line and not line.startswith("error:")
+                  and line != HELP_HINT]
+        if others:
+            problems.append(f"printed more than the error on stderr: {others[0]!r}")
         if result.stdout.strip():
             problems.append("printed on stdout (something ran before the options were checked): "
                             + result.stdout.strip().splitlines()[0])
