@@ -3,7 +3,9 @@
 #   1. grading   each exercise, stubbed alone, fails at least one of its tagged tests, and they
 #                pass with only it and what its docs say it builds on done (a table)
 #   2. exercises every chapter compiles from exercises/ (the stubs students start from)
-#   3. asan      the unit tests pass under AddressSanitizer + UndefinedBehaviorSanitizer
+#   3. asan      under AddressSanitizer + UndefinedBehaviorSanitizer (and float-cast-overflow):
+#                the unit tests, and each executable's --quick run, bad command lines and the
+#                output-folder rule
 #   4. release   every test passes on the reference solutions: unit tests, the layout and
 #                exercise-sync checks, each executable's --quick run against stored numbers, and
 #                each chapter's docs against its executable
@@ -28,9 +30,9 @@ step "2/5 every chapter library compiles from exercises/"
 cmake --preset exercises -DFEM_WERROR=ON >/dev/null
 cmake --build --preset exercises -j "$JOBS"
 
-step "3/5 unit tests under AddressSanitizer + UndefinedBehaviorSanitizer"
+step "3/5 unit tests and executables under AddressSanitizer + UndefinedBehaviorSanitizer"
 cmake --preset asan -DFEM_WERROR=ON >/dev/null
-cmake --build --preset asan -j "$JOBS" --target fem_tests
+cmake --build --preset asan -j "$JOBS"
 with_display ctest --preset asan
 
 step "4/5 release: all tests on the reference solutions"

@@ -203,6 +203,15 @@ TEST_CASE("StagedFiles: files appear together on publish, replace old ones, obso
     CHECK(contents(folder) == std::map<std::string, std::string>{
                                   {"b.csv", "b2"}, {"frames/f_0000.vtu", "f2"}, {"notes.txt", "a file of the user's"}});
 
+    // A staging folder left by a process that no longer runs (killed mid-write) is removed; one
+    // of a running process (this one's) is not.
+    fem::ensure_directory(folder / ".staging-999999999-0");  // beyond any pid Linux hands out
+    fem::ensure_directory(folder / fem::str(".staging-", ::getpid(), "-999"));
+    { fem::StagedFiles third(folder); }
+    CHECK_FALSE(fs::exists(folder / ".staging-999999999-0"));
+    CHECK(fs::exists(folder / fem::str(".staging-", ::getpid(), "-999")));
+    fs::remove(folder / fem::str(".staging-", ::getpid(), "-999"));
+
     // A folder the failed run created is removed again, with the parents it created.
     const fs::path fresh = fem::test::fresh_output_dir("staged_fresh");
     { fem::StagedFiles unused(fresh / "new" / "out"); }
