@@ -37,32 +37,25 @@ int main(int argc, char** argv)
     ChapterCli cli("ch11_corotational", "11_corotational",
                    "Chapter 11: corotational elements: best-fit rotations, warped stiffness, a step matrix that changes");
     study::Settings settings;
-    cli.app.add_option("--youngs", settings.soft.youngs_modulus, "Young's modulus Y of the swinging beam [Pa] (> 0)")
-        ->capture_default_str();
-    cli.app.add_option("--duration", settings.duration, "Length of the swing [s] (> 0, <= 10, a multiple of 1/30)")
-        ->capture_default_str();
-    cli.app.add_option("--swing-cells", settings.swing_cells, "Cells along the swinging beam (2 to 60)")
-        ->capture_default_str();
-    cli.app.add_option("--cost-cells", settings.cost_cells, "Cells along the beams of the cost study (10 to 200)")
-        ->capture_default_str();
-    cli.app.add_option("--seconds", settings.seconds, "Measuring time per timed kernel [s] (> 0)")->capture_default_str();
-    return cli.run(argc, argv, [&](const RunContext& run) {
-        // Every option is checked before anything is computed.
-        require_positive(settings.soft.youngs_modulus, "--youngs");
-        require_positive(settings.duration, "--duration");
-        if (settings.duration > 10.0)
-            throw Error(str("--duration: at most 10 s, got ", settings.duration));
+    cli.app.add_option("--youngs", settings.soft.youngs_modulus, "Young's modulus Y of the swinging beam [Pa]")
+        ->check(check::positive())->capture_default_str();
+    cli.app.add_option("--duration", settings.duration, "Length of the swing [s] (a multiple of 1/30)")
+        ->check(check::real(0.0, 10.0, check::Ends::open_closed))->capture_default_str();
+    cli.app.add_option("--swing-cells", settings.swing_cells, "Cells along the swinging beam")
+        ->check(check::integer(2, 60))->capture_default_str();
+    cli.app.add_option("--cost-cells", settings.cost_cells, "Cells along the beams of the cost study")
+        ->check(check::integer(10, 200))->capture_default_str();
+    cli.app.add_option("--seconds", settings.seconds, "Measuring time per timed kernel [s]")
+        ->check(check::real(0.0, 60.0, check::Ends::open_closed))->capture_default_str();
+    // The swing runs at steps of 1/30 s and finer: its length must be a whole number of them.
+    cli.check_options([&] {
         try {
-            dynamics::step_count(settings.duration, 1.0 / 30.0);  // a whole number of the largest steps
+            dynamics::step_count(settings.duration, 1.0 / 30.0);
         } catch (const Error& e) {
             throw Error(str("--duration must be a multiple of 1/30 s, the swing's largest step: ", e.what()));
         }
-        if (settings.swing_cells < 2 || settings.swing_cells > 60)
-            throw Error(str("--swing-cells must lie in [2, 60], got ", settings.swing_cells));
-        for (int cells : settings.cost_cells)
-            if (cells < 10 || cells > 200)
-                throw Error(str("--cost-cells: every count must lie in [10, 200], got ", cells));
-        require_positive(settings.seconds, "--seconds");
+    });
+    return cli.run(argc, argv, [&](const RunContext& run) {
         if (run.quick) {
             settings.cost_cells = {10, 20};
             settings.seconds = std::min(settings.seconds, 0.02);

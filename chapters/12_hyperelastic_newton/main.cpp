@@ -33,9 +33,10 @@ int main(int argc, char** argv)
     ChapterCli cli("ch12_hyperelastic_newton", "12_hyperelastic_newton",
                    "Chapter 12: hyperelastic materials and backward Euler by Newton's method with a line search");
     study::Settings settings;
-    cli.app.add_option("--cost-cells", settings.cost_cells, "Cells along the beams of the cost study (10 to 200)")
-        ->capture_default_str();
-    cli.app.add_option("--seconds", settings.seconds, "Measuring time per timed kernel [s] (> 0)")->capture_default_str();
+    cli.app.add_option("--cost-cells", settings.cost_cells, "Cells along the beams of the cost study")
+        ->check(check::integer(10, 200))->capture_default_str();
+    cli.app.add_option("--seconds", settings.seconds, "Measuring time per timed kernel [s]")
+        ->check(check::real(0.0, 60.0, check::Ends::open_closed))->capture_default_str();
     return cli.run(argc, argv, [&](const RunContext& run) {
         if (run.quick) {
             settings.cost_cells = {10, 20};
