@@ -70,6 +70,14 @@ struct Scene {
 /// docs/10_linear_dynamics.md#scenes
 void validate(const Scene& scene);
 
+/// Chapter 10's cantilever: 0.2 × 0.02 × 0.02 m along x (beam_mesh with cells_along cubes along
+/// it), clamped at x = 0, under gravity −z, undamped, Δt = 1/60 s, lasting `duration` [s]. Chapters
+/// 11 and 12 swing a softer one. docs/10_linear_dynamics.md#scenes
+Scene cantilever_scene(const Material& material, int cells_along, double duration = 1.0);
+
+/// The vertex with the largest x + y + z: a box's far top corner (a cantilever's tip).
+int far_corner(const TetMesh& mesh);
+
 /// The number of steps that cover `duration`: duration / Δt when that is a whole number to within
 /// 1e-9 relative (1.0 / (1/60) = 60), fem::Error otherwise (e.g. 1.05 s at Δt = 0.1 s: "10.5
 /// steps"), never a silently shortened or lengthened run. fem::Error for Δt ≤ 0 or duration < 0.

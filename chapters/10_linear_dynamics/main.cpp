@@ -60,7 +60,7 @@ int main(int argc, char** argv)
     cli.app.add_option("--seconds", settings.seconds, "Measuring time per timed kernel [s]")
         ->check(check::real(0.0, 60.0, check::Ends::open_closed))->capture_default_str();
     // The beam's scene as a whole (its mass, its stiffness, its time step) is checked once more.
-    cli.check_options([&] { validate(study::beam_scene(settings.beam, 2)); });
+    cli.check_options([&] { validate(cantilever_scene(settings.beam, 2)); });
     return cli.run(argc, argv, [&](const RunContext& run) {
         if (run.quick) {
             settings.accuracy_cells = std::min(settings.accuracy_cells, 10);

@@ -22,17 +22,6 @@ struct Settings {
     double seconds = 0.2;                    ///< measuring time per timed kernel [s]
 };
 
-/// The beam 0.2 × 0.02 × 0.02 m along x with `cells_along` cubes along it (cross-section cells keep
-/// them near cubes), clamped at x = 0, under gravity −z, undamped, Δt = 1/60 s.
-Scene beam_scene(const Material& material, int cells_along);
-
-/// The tip: the vertex at the free end's top corner (x = L, y = W, z = H).
-int beam_tip(const TetMesh& mesh);
-
-/// One frame of a body for the .pvd: rest positions, displacement and velocity (point fields) and
-/// the von Mises stress (cell field, from the force model).
-io::MeshData frame(const Body& body, const State& state);
-
 void modes_study(const RunContext& run, const Settings& settings);
 void recurrence_study(const RunContext& run, const Settings& settings);
 void accuracy_study(const RunContext& run, const Settings& settings);

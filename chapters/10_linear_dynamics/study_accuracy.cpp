@@ -55,14 +55,14 @@ void accuracy_study(const RunContext& run, const Settings& settings)
     std::cout << "\n== 3. Speed against error: the beam released under gravity, against the exact modal solution\n\n";
     // Why: the modal solution is exact in time for the semi-discrete equations, so the tip error
     // below is the integrator's alone (the mesh's own error is the same for every row).
-    Scene scene = beam_scene(settings.beam, settings.accuracy_cells);
+    Scene scene = cantilever_scene(settings.beam, settings.accuracy_cells);
     Body body(scene);
     const FreeDofs& dofs = body.dofs();
     const SparseMatrix K = dofs.reduce(body.model().stiffness(Eigen::VectorXd::Zero(dofs.full_size())));
     const SparseMatrix M = dofs.reduce(body.mass_matrix());
     const Eigen::VectorXd zero = Eigen::VectorXd::Zero(K.rows());
     const ModalSolution reference(K, M, dofs.gather(body.external_forces()), scene.damping, zero, zero);
-    const int tip_dof = 3 * beam_tip(scene.mesh) + 2;
+    const int tip_dof = 3 * far_corner(scene.mesh) + 2;
     const Eigen::Index tip_free = free_position(dofs, tip_dof);
     const double T = settings.duration;
     double amplitude = 0.0;
@@ -189,7 +189,7 @@ void statics_study(const RunContext& run, const Settings& settings)
 {
     std::cout << "\n== 4. Statics: a damped beam under gravity settles to K^-1 f\n\n";
     // Why: at rest the step reduces to K u = f; how fast it gets there depends on dt and damping.
-    Scene scene = beam_scene(settings.beam, settings.accuracy_cells);
+    Scene scene = cantilever_scene(settings.beam, settings.accuracy_cells);
     scene.damping = {0.0, 0.02};
     Table table("Steps until |u - K^-1 f| <= 1e-8 |K^-1 f| (beta = 0.02, from rest)",
                 {{"integrator", Format::text}, {"dt (s)", Format::scientific, 3}, {"steps to 1e-8", Format::text},
@@ -220,7 +220,7 @@ void statics_study(const RunContext& run, const Settings& settings)
 void hard_cases_study(const RunContext& run, const Settings& settings)
 {
     std::cout << "\n== 5. Hard cases: stability limits, stiffness, free fall, and the two forms of the step\n\n";
-    Scene scene = beam_scene(settings.beam, run.quick ? 6 : 10);
+    Scene scene = cantilever_scene(settings.beam, run.quick ? 6 : 10);
     Body probe(scene);
     const SparseMatrix K = probe.dofs().reduce(probe.model().stiffness(Eigen::VectorXd::Zero(probe.dofs().full_size())));
     const double limit = explicit_stability_limit(highest_frequency(K, probe.dofs().reduce(probe.mass_matrix())));
@@ -307,7 +307,7 @@ void hard_cases_study(const RunContext& run, const Settings& settings)
     Scene swinging = scene;
     swinging.gravity.setZero();
     swinging.time_step = 0.01;
-    Body loaded(beam_scene(settings.beam, run.quick ? 6 : 10));
+    Body loaded(cantilever_scene(settings.beam, run.quick ? 6 : 10));
     const Eigen::VectorXd start = static_displacement(loaded);
     Body free_body(swinging);
     Table forms("The two forms of the implicit midpoint step: energy drift of an undamped swing over 1000 steps",

@@ -52,7 +52,7 @@ void cost_study(const RunContext& run, const Settings& settings)
                  {"step, solve for v+ [s]", Format::scientific, 2}, {"dv step / floor [measured]", Format::fixed, 2},
                  {"v+ step / floor [measured]", Format::fixed, 2}});
     for (int cells : settings.cost_cells) {
-        Scene scene = beam_scene(settings.beam, cells);
+        Scene scene = cantilever_scene(settings.beam, cells);
         Body body(scene);
         const FreeDofs& dofs = body.dofs();
         const double free_dofs = double(dofs.size());
@@ -108,7 +108,7 @@ void cost_study(const RunContext& run, const Settings& settings)
 
     // Why: a published reference point. SOFA's implicit Euler on its 1,664-vertex validation beam
     // takes 8.5 ms a step with CG capped at 20 iterations (an inexact solve).
-    Scene sofa = beam_scene(settings.beam, 2);
+    Scene sofa = cantilever_scene(settings.beam, 2);
     sofa.mesh = box_mesh(25, 7, 7, Eigen::Vector3d(0.2, 0.02, 0.02));  // 26 × 8 × 8 = 1,664 vertices
     sofa.pinned = assembly::vertices_on_plane(sofa.mesh, 0, 0.0);
     Body body(sofa);

@@ -33,7 +33,7 @@ void modes_study(const RunContext& run, const Settings& settings)
 {
     std::cout << "== 1. Modes: K phi = omega^2 M phi on the free dofs of the cantilever\n\n";
     // Why: every check of this chapter is measured against the body's own modes.
-    const Scene scene = beam_scene(settings.beam, settings.accuracy_cells);
+    const Scene scene = cantilever_scene(settings.beam, settings.accuracy_cells);
     Body body(scene);
     const FreeSystem free = free_system(body);
     Timer dense_clock;
@@ -63,7 +63,7 @@ void modes_study(const RunContext& run, const Settings& settings)
                   {"f1 / Euler-Bernoulli", Format::fixed, 4}});
     fig::Series ratio_series{"f1 of linear tets / Euler-Bernoulli", {}, {}};
     for (int cells : run.quick ? std::vector<int>{10, 20} : std::vector<int>{10, 20, 40, 80}) {
-        Body refined(beam_scene(settings.beam, cells));
+        Body refined(cantilever_scene(settings.beam, cells));
         const FreeSystem system = free_system(refined);
         const double f1 = lowest_modes(system.K, system.M, 1).omega[0] / (2 * pi);
         theory.add_row({double(cells), double(system.K.rows()), f1, f1 / f_beam});
@@ -89,7 +89,7 @@ void modes_study(const RunContext& run, const Settings& settings)
                  {"power iterations", Format::integer}, {"power converged", Format::text},
                  {"dt limit (s)", Format::scientific, 4}, {"steps per simulated second", Format::integer}});
     for (int cells : run.quick ? std::vector<int>{10, 20} : std::vector<int>{10, 20, 40}) {
-        Body refined(beam_scene(settings.beam, cells));
+        Body refined(cantilever_scene(settings.beam, cells));
         const FreeSystem system = free_system(refined);
         const double omega_max = highest_frequency(system.K, system.M);
         const PowerIteration power =
@@ -107,13 +107,13 @@ void recurrence_study(const RunContext& run, const Settings& settings)
     std::cout << "\n== 2. One mode, one oscillator: the body started in mode 1 against the 2x2 recurrence\n\n";
     // Why: D = alpha M + beta K is diagonal in the modal basis, so each step acts on mode 1 as the
     // scalar oscillator's step matrix G. The whole body must follow G^n to round-off.
-    Scene scene = beam_scene(settings.beam, 6);
+    Scene scene = cantilever_scene(settings.beam, 6);
     scene.gravity.setZero();
     Body probe(scene);
     const FreeSystem free = free_system(probe);
     const Modes modes = lowest_modes_dense(free.K, free.M, 1);
     const double omega = modes.omega[0];
-    const int tip_dof = 3 * beam_tip(scene.mesh) + 2;
+    const int tip_dof = 3 * far_corner(scene.mesh) + 2;
     Eigen::VectorXd phi = Eigen::VectorXd::Zero(probe.dofs().full_size());
     probe.dofs().scatter(modes.shapes.col(0), phi);
     phi *= 1e-3 / std::abs(phi[tip_dof]);

@@ -26,7 +26,7 @@ std::vector<Cell> record(const RunContext& run, const std::string& name, const S
     double largest = 0.0, peak_stress = 0.0;
     Timer clock;
     simulation.run(step_count(scene.duration, scene.time_step), [&](const State& state, const StepRecord&) {
-        const io::MeshData data = frame(body, state);
+        const io::MeshData data = body_frame(body, state);
         largest = std::max(largest, io::vertex_rows(state.u).rowwise().norm().maxCoeff());
         peak_stress = std::max(peak_stress, data.field("von Mises stress").values.maxCoeff());
         recorder.add(state.time, data);
@@ -47,7 +47,7 @@ void demo_scenes(const RunContext& run, const Settings& settings)
                  {"free dofs", Format::integer}, {"frames", Format::integer}, {"largest |u| (m)", Format::scientific, 3},
                  {"largest von Mises (Pa)", Format::scientific, 3}, {"time [s]", Format::scientific, 2}});
 
-    Scene beam = beam_scene(settings.beam, run.quick ? 10 : 20);
+    Scene beam = cantilever_scene(settings.beam, run.quick ? 10 : 20);
     beam.duration = settings.duration;
     fig::RenderOptions beam_view;
     beam_view.title = "Cantilever released under gravity, backward Euler";

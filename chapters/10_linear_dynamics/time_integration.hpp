@@ -31,6 +31,8 @@
 
 #include "10_linear_dynamics/body.hpp"
 
+#include "common/vtk_io.hpp"
+
 #include "09_conjugate_gradient/linear_solver.hpp"
 
 #include <Eigen/Core>
@@ -62,6 +64,10 @@ State initial_state(Body& body, const Eigen::VectorXd& u0 = {}, const Eigen::Vec
 /// energy kept in the state for the next step and the energies), then u, v, time and step. Nothing
 /// of state changes if the model throws. For integrators of later chapters (chapter 12's Newton).
 void commit_step(ForceModel& model, double time_step, Eigen::VectorXd u_next, Eigen::VectorXd v_next, State& state);
+
+/// One frame of a body for a .pvd time series: rest positions with the point fields "displacement"
+/// and "velocity" and the cell field "von Mises stress" (from the force model).
+io::MeshData body_frame(const Body& body, const State& state);
 
 /// T, U and W of a state (see Energies). docs/10_linear_dynamics.md#energy
 Energies energies(const Body& body, const State& state);

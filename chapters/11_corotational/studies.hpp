@@ -26,13 +26,6 @@ struct Settings {
     double seconds = 0.2;                         ///< measuring time per timed kernel [s]
 };
 
-/// The beam 0.2 × 0.02 × 0.02 m along x with `cells_along` cubes along it, clamped at x = 0, under
-/// gravity −z, undamped, Δt = 1/60 s: chapter 10's cantilever, here released from the horizontal.
-dynamics::Scene beam_scene(const dynamics::Material& material, int cells_along, double duration);
-
-/// The tip: the vertex at the free end's top corner (x = L, y = W, z = H).
-int beam_tip(const TetMesh& mesh);
-
 /// The force model called "linear" or "corotational" (polar fit) for a scene.
 std::unique_ptr<dynamics::ForceModel> force_model(const std::string& name, const dynamics::Scene& scene);
 
@@ -47,10 +40,6 @@ dynamics::ImplicitOptions solver_option(const std::string& name, double toleranc
 
 /// The solver option names, in the order of the tables.
 const std::vector<std::string>& solver_option_names();
-
-/// One frame of a body for the .pvd: rest positions, displacement and velocity (point fields) and
-/// the von Mises stress (cell field, from the force model).
-io::MeshData frame(const dynamics::Body& body, const dynamics::State& state);
 
 void rotation_study(const RunContext& run, const Settings& settings);
 void swing_study(const RunContext& run, const Settings& settings);

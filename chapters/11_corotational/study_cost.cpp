@@ -72,7 +72,7 @@ void cost_study(const RunContext& run, const Settings& settings)
                    {"CG iterations per step", Format::fixed, 1}, {"factorizations", Format::integer}});
     for (int cells : settings.cost_cells) {
         // Why: which part of a step to make faster depends on the size; the table shows each.
-        const dynamics::Scene scene = beam_scene(settings.sofa, cells, 1.0);
+        const dynamics::Scene scene = dynamics::cantilever_scene(settings.sofa, cells, 1.0);
         dynamics::Body body(scene, force_model("corotational", scene));
         auto& model = dynamic_cast<CorotationalElasticity&>(body.model());
         const dynamics::State start = sagging_state(body, 10);
@@ -103,7 +103,7 @@ void cost_study(const RunContext& run, const Settings& settings)
 
     // Why: a published reference point. SOFA's TetrahedralCorotationalFEMForceField on a 1,664-vertex
     // beam: 14 ms a step, 5.8 ms in its "fast" variant with CG capped at 20 iterations (inexact).
-    dynamics::Scene sofa = beam_scene(settings.sofa, 2, 1.0);
+    dynamics::Scene sofa = dynamics::cantilever_scene(settings.sofa, 2, 1.0);
     sofa.mesh = box_mesh(25, 7, 7, Eigen::Vector3d(0.2, 0.02, 0.02));  // 26 × 8 × 8 = 1,664 vertices
     sofa.pinned = assembly::vertices_on_plane(sofa.mesh, 0, 0.0);
     dynamics::Body body(sofa, force_model("corotational", sofa));

@@ -36,7 +36,7 @@ SwingRun swing(const dynamics::Scene& base, const std::string& model, double the
     dynamics::Body body(scene, force_model(model, scene));
     const auto stepper = std::make_unique<dynamics::ThetaMethod>(theta);
     dynamics::Simulation simulation(body, *stepper, dynamics::initial_state(body), time_step);
-    const int tip = beam_tip(scene.mesh);
+    const int tip = dynamics::far_corner(scene.mesh);
     const double rest_volume = total_volume(scene.mesh);
     SwingRun run{model, stepper->name(), time_step, {}, {}, {}, 0.0, 0.0, 0.0, 0.0};
     double h0 = 0.0, scale = 0.0;
@@ -100,7 +100,7 @@ io::MeshData side_by_side(const dynamics::Body& linear, const dynamics::State& l
 void swing_study(const RunContext& run, const Settings& settings)
 {
     const double base_dt = 1.0 / 60.0;
-    const dynamics::Scene scene = beam_scene(settings.soft, run.quick ? 10 : settings.swing_cells, settings.duration);
+    const dynamics::Scene scene = dynamics::cantilever_scene(settings.soft, run.quick ? 10 : settings.swing_cells, settings.duration);
     std::cout << "\n== 2. A large swing: the soft cantilever (Y = " << settings.soft.youngs_modulus
               << " Pa) released from the horizontal, " << scene.mesh.T.rows() << " tets, " << settings.duration
               << " s, no damping\n\n";

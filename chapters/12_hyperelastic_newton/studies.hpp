@@ -25,22 +25,12 @@ struct Settings {
     double seconds = 0.2;                          ///< measuring time per timed kernel [s]
 };
 
-/// Chapter 11's soft cantilever, 0.2 × 0.02 × 0.02 m, clamped at x = 0, released from the horizontal
-/// under gravity, undamped, Δt = 1/60 s.
-dynamics::Scene beam_scene(const dynamics::Material& material, int cells_along, double duration);
-
-/// The tip: the vertex at the free end's top corner.
-int beam_tip(const TetMesh& mesh);
-
 /// The models compared: "linear" (chapter 10), "corotational" (chapter 11), "stvk", "neo-hookean",
 /// "stable-neo-hookean".
 const std::vector<std::string>& model_names();
 
 /// The force model called `name` for a scene's mesh and material.
 std::unique_ptr<dynamics::ForceModel> force_model(const std::string& name, const dynamics::Scene& scene);
-
-/// One frame of a body for the .pvd: rest positions, displacement, velocity, von Mises stress.
-io::MeshData frame(const dynamics::Body& body, const dynamics::State& state);
 
 void materials_study(const RunContext& run, const Settings& settings);
 void newton_study(const RunContext& run, const Settings& settings);

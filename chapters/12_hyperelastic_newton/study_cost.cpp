@@ -23,7 +23,7 @@ void cost_study(const RunContext& run, const Settings& settings)
                  {"exact Hessian [s]", Format::scientific, 2}, {"projected Hessian [s]", Format::scientific, 2},
                  {"step matrix [s]", Format::scientific, 2}, {"factor and solve [s]", Format::scientific, 2}});
     for (int cells : settings.cost_cells) {
-        dynamics::Scene scene = beam_scene(dynamics::Material{1e6, 0.45, 1100.0}, cells, 1.0);
+        dynamics::Scene scene = dynamics::cantilever_scene(dynamics::Material{1e6, 0.45, 1100.0}, cells, 1.0);
         dynamics::Body body(scene, force_model("neo-hookean", scene));
         NewtonBackwardEuler newton;
         dynamics::State state = dynamics::initial_state(body);
@@ -51,7 +51,7 @@ void cost_study(const RunContext& run, const Settings& settings)
     parts.write_csv(run.file("parts_table.csv"));
 
     // Why: a published reference point. Vega runs StVK on a 9 875-vertex mesh at 2 steps per second.
-    dynamics::Scene vega = beam_scene(dynamics::Material{1e6, 0.45, 1100.0}, 2, 1.0);
+    dynamics::Scene vega = dynamics::cantilever_scene(dynamics::Material{1e6, 0.45, 1100.0}, 2, 1.0);
     vega.mesh = box_mesh(60, 12, 12, Eigen::Vector3d(0.2, 0.04, 0.04));  // 61 × 13 × 13 = 10 309 vertices
     vega.pinned = assembly::vertices_on_plane(vega.mesh, 0, 0.0);
     dynamics::Body body(vega, force_model("neo-hookean", vega));

@@ -43,7 +43,7 @@ SlammedCube slammed_cube()
 void newton_study(const RunContext& run, const Settings& settings)
 {
     std::cout << "\n== 2. Newton's method: convergence, the Hessian, the line search, the tolerance\n\n";
-    const dynamics::Scene swing = beam_scene(settings.soft, run.quick ? 10 : settings.swing_cells, settings.duration);
+    const dynamics::Scene swing = dynamics::cantilever_scene(settings.soft, run.quick ? 10 : settings.swing_cells, settings.duration);
 
     // Why: quadratic convergence is Newton's promise; the gradient norms of a few steps show it.
     fig::LineChart history;
@@ -125,7 +125,7 @@ void newton_study(const RunContext& run, const Settings& settings)
         options.relative_tolerance = tolerance;
         NewtonBackwardEuler newton(options);
         dynamics::Simulation simulation(body, newton, dynamics::initial_state(body), swing.time_step);
-        const int tip = beam_tip(swing.mesh), steps = dynamics::step_count(swing.duration, swing.time_step);
+        const int tip = dynamics::far_corner(swing.mesh), steps = dynamics::step_count(swing.duration, swing.time_step);
         std::vector<Eigen::Vector3d> path;
         iterations = 0.0;
         Timer clock;

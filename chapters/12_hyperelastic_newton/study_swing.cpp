@@ -37,7 +37,7 @@ SwingRun swing(const dynamics::Scene& base, const std::string& model, double tim
     options.relative_tolerance = tolerance;
     NewtonBackwardEuler newton(options);
     dynamics::Simulation simulation(body, newton, dynamics::initial_state(body), time_step);
-    const int tip = beam_tip(scene.mesh), steps = dynamics::step_count(scene.duration, time_step);
+    const int tip = dynamics::far_corner(scene.mesh), steps = dynamics::step_count(scene.duration, time_step);
     const double rest_volume = total_volume(scene.mesh);
     SwingRun run{model, time_step, {}, {}, {}, 0.0, 0.0, 0.0, 0};
     Timer clock;
@@ -51,7 +51,7 @@ SwingRun swing(const dynamics::Scene& base, const std::string& model, double tim
         run.largest_volume_change =
             std::max(run.largest_volume_change, std::abs(total_volume(TetMesh{x, scene.mesh.T}) / rest_volume - 1.0));
         if (recorder != nullptr)
-            recorder->add(state.time, frame(body, state));
+            recorder->add(state.time, dynamics::body_frame(body, state));
     });
     run.seconds_per_step = clock.seconds() / steps;
     run.mean_iterations /= steps;
@@ -74,7 +74,7 @@ double tip_error(const SwingRun& run, const SwingRun& reference)
 
 void swing_study(const RunContext& run, const Settings& settings)
 {
-    const dynamics::Scene scene = beam_scene(settings.soft, run.quick ? 10 : settings.swing_cells, settings.duration);
+    const dynamics::Scene scene = dynamics::cantilever_scene(settings.soft, run.quick ? 10 : settings.swing_cells, settings.duration);
     std::cout << "\n== 3. The swing: chapter 11's soft cantilever, " << scene.mesh.T.rows()
               << " tets, every model under backward Euler by Newton (relative tolerance 1e-6)\n\n";
     std::vector<double> steps_per_second{30.0, 60.0, 120.0};

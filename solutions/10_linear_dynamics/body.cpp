@@ -210,4 +210,23 @@ double load_potential(const Eigen::VectorXd& f_ext, const Eigen::VectorXd& u)
     return -f_ext.dot(u);
 }
 
+Scene cantilever_scene(const Material& material, int cells_along, double duration)
+{
+    Scene scene;
+    scene.mesh = beam_mesh(0.2, 0.02, 0.02, cells_along);
+    scene.material = material;
+    scene.pinned = assembly::vertices_on_plane(scene.mesh, 0, 0.0);
+    scene.gravity = Eigen::Vector3d(0.0, 0.0, -9.81);
+    scene.time_step = 1.0 / 60.0;
+    scene.duration = duration;
+    return scene;
+}
+
+int far_corner(const TetMesh& mesh)
+{
+    Eigen::Index corner = 0;
+    mesh.V.rowwise().sum().maxCoeff(&corner);
+    return static_cast<int>(corner);
+}
+
 }  // namespace fem::dynamics

@@ -45,6 +45,14 @@ void commit_step(ForceModel& model, double time_step, Eigen::VectorXd u_next, Ei
     state.step += 1;
 }
 
+io::MeshData body_frame(const Body& body, const State& state)
+{
+    io::MeshData data = io::displaced_mesh(body.mesh().V, body.mesh().T, io::vertex_rows(state.u));
+    data.point_data.push_back({"velocity", io::vertex_rows(state.v)});
+    data.cell_data.push_back({"von Mises stress", body.model().von_mises_stress(state.u)});
+    return data;
+}
+
 State initial_state(Body& body, const Eigen::VectorXd& u0, const Eigen::VectorXd& v0)
 {
     const Eigen::Index n = body.dofs().full_size();
