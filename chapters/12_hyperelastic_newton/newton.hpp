@@ -49,7 +49,7 @@ struct NewtonOptions {
     /// max(its own tolerance, min(forcing, ‖∇E‖/scale)) — loose far from the answer, tight near it,
     /// where η = O(‖∇E‖) keeps the convergence quadratic (Eisenstat and Walker 1996). 0: always to
     /// its own tolerance. A direct solver solves exactly either way. In [0, 1).
-    double forcing = 0.1;
+    double forcing = 0.01;
     std::string solver = "default";    ///< chapter 09's solver of H d = −∇E
     /// When set, the solver is made by this instead of cg::make_solver(solver): e.g. chapter 11's
     /// frozen-factor PCG, which keeps one factorization across Newton iterations and steps.
@@ -128,6 +128,8 @@ public:
     /// What the last step's Newton iterations did (gradient norms relative to the momentum scale,
     /// step lengths, fallbacks to the definite Hessian).
     const NewtonResult& last() const { return last_; }
+    /// The solver of Newton's systems (made from the options).
+    const cg::LinearSolver& solver() const { return *solver_; }
 
 private:
     NewtonOptions options_;

@@ -148,6 +148,76 @@ void newton_study(const RunContext& run, const Settings& settings)
     }
     tolerances.print(std::cout);
     tolerances.write_csv(run.file("tolerance_table.csv"));
+
+    // Why: neo-Hookean's log J is undefined for an inverted tet, so only a line search that rejects
+    // inverting steps (E = +∞ there) keeps it alive; the stable neo-Hookean is defined everywhere and
+    // needs no such filter. Both on the same slammed cube, with and without the line search.
+    Table inversion("Inversion on the slammed cube: neo-Hookean needs the line search's filter, stable "
+                    "neo-Hookean does not",
+                    {{"material", Format::text}, {"line search", Format::text}, {"outcome", Format::text},
+                     {"Newton iterations", Format::integer}, {"rejected trial steps", Format::integer},
+                     {"smallest det F", Format::fixed, 3}});
+    for (const std::string material : {"neo-hookean", "stable-neo-hookean"})
+        for (const bool line_search : {true, false}) {
+            auto model = std::make_unique<HyperelasticElasticity>(cube.scene.mesh, make_material(material, 1e4, 0.4));
+            const HyperelasticElasticity& view = *model;
+            dynamics::Body body(cube.scene, std::move(model));
+            NewtonOptions options;
+            options.line_search = line_search;
+            options.max_iterations = 200;
+            NewtonBackwardEuler newton(options);
+            dynamics::State state = dynamics::initial_state(body, {}, cube.v0);
+            std::string outcome = "converged";
+            try {
+                newton.step(body, cube.scene.time_step, state);
+            } catch (const Error& e) {
+                outcome = std::string(e.what()).find("det F") != std::string::npos ? "failed: a tet inverted"
+                                                                                    : "failed: no convergence";
+            }
+            int rejected = 0;  // each α < 1 took log2(1/α) halvings
+            for (const double alpha : newton.last().step_lengths)
+                rejected += static_cast<int>(std::lround(std::log2(1.0 / alpha)));
+            inversion.add_row({material, std::string(line_search ? "Armijo" : "none (plain Newton)"), outcome,
+                               double(newton.last().iterations), double(rejected),
+                               outcome == "converged" ? view.smallest_volume_ratio(state.u) : 0.0});
+        }
+    inversion.print(std::cout);
+    inversion.write_csv(run.file("inversion_table.csv"));
+
+    // Why: as ν → ½ the material resists any change of volume, and linear tets, which can bend only
+    // by changing volume somewhere, lock: the beam sags less than its bending stiffness (Y I, with
+    // no ν in it) says. Newton itself keeps converging; the iterations and the sag show the cost.
+    Table locking("Locking: the swinging beam (stable neo-Hookean, 0.5 s) as the Poisson ratio nears 1/2",
+                  {{"Poisson ratio", Format::fixed, 3}, {"Newton iterations per step", Format::fixed, 2},
+                   {"most Newton iterations", Format::integer}, {"max tip drop [m]", Format::scientific, 3},
+                   {"tip drop / tip drop at nu = 0.3", Format::fixed, 3}, {"max |V/V0 - 1|", Format::scientific, 2}});
+    double reference_drop = 0.0;
+    for (const double poisson : {0.3, 0.45, 0.49, 0.499}) {
+        dynamics::Material material = settings.soft;
+        material.poisson_ratio = poisson;
+        const dynamics::Scene beam = dynamics::cantilever_scene(material, run.quick ? 10 : settings.swing_cells, 0.5);
+        dynamics::Body body(beam, force_model("stable-neo-hookean", beam));
+        NewtonBackwardEuler newton;
+        dynamics::Simulation simulation(body, newton, dynamics::initial_state(body), beam.time_step);
+        const int tip = dynamics::far_corner(beam.mesh);
+        const double rest_volume = total_volume(beam.mesh);
+        double drop = 0.0, volume_change = 0.0, mean = 0.0;
+        int most = 0;
+        simulation.run(dynamics::step_count(beam.duration, beam.time_step),
+                       [&](const dynamics::State& state, const dynamics::StepRecord& record) {
+                           const MatrixX3d x = body.positions(state.u);
+                           drop = std::max(drop, beam.mesh.V(tip, 2) - x(tip, 2));
+                           volume_change = std::max(volume_change, std::abs(total_volume(TetMesh{x, beam.mesh.T}) / rest_volume - 1.0));
+                           mean += record.newton_iterations;
+                           most = std::max(most, record.newton_iterations);
+                       });
+        if (poisson == 0.3)
+            reference_drop = drop;
+        locking.add_row({poisson, mean / dynamics::step_count(beam.duration, beam.time_step), double(most), drop,
+                         drop / reference_drop, volume_change});
+    }
+    locking.print(std::cout);
+    locking.write_csv(run.file("locking_table.csv"));
 }
 
 }  // namespace fem::hyper::study
