@@ -38,6 +38,37 @@ SlammedCube slammed_cube()
     return cube;
 }
 
+/// What one Newton step of the slammed cube did, in the tables' words.
+struct SlamOutcome {
+    std::string outcome;       ///< "converged" or "failed: …"
+    NewtonResult newton;       ///< its iterations, fallbacks and step lengths
+    double smallest_det = 0.0; ///< smallest det F of the converged step (0 if it failed)
+};
+
+/// One step of the slammed cube with `material` (Y = 1e4, ν = 0.4), the element Hessians projected
+/// by `projection`, Newton with `options` (its cap raised to 200).
+SlamOutcome slam(const SlammedCube& cube, const std::string& material, Projection projection, NewtonOptions options)
+{
+    auto model = std::make_unique<HyperelasticElasticity>(cube.scene.mesh, make_material(material, 1e4, 0.4), projection);
+    const HyperelasticElasticity& view = *model;
+    dynamics::Body body(cube.scene, std::move(model));
+    options.max_iterations = 200;
+    NewtonBackwardEuler newton(options);
+    dynamics::State state = dynamics::initial_state(body, {}, cube.v0);
+    SlamOutcome result{"converged", {}, 0.0};
+    try {
+        newton.step(body, cube.scene.time_step, state);
+        result.smallest_det = view.smallest_volume_ratio(state.u);
+    } catch (const Error& e) {
+        const std::string what = e.what();
+        result.outcome = what.find("det F") != std::string::npos               ? "failed: a tet inverted"
+                         : what.find("positive definite") != std::string::npos ? "failed: indefinite Hessian"
+                                                                               : "failed: no convergence";
+    }
+    result.newton = newton.last();
+    return result;
+}
+
 }  // namespace
 
 void newton_study(const RunContext& run, const Settings& settings)
@@ -88,28 +119,12 @@ void newton_study(const RunContext& run, const Settings& settings)
                                  Choice{"projected (absolute)", HessianChoice::definite, Projection::absolute, true},
                                  Choice{"exact", HessianChoice::exact, Projection::clamp, true},
                                  Choice{"exact, projected where needed (clamp)", HessianChoice::exact_then_definite, Projection::clamp, false}}) {
-        auto model = std::make_unique<HyperelasticElasticity>(cube.scene.mesh, make_material("neo-hookean", 1e4, 0.4),
-                                                              choice.projection);
-        const HyperelasticElasticity& view = *model;
-        dynamics::Body body(cube.scene, std::move(model));
         NewtonOptions options;
         options.hessian = choice.hessian;
         options.line_search = choice.line_search;
-        options.max_iterations = 200;
-        NewtonBackwardEuler newton(options);
-        dynamics::State state = dynamics::initial_state(body, {}, cube.v0);
-        std::string outcome = "converged";
-        try {
-            newton.step(body, cube.scene.time_step, state);
-        } catch (const Error& e) {
-            const std::string what = e.what();
-            outcome = what.find("det F") != std::string::npos        ? "failed: a tet inverted"
-                      : what.find("positive definite") != std::string::npos ? "failed: indefinite Hessian"
-                                                                            : "failed: no convergence";
-        }
-        hessians.add_row({choice.name, std::string(choice.line_search ? "Armijo" : "none (plain Newton)"), outcome,
-                          double(newton.last().iterations), double(newton.last().definite_fallbacks),
-                          outcome == "converged" ? view.smallest_volume_ratio(state.u) : 0.0});
+        const SlamOutcome step = slam(cube, "neo-hookean", choice.projection, options);
+        hessians.add_row({choice.name, std::string(choice.line_search ? "Armijo" : "none (plain Newton)"), step.outcome,
+                          double(step.newton.iterations), double(step.newton.definite_fallbacks), step.smallest_det});
     }
     hessians.print(std::cout);
     hessians.write_csv(run.file("hessian_table.csv"));
@@ -159,27 +174,14 @@ void newton_study(const RunContext& run, const Settings& settings)
                      {"smallest det F", Format::fixed, 3}});
     for (const std::string material : {"neo-hookean", "stable-neo-hookean"})
         for (const bool line_search : {true, false}) {
-            auto model = std::make_unique<HyperelasticElasticity>(cube.scene.mesh, make_material(material, 1e4, 0.4));
-            const HyperelasticElasticity& view = *model;
-            dynamics::Body body(cube.scene, std::move(model));
             NewtonOptions options;
             options.line_search = line_search;
-            options.max_iterations = 200;
-            NewtonBackwardEuler newton(options);
-            dynamics::State state = dynamics::initial_state(body, {}, cube.v0);
-            std::string outcome = "converged";
-            try {
-                newton.step(body, cube.scene.time_step, state);
-            } catch (const Error& e) {
-                outcome = std::string(e.what()).find("det F") != std::string::npos ? "failed: a tet inverted"
-                                                                                    : "failed: no convergence";
-            }
+            const SlamOutcome step = slam(cube, material, Projection::clamp, options);
             int rejected = 0;  // each α < 1 took log2(1/α) halvings
-            for (const double alpha : newton.last().step_lengths)
+            for (const double alpha : step.newton.step_lengths)
                 rejected += static_cast<int>(std::lround(std::log2(1.0 / alpha)));
-            inversion.add_row({material, std::string(line_search ? "Armijo" : "none (plain Newton)"), outcome,
-                               double(newton.last().iterations), double(rejected),
-                               outcome == "converged" ? view.smallest_volume_ratio(state.u) : 0.0});
+            inversion.add_row({material, std::string(line_search ? "Armijo" : "none (plain Newton)"), step.outcome,
+                               double(step.newton.iterations), double(rejected), step.smallest_det});
         }
     inversion.print(std::cout);
     inversion.write_csv(run.file("inversion_table.csv"));
