@@ -15,6 +15,9 @@ set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 cd "$FEM_ROOT"
 export ASAN_OPTIONS="detect_leaks=0:abort_on_error=1" UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+# Two tests run at once on two cores: each runs its element loops on one thread (tests that compare
+# thread counts set them themselves).
+export OMP_NUM_THREADS=1
 
 "$FEM_ROOT/tools/setup.sh"
 

@@ -149,6 +149,10 @@ private:
     Eigen::VectorXd rotated_at_;                  // the u of rotations_
     std::vector<Eigen::Matrix3d> rotations_;
     std::vector<Eigen::Matrix3d> rest_edges_inverse_;  // T_X⁻¹ of every tet (chapter 04), for F
+    // Per-tet results of the parallel loops (common/parallel.hpp), added up in tet order after them.
+    std::vector<Vector12d> element_forces_;
+    std::vector<double> element_energies_;
+    std::vector<Matrix12d> element_matrices_;
 };
 
 /// The rotations of the free vertices of `dofs` (vertex_rotations of those whose three dofs are

@@ -78,6 +78,10 @@ private:
     Eigen::VectorXd volumes_;
     assembly::AssemblyPattern pattern_;
     dynamics::SparseMatrix K_;
+    // Per-tet results of the parallel loops (common/parallel.hpp), added up in tet order after them.
+    std::vector<double> element_energies_;
+    std::vector<Vector12d> element_forces_;
+    std::vector<Matrix12d> element_matrices_;
 };
 
 }  // namespace fem::hyper

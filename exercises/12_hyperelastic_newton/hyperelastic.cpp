@@ -3,6 +3,7 @@
 #include "12_hyperelastic_newton/hyperelastic.hpp"
 
 #include "common/error.hpp"
+#include "common/parallel.hpp"
 #include "common/vtk_io.hpp"
 
 #include <Eigen/LU>
@@ -73,9 +74,14 @@ Eigen::Matrix3d HyperelasticElasticity::displacement_gradient(const MatrixX3d& d
 double HyperelasticElasticity::energy(const Eigen::VectorXd& u)
 {
     const MatrixX3d x = displacement_rows(u);
+    // Every tet's energy on every core, then the sum in tet order (common/parallel.hpp).
+    element_energies_.resize(static_cast<std::size_t>(mesh_.T.rows()));
+    parallel_for(mesh_.T.rows(), [&](Eigen::Index t) {
+        element_energies_[static_cast<std::size_t>(t)] = element_energy(*material_, volumes_[t], displacement_gradient(x, t));
+    });
     double total = 0.0;
-    for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t) {
-        total += element_energy(*material_, volumes_[t], displacement_gradient(x, t));
+    for (const double e : element_energies_) {
+        total += e;
         if (!std::isfinite(total))
             return std::numeric_limits<double>::infinity();
     }
@@ -85,18 +91,27 @@ double HyperelasticElasticity::energy(const Eigen::VectorXd& u)
 double HyperelasticElasticity::evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& forces)
 {
     const MatrixX3d x = displacement_rows(u);
+    // Every tet's energy and forces on every core, each into its own slot, then the sums in tet
+    // order (common/parallel.hpp: the same bits on any number of threads, and the same tet named
+    // when one is inverted: the lowest-numbered).
+    element_energies_.resize(static_cast<std::size_t>(mesh_.T.rows()));
+    element_forces_.resize(static_cast<std::size_t>(mesh_.T.rows()));
+    parallel_for(mesh_.T.rows(), [&](Eigen::Index t) {
+        const auto k = static_cast<std::size_t>(t);
+        const Eigen::Matrix3d H = displacement_gradient(x, t);
+        element_energies_[k] = element_energy(*material_, volumes_[t], H);
+        if (!std::isfinite(element_energies_[k]))
+            throw Error(str(material_->name(), ": tet ", t, " has det F = ", 1.0 + volume_change(H),
+                            ", where the material is undefined (inverted)"));
+        element_forces_[k] = element_forces(*material_, volumes_[t], B_[k], H);
+    });
     forces = Eigen::VectorXd::Zero(u.size());
     double total = 0.0;
     for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t) {
-        const Eigen::Matrix3d H = displacement_gradient(x, t);
-        const double e = element_energy(*material_, volumes_[t], H);
-        if (!std::isfinite(e))
-            throw Error(str(material_->name(), ": tet ", t, " has det F = ", 1.0 + volume_change(H),
-                            ", where the material is undefined (inverted)"));
-        total += e;
-        const Vector12d f = element_forces(*material_, volumes_[t], B_[static_cast<std::size_t>(t)], H);
+        const auto k = static_cast<std::size_t>(t);
+        total += element_energies_[k];
         for (int i = 0; i < 4; ++i)
-            forces.segment<3>(3 * mesh_.T(t, i)) += f.segment<3>(3 * i);
+            forces.segment<3>(3 * mesh_.T(t, i)) += element_forces_[k].segment<3>(3 * i);
     }
     return total;
 }
@@ -119,10 +134,14 @@ const dynamics::SparseMatrix& HyperelasticElasticity::assemble_hessian(const Eig
     // two layouts coincide, so the pattern's offsets address K_'s values directly.
     double* values = K_.valuePtr();
     std::fill(values, values + K_.nonZeros(), 0.0);
+    // Every tet's Hessian on every core, then added into the pattern in tet order.
+    element_matrices_.resize(static_cast<std::size_t>(mesh_.T.rows()));
+    parallel_for(mesh_.T.rows(), [&](Eigen::Index t) {
+        const auto k = static_cast<std::size_t>(t);
+        element_matrices_[k] = element_hessian(*material_, volumes_[t], B_[k], displacement_gradient(x, t), projection);
+    });
     for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t)
-        pattern_.add_element(t, element_hessian(*material_, volumes_[t], B_[static_cast<std::size_t>(t)],
-                                                displacement_gradient(x, t), projection),
-                             values);
+        pattern_.add_element(t, element_matrices_[static_cast<std::size_t>(t)], values);
     return K_;
 }
 

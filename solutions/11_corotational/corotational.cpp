@@ -1,6 +1,7 @@
 #include "11_corotational/corotational.hpp"
 
 #include "common/error.hpp"
+#include "common/parallel.hpp"
 #include "common/vtk_io.hpp"
 
 #include <Eigen/Geometry>
@@ -168,7 +169,7 @@ std::vector<Eigen::Matrix3d> CorotationalElasticity::rotations(const Eigen::Vect
         throw Error(str("displacement has ", u.size(), " entries, expected 3n = ", 3 * mesh_.V.rows()));
     const MatrixX3d x = mesh_.V + io::vertex_rows(u);
     std::vector<Eigen::Matrix3d> R(static_cast<std::size_t>(mesh_.T.rows()));
-    for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t) {
+    parallel_for(mesh_.T.rows(), [&](Eigen::Index t) {  // each tet's own rotation: on every core
         const tet::TetVertices rest = tet::tet_vertices(mesh_, mesh_.V, static_cast<int>(t));
         const tet::TetVertices now = tet::tet_vertices(mesh_, x, static_cast<int>(t));
         Eigen::Matrix3d& R_t = R[static_cast<std::size_t>(t)];
@@ -182,7 +183,7 @@ std::vector<Eigen::Matrix3d> CorotationalElasticity::rotations(const Eigen::Vect
         case RotationFit::centroid: R_t = best_fit_rotation(centroid_covariance(rest, now)); break;
         case RotationFit::edges: R_t = best_fit_rotation(edge_covariance(rest, now)); break;
         }
-    }
+    });
     return R;
 }
 
@@ -212,19 +213,28 @@ double CorotationalElasticity::evaluate(const Eigen::VectorXd& u, Eigen::VectorX
 {
     const std::vector<Eigen::Matrix3d>& R = rotations_at(u);
     const MatrixX3d x = mesh_.V + io::vertex_rows(u);
+    // Every tet's force and energy on every core, each into its own slot; then the sums, one tet
+    // after another in order (common/parallel.hpp: the same bits on any number of threads).
+    element_forces_.resize(static_cast<std::size_t>(mesh_.T.rows()));
+    element_energies_.resize(static_cast<std::size_t>(mesh_.T.rows()));
+    parallel_for(mesh_.T.rows(), [&](Eigen::Index t) {
+        const auto e = static_cast<std::size_t>(t);
+        const Vector12d x_e = element_vector(mesh_, x, t), X_e = element_vector(mesh_, mesh_.V, t);
+        element_forces_[e] = corotated_force(K_e_[e], R[e], x_e, X_e);
+        // U_e = ½ dᵀ K_e d = −½ Σᵢ (R dᵢ)·f_e,i, since f_e,i = −R (K_e d)ᵢ: no second product with K_e
+        const Vector12d d = corotated_displacement(R[e], x_e, X_e);
+        double energy = 0.0;
+        for (int i = 0; i < 4; ++i)
+            energy -= 0.5 * (R[e] * d.segment<3>(3 * i)).dot(element_forces_[e].segment<3>(3 * i));
+        element_energies_[e] = energy;
+    });
     forces = Eigen::VectorXd::Zero(u.size());
     double energy = 0.0;
     for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t) {
-        const Matrix12d& K = K_e_[static_cast<std::size_t>(t)];
-        const Vector12d x_e = element_vector(mesh_, x, t), X_e = element_vector(mesh_, mesh_.V, t);
-        const Eigen::Matrix3d& R_t = R[static_cast<std::size_t>(t)];
-        const Vector12d f_e = corotated_force(K, R_t, x_e, X_e);
-        // U_e = ½ dᵀ K_e d = −½ Σᵢ (R dᵢ)·f_e,i, since f_e,i = −R (K_e d)ᵢ: no second product with K_e
-        const Vector12d d = corotated_displacement(R_t, x_e, X_e);
-        for (int i = 0; i < 4; ++i) {
-            energy -= 0.5 * (R_t * d.segment<3>(3 * i)).dot(f_e.segment<3>(3 * i));
-            forces.segment<3>(3 * mesh_.T(t, i)) += f_e.segment<3>(3 * i);
-        }
+        const auto e = static_cast<std::size_t>(t);
+        energy += element_energies_[e];
+        for (int i = 0; i < 4; ++i)
+            forces.segment<3>(3 * mesh_.T(t, i)) += element_forces_[e].segment<3>(3 * i);
     }
     return energy;
 }
@@ -237,11 +247,17 @@ const dynamics::SparseMatrix& CorotationalElasticity::stiffness(const Eigen::Vec
     double* values = K_R_.valuePtr();
     std::fill(values, values + K_R_.nonZeros(), 0.0);
     // BEGIN EXERCISE 11.6 warped_stiffness #forces-and-warped-stiffness
-    // HINT: per tet t, rotated_stiffness(K_e_[t], R[t]) added into the fixed pattern's values by
-    // HINT: pattern_.add_element (chapter 06's route c, one element at a time: nothing stored).
+    // HINT: per tet t, element_matrices_[t] = rotated_stiffness(K_e_[t], R[t]), on every core
+    // HINT: (parallel_for of common/parallel.hpp: each tet writes its own slot); then, one tet after
+    // HINT: another in order, pattern_.add_element(t, element_matrices_[t], values) (chapter 06's
+    // HINT: route c into the fixed pattern; in order, so the sums do not depend on the threads).
+    element_matrices_.resize(static_cast<std::size_t>(mesh_.T.rows()));
+    parallel_for(mesh_.T.rows(), [&](Eigen::Index t) {
+        const auto e = static_cast<std::size_t>(t);
+        element_matrices_[e] = rotated_stiffness(K_e_[e], R[e]);
+    });
     for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t)
-        pattern_.add_element(t, rotated_stiffness(K_e_[static_cast<std::size_t>(t)], R[static_cast<std::size_t>(t)]),
-                             values);
+        pattern_.add_element(t, element_matrices_[static_cast<std::size_t>(t)], values);
     // END EXERCISE
     return K_R_;
 }

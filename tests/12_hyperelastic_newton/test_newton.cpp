@@ -4,10 +4,13 @@
 #include "12_hyperelastic_newton/hyperelastic.hpp"
 #include "12_hyperelastic_newton/newton.hpp"
 
+#include "11_corotational/corotational.hpp"
+
 #include "06_assembly/assembly.hpp"
 
 #include "common/error.hpp"
 #include "common/mesh.hpp"
+#include "common/parallel.hpp"
 #include "common/random.hpp"
 #include "common/vtk_io.hpp"
 
@@ -418,4 +421,47 @@ TEST_CASE("inexact Newton: CG solved only as tightly as the gradient needs, the 
     CHECK((exact_solves - reference).norm() <= 1e-5 * reference.norm());
     CHECK((inexact - reference).norm() <= 1e-5 * reference.norm());
     CHECK(loose < tight);
+}
+
+TEST_CASE("the element loops on 1 and 2 threads: the same energy, forces and Hessian to the last bit", "[ex12.5]")
+{
+    // Each tet's result goes to its own slot on any thread; the sums run in tet order afterwards
+    // (common/parallel.hpp), so the thread count cannot change a bit.
+    const TetMesh mesh = beam_mesh(0.2, 0.02, 0.02, 12);
+    const Eigen::VectorXd u = 2e-3 * fem::random_vector(3 * mesh.V.rows(), 31);
+    HyperelasticElasticity model(mesh, make_material("stable-neo-hookean", 1e6, 0.45));
+    corot::CorotationalElasticity corotated(mesh, dynamics::Material{1e6, 0.45, 1000.0});
+    struct Results {
+        double energy = 0.0, corotated_energy = 0.0;
+        Eigen::VectorXd forces, corotated_forces;
+        dynamics::SparseMatrix hessian, warped;
+    };
+    const auto evaluate = [&](int threads) {
+        fem::set_thread_count(threads);
+        Results r;
+        r.energy = model.evaluate(u, r.forces);
+        r.hessian = model.definite_stiffness(u);
+        r.corotated_energy = corotated.evaluate(u, r.corotated_forces);
+        r.warped = corotated.stiffness(u);
+        return r;
+    };
+    const int original = fem::thread_count();
+    const Results one = evaluate(1), two = evaluate(2);
+    CHECK(one.energy == two.energy);
+    CHECK(one.corotated_energy == two.corotated_energy);
+    CHECK((one.forces - two.forces).cwiseAbs().maxCoeff() == 0.0);
+    CHECK((one.corotated_forces - two.corotated_forces).cwiseAbs().maxCoeff() == 0.0);
+    CHECK((one.hessian.coeffs() - two.hessian.coeffs()).cwiseAbs().maxCoeff() == 0.0);  // one pattern
+    CHECK((one.warped.coeffs() - two.warped.coeffs()).cwiseAbs().maxCoeff() == 0.0);
+    // An inverted neo-Hookean tet is named the same way on 2 threads: the lowest-numbered one.
+    HyperelasticElasticity neo(mesh, make_material("neo-hookean", 1e6, 0.45));
+    Eigen::VectorXd squashed = Eigen::VectorXd::Zero(3 * mesh.V.rows());
+    for (Eigen::Index v = 0; v < mesh.V.rows(); ++v)
+        squashed[3 * v + 2] = -2.0 * mesh.V(v, 2);  // z -> -z: every tet inverted
+    Eigen::VectorXd forces;
+    fem::set_thread_count(2);
+    CHECK_THROWS_WITH(neo.evaluate(squashed, forces), Contains("tet 0 "));
+    fem::set_thread_count(1);
+    CHECK_THROWS_WITH(neo.evaluate(squashed, forces), Contains("tet 0 "));
+    fem::set_thread_count(original);
 }

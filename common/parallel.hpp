@@ -1,0 +1,78 @@
+#pragma once
+// Per-element loops on every core, with results that do not depend on the number of threads.
+//
+// A finite element loop computes something per element (a rotation, a force, a 12×12 matrix) and
+// adds it into global arrays. The adding is where threads would race, and where a parallel sum
+// would make the last bits depend on how the elements were split among the threads. So the
+// course splits the two: parallel_for computes every element's result into its own slot, and the
+// caller adds the slots up afterwards, one element after another in element order. That is the
+// same sequence of floating-point operations on 1 thread or 64, so the results are identical to
+// the last bit (the scenes runner tests it), and the serial part is only the adding.
+//
+// OpenMP (g++ -fopenmp, linked through fem_common) runs the loop; OMP_NUM_THREADS sets the number
+// of threads. Built without OpenMP, parallel_for is a plain loop.
+
+#include <Eigen/Core>
+
+#include <exception>
+#include <utility>
+#include <vector>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+namespace fem {
+
+/// The number of threads parallel_for runs on (omp_get_max_threads(); 1 without OpenMP).
+inline int thread_count()
+{
+#ifdef _OPENMP
+    return omp_get_max_threads();
+#else
+    return 1;
+#endif
+}
+
+/// Sets the number of threads of the next parallel_for loops (omp_set_num_threads; ≥ 1), e.g. to
+/// measure the speed-up or to check that the results do not change. Ignored without OpenMP.
+inline void set_thread_count(int threads)
+{
+#ifdef _OPENMP
+    omp_set_num_threads(threads < 1 ? 1 : threads);
+#else
+    (void)threads;
+#endif
+}
+
+/// Calls body(i) for every i in [0, n), split among thread_count() threads (a static schedule).
+/// Each body(i) must write only what belongs to i. An exception thrown by body(i) is rethrown
+/// after the loop: the one of the smallest such i, so that a run fails with the same message on
+/// any number of threads (an exception may not leave an OpenMP region by itself).
+template <class Body>
+void parallel_for(Eigen::Index n, Body&& body)
+{
+    std::vector<std::pair<Eigen::Index, std::exception_ptr>> failures;
+#ifdef _OPENMP
+#pragma omp parallel for schedule(static)
+#endif
+    for (Eigen::Index i = 0; i < n; ++i) {
+        try {
+            body(i);
+        } catch (...) {
+#ifdef _OPENMP
+#pragma omp critical(fem_parallel_for_failures)
+#endif
+            failures.emplace_back(i, std::current_exception());
+        }
+    }
+    if (failures.empty())
+        return;
+    std::size_t first = 0;
+    for (std::size_t k = 1; k < failures.size(); ++k)
+        if (failures[k].first < failures[first].first)
+            first = k;
+    std::rethrow_exception(failures[first].second);
+}
+
+}  // namespace fem
