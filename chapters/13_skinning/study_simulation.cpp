@@ -1,0 +1,158 @@
+// Study 3 of ch13_skinning: the pushed rubber bunny simulated on coarse lattices and skinned, against
+// the same bunny simulated on TetGen's fine tets (whose surface is the bunny's): the surface error,
+// the cost of a step and of a skin, the cost of a frame's skin on 10⁵ vertices, a .pvd of the skin
+// beside the coarse tets and PNG frames. docs/13_skinning.md#skinning-against-simulation
+#include "13_skinning/studies.hpp"
+
+#include "07_sparse_storage/sparse_formats.hpp"
+
+#include "common/error.hpp"
+#include "common/figures.hpp"
+#include "common/motion.hpp"
+#include "common/table.hpp"
+#include "common/timer.hpp"
+
+#include <algorithm>
+#include <iostream>
+
+namespace fem::skin::study {
+namespace {
+
+/// What one simulated and skinned run reports.
+struct SkinnedRun {
+    double seconds_per_step = 0.0;
+    std::vector<MatrixX3d> surface;  ///< the skinned surface at every frame
+};
+
+/// Runs the pushed bunny on mesh and skins surface with it every frame; records the coarse frames
+/// and the skin's when recorders are given.
+SkinnedRun simulate(const TetMesh& mesh, const TriMesh& surface, const Settings& settings, io::MotionRecorder* coarse = nullptr,
+                    io::MotionRecorder* skin_series = nullptr)
+{
+    Run run = bunny_run(mesh, surface, settings);
+    const Skin skin = build_skin(mesh, surface);
+    dynamics::Body& body = *run.body;
+    dynamics::Simulation simulation(body, *run.integrator, dynamics::initial_state(body, {}, run.push),
+                                    body.scene().time_step);
+    SkinnedRun result;
+    double skinning = 0.0;
+    const int steps = dynamics::step_count(body.scene().duration, body.scene().time_step);
+    Timer clock;
+    simulation.run(steps, [&](const dynamics::State& state, const dynamics::StepRecord&) {
+        Timer skin_clock;
+        const MatrixX3d Q = body.positions(state.u);
+        result.surface.push_back(skinned_positions(skin.W, Q));
+        skinning += skin_clock.seconds();
+        if (coarse != nullptr)
+            coarse->add(state.time, dynamics::body_frame(body, state));
+        if (skin_series != nullptr)
+            skin_series->add(state.time, skin_frame(skin, Q));
+    });
+    result.seconds_per_step = (clock.seconds() - skinning) / steps;
+    return result;
+}
+
+/// The largest distance between two surfaces over all frames.
+double largest_distance(const std::vector<MatrixX3d>& a, const std::vector<MatrixX3d>& b)
+{
+    double largest = 0.0;
+    for (std::size_t k = 0; k < a.size(); ++k)
+        largest = std::max(largest, (a[k] - b[k]).rowwise().norm().maxCoeff());
+    return largest;
+}
+
+}  // namespace
+
+void simulation_study(const RunContext& run, const Settings& settings)
+{
+    std::cout << "\n== 3. Skinning against simulation: the pushed rubber bunny (" << settings.model
+              << ", backward Euler, dt = 1/60 s, " << settings.duration << " s)\n\n";
+    TriMesh bunny = bunny_surface();
+    bunny.V *= 0.01;  // a 9.7 cm bunny, as in chapter 10
+    TetMesh fine = bunny_tets();
+    fine.V *= 0.01;
+
+    // Why: the reference is the bunny simulated on TetGen's tets, whose boundary is the bunny's
+    // surface itself: its skin is a selection (W has one weight 1 a row) and carries no error.
+    const SkinnedRun reference = simulate(fine, bunny, settings);
+    double motion = 0.0;
+    for (const MatrixX3d& x : reference.surface)
+        motion = std::max(motion, (x - bunny.V).rowwise().norm().maxCoeff());
+
+    Table sweep(str("Coarse lattices against TetGen's fine bunny (", fine.T.rows(), " tets, ", reference.seconds_per_step,
+                    " s a step; the surface moves up to ", motion, " m)"),
+                {{"coarse mesh", Format::text}, {"vertices", Format::integer}, {"tets", Format::integer},
+                 {"step [s]", Format::scientific, 2}, {"skin W q [s]", Format::scientific, 2},
+                 {"step + skin / fine step [measured]", Format::fixed, 3}, {"surface error (m)", Format::scientific, 3},
+                 {"error / largest motion", Format::scientific, 3}});
+    fig::Series pareto_series{"coarse lattice + skin", {}, {}};
+    const int png_every = run.figures ? (run.quick ? 5 : 10) : 0;
+    io::MotionRecorder coarse_series(run.file("coarse.pvd"));
+    io::MotionRecorder skin_series(run.file("skin.pvd"), png_every, io::FrameFile::surface);
+    std::vector<int> cells = settings.cells;
+    if (std::find(cells.begin(), cells.end(), settings.shown_cells) == cells.end())
+        cells.push_back(settings.shown_cells);
+    for (int n : cells) {
+        const TetMesh lattice = enclosing_lattice(bunny, n);
+        const bool shown = n == settings.shown_cells;
+        const SkinnedRun coarse = simulate(lattice, bunny, settings, shown ? &coarse_series : nullptr, shown ? &skin_series : nullptr);
+        if (std::find(settings.cells.begin(), settings.cells.end(), n) == settings.cells.end())
+            continue;
+        const Skin skin = build_skin(lattice, bunny);
+        const MatrixX3d Q = lattice.V;
+        const double skinning = best_time([&] { (void)skinned_positions(skin.W, Q); }, settings.seconds);
+        const double error = largest_distance(coarse.surface, reference.surface);
+        sweep.add_row({str("lattice ", n), double(lattice.V.rows()), double(lattice.T.rows()), coarse.seconds_per_step, skinning,
+                       (coarse.seconds_per_step + skinning) / reference.seconds_per_step, error, error / motion});
+        pareto_series.x.push_back(coarse.seconds_per_step + skinning);
+        pareto_series.y.push_back(error);
+    }
+    sweep.print(std::cout);
+    sweep.write_csv(run.file("sweep_table.csv"));
+
+    fig::LineChart pareto;
+    pareto.title = str("Skinned coarse lattices: surface error against the cost of a frame (fine step: ", reference.seconds_per_step, " s)");
+    pareto.x_label = "step + skin [s]";
+    pareto.y_label = "surface error against the fine simulation (m)";
+    pareto.log_x = pareto.log_y = true;
+    pareto.series = {pareto_series};
+    fig::save_chart(pareto, run.file("skinning_pareto"), run.figures);
+
+    // Why: what a frame costs beside a step: the product W Q by hand and by Eigen, the normals, on the
+    // bunny and on the upsampled bunny, carried by the lattice shown.
+    const TetMesh lattice = enclosing_lattice(bunny, settings.shown_cells);
+    Run shown = bunny_run(lattice, bunny, settings);
+    dynamics::State state = dynamics::initial_state(*shown.body, {}, shown.push);
+    const double step = best_time([&] { shown.integrator->step(*shown.body, shown.body->scene().time_step, state); },
+                                  settings.seconds, 20);
+    const MatrixX3d Q = shown.body->positions(state.u);
+    Table frame(str("One frame on lattice ", settings.shown_cells, " (", lattice.T.rows(), " tets): the skin against the step"),
+                {{"surface vertices", Format::integer}, {"W nonzeros", Format::integer}, {"build skin [s]", Format::scientific, 2},
+                 {"W Q by hand [s]", Format::scientific, 2}, {"W Q by Eigen [s]", Format::scientific, 2},
+                 {"normals [s]", Format::scientific, 2}, {"coarse step [s]", Format::scientific, 2},
+                 {"outside", Format::integer}, {"largest outside distance (m)", Format::scientific, 3}});
+    for (const TriMesh& surface : {bunny, midpoint_subdivision(bunny, settings.levels)}) {
+        Skin skin;
+        const double build = best_time([&] { skin = build_skin(lattice, surface); }, settings.seconds, 3);
+        const Eigen::SparseMatrix<double, Eigen::RowMajor> W = sparse::to_eigen(skin.W);
+        MatrixX3d x;
+        const double hand = best_time([&] { x = skinned_positions(skin.W, Q); }, settings.seconds);
+        const double eigen = best_time([&] { x = W * Q; }, settings.seconds);
+        const double normals = best_time([&] { (void)vertex_normals(surface.F, x); }, settings.seconds);
+        frame.add_row({double(surface.V.rows()), double(skin.W.nonzeros()), build, hand, eigen, normals, step,
+                       double(skin.outside.size()), skin.largest_outside_distance()});
+    }
+    frame.print(std::cout);
+    frame.write_csv(run.file("frame_table.csv"));
+
+    fig::RenderOptions view;
+    view.title = str("Rubber bunny skinned on lattice ", settings.shown_cells, " (", settings.model, ")");
+    view.field = "displacement";
+    view.view_direction = {0.2, -0.25, -1.0};
+    view.view_up = {0.0, 1.0, 0.0};
+    view.show_edges = false;
+    view.height = 600;
+    skin_series.render_png_frames(run.file("skin"), view);
+}
+
+}  // namespace fem::skin::study
