@@ -35,20 +35,20 @@ SkinnedRun simulate(const TetMesh& mesh, const TriMesh& surface, const Settings&
     dynamics::Simulation simulation(body, *run.integrator, dynamics::initial_state(body, {}, run.push),
                                     body.scene().time_step);
     SkinnedRun result;
-    double skinning = 0.0;
+    double observing = 0.0;  // the skin and the files, taken out of the step's time
     const int steps = dynamics::step_count(body.scene().duration, body.scene().time_step);
     Timer clock;
     simulation.run(steps, [&](const dynamics::State& state, const dynamics::StepRecord&) {
-        Timer skin_clock;
+        Timer observer_clock;
         const MatrixX3d Q = body.positions(state.u);
         result.surface.push_back(skinned_positions(skin.W, Q));
-        skinning += skin_clock.seconds();
         if (coarse != nullptr)
             coarse->add(state.time, dynamics::body_frame(body, state));
         if (skin_series != nullptr)
             skin_series->add(state.time, skin_frame(skin, Q));
+        observing += observer_clock.seconds();
     });
-    result.seconds_per_step = (clock.seconds() - skinning) / steps;
+    result.seconds_per_step = (clock.seconds() - observing) / steps;
     return result;
 }
 
@@ -152,7 +152,7 @@ void simulation_study(const RunContext& run, const Settings& settings)
     view.view_up = {0.0, 1.0, 0.0};
     view.show_edges = false;
     view.height = 600;
-    skin_series.render_png_frames(run.file("skin"), view);
+    skin_series.render_png_frames(run.file("skin"), view, 5.0);  // a 5 mm sway on a 9.7 cm bunny: exaggerated
 }
 
 }  // namespace fem::skin::study
