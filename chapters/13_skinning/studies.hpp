@@ -17,7 +17,7 @@ namespace fem::skin::study {
 
 /// The executable's options (main.cpp checks them before any study runs).
 struct Settings {
-    std::vector<int> cells{4, 6, 8, 12};           ///< lattice resolutions of the sweep (cubes along the longest side)
+    std::vector<int> cells{4, 6, 8, 12, 16};           ///< lattice resolutions of the sweep (cubes along the longest side)
     int shown_cells = 8;                           ///< the lattice of the time series and PNG frames
     int levels = 3;                                ///< midpoint subdivisions of the upsampled bunny
     std::string model = "corotational";            ///< the force model of both simulations

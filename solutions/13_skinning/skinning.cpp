@@ -314,7 +314,7 @@ std::unique_ptr<PointLocator> make_locator(LocateMethod method, const Barycentri
 Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
                                           const Eigen::Vector3d& b, const Eigen::Vector3d& c)
 {
-    // BEGIN EXERCISE 13.4 closest_point_on_triangle #points-outside
+    // BEGIN EXERCISE 13.5 closest_point_on_triangle #points-outside
     // HINT: Ericson's Voronoi-region walk: with ab = b − a, ac = c − a and the dot products of ab, ac
     // HINT: with p − a, p − b, p − c, decide whether p projects onto a corner (a, b, c), an edge
     // HINT: (ab, ac, bc) or the face, and return that projection.
@@ -407,7 +407,7 @@ sparse::CsrMatrix skinning_matrix(const TetMesh& coarse, const std::vector<int>&
         if (tet[s] < 0 || tet[s] >= coarse.T.rows())
             throw Error(str("skinning_matrix: surface vertex ", s, " refers to tet ", tet[s], "; the coarse mesh has ",
                             coarse.T.rows(), " (numbered from 0)"));
-    // BEGIN EXERCISE 13.5 skinning_matrix #the-skinning-matrix
+    // BEGIN EXERCISE 13.4 skinning_matrix #the-skinning-matrix
     // HINT: One triplet (s, corner v of tet[s], φ) per corner: a CooMatrix of #V_skin × #V_sim with
     // HINT: four entries a row, then chapter 07's coo_to_csr (which sorts the columns of each row).
     sparse::CooMatrix W;

@@ -67,7 +67,7 @@ TriMesh fan(const MatrixX3d& V)
 }  // namespace
 
 TEST_CASE("W: four weights a row, summing to 1, in [-tol, 1 + tol] for inside points, the rest surface exactly",
-          "[ex13.5]")
+          "[ex13.4]")
 {
     const TetMesh mesh = bunny_tets();
     const TriMesh surface = midpoint_subdivision(bunny(), 1);
@@ -92,7 +92,7 @@ TEST_CASE("W: four weights a row, summing to 1, in [-tol, 1 + tol] for inside po
 }
 
 TEST_CASE("W carries any affine motion of the coarse mesh exactly, and is the identity's rows on its own vertices",
-          "[ex13.5]")
+          "[ex13.4]")
 {
     const TetMesh mesh = bunny_tets();
     const TriMesh surface = bunny();
@@ -110,7 +110,7 @@ TEST_CASE("W carries any affine motion of the coarse mesh exactly, and is the id
     CHECK(W.rightCols(mesh.V.rows() - surface.V.rows()).cwiseAbs().maxCoeff() <= 1e-12);
 }
 
-TEST_CASE("skinning a smooth motion: the error of a quadratic field falls as h^2 with the lattice's cube size", "[ex13.5]")
+TEST_CASE("skinning a smooth motion: the error of a quadratic field falls as h^2 with the lattice's cube size", "[ex13.4]")
 {
     // The field x(X) = X + ε (X_y², X_z X_x, X_x²): W interpolates it linearly in each tet, with an
     // error ≤ (ε/2)·|second derivative|·h² per vertex; halving h divides it by about four.
@@ -168,7 +168,7 @@ TEST_CASE("a skin frame: rest points, the displacement W Q - X, the deformed nor
     CHECK(frame.field("normal").values.rows() == 4);
 }
 
-TEST_CASE("closest point on a triangle: corners, edges and the face, against a dense sampling", "[ex13.4]")
+TEST_CASE("closest point on a triangle: corners, edges and the face, against a dense sampling", "[ex13.5]")
 {
     const Eigen::Vector3d a(0.0, 0.0, 0.0), b(2.0, 0.0, 0.0), c(0.5, 1.5, 0.0);
     // Known answers in each Voronoi region.
@@ -191,7 +191,7 @@ TEST_CASE("closest point on a triangle: corners, edges and the face, against a d
 }
 
 TEST_CASE("points outside a cube: the nearest tet, the distances, extrapolated weights carrying affine motions, the limit",
-          "[ex13.4]")
+          "[ex13.5]")
 {
     // The unit cube as six tets; surface vertices at known distances outside: 0.2 beyond x = 1,
     // 0.1 above z = 1, 0.3 below y = 0, and one inside.
