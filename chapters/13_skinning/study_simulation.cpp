@@ -114,12 +114,8 @@ void simulation_study(const RunContext& run, const Settings& settings)
     sweep.print(std::cout);
     sweep.write_csv(run.file("sweep_table.csv"));
 
-    fig::LineChart pareto;
-    pareto.title = "Skinned coarse lattices: surface error against the cost of a frame";
-    pareto.x_label = "step + skin [s]";
-    pareto.y_label = "surface error against the fine simulation (m)";
-    pareto.log_x = pareto.log_y = true;
-    pareto.series = {pareto_series};
+    const fig::LineChart pareto{"Skinned coarse lattices: surface error against the cost of a frame", "step + skin [s]",
+                                "surface error against the fine simulation (m)", true, true, {pareto_series}};
     fig::save_chart(pareto, run.file("skinning_pareto"), run.figures);
 
     // Why: what a frame costs beside a step: the product W Q by hand and by Eigen, the normals, on the

@@ -400,10 +400,10 @@ MatrixX3d skinned_positions(const sparse::CsrMatrix& W, const MatrixX3d& Q)
                         " columns; give one row per coarse vertex"));
     (void)sparse::view(W);  // checks the array sizes
     MatrixX3d x(W.rows, 3);
-    // EXERCISE 13.6 (skinned_positions): see docs/13_skinning.md#the-skinned-surface
+    // EXERCISE 13.7 (skinned_positions): see docs/13_skinning.md#the-skinned-surface
     // HINT: Row s of x is Σ A[k] Q.row(JA[k]) over k = IA[s] … IA[s+1]−1: one pass over W for all
     // HINT: three coordinates (three separate SpMVs would read W three times).
-    throw fem::NotImplemented("13.6", "skinned_positions", "docs/13_skinning.md#the-skinned-surface");
+    throw fem::NotImplemented("13.7", "skinned_positions", "docs/13_skinning.md#the-skinned-surface");
     return x;
 }
 
@@ -414,10 +414,10 @@ MatrixX3d vertex_normals(const MatrixX3i& F, const MatrixX3d& x)
         for (int i = 0; i < 3; ++i)
             if (F(f, i) < 0 || F(f, i) >= x.rows())
                 throw Error(str("vertex_normals: triangle ", f, " refers to vertex ", F(f, i), "; there are ", x.rows()));
-    // EXERCISE 13.7 (vertex_normals): see docs/13_skinning.md#normals
+    // EXERCISE 13.6 (vertex_normals): see docs/13_skinning.md#normals
     // HINT: Add (b − a) × (c − a) of each triangle (a, b, c) to its three vertices, then normalise
     // HINT: each row that is not zero.
-    throw fem::NotImplemented("13.7", "vertex_normals", "docs/13_skinning.md#normals");
+    throw fem::NotImplemented("13.6", "vertex_normals", "docs/13_skinning.md#normals");
     return normals;
 }
 

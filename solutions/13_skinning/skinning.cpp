@@ -468,7 +468,7 @@ MatrixX3d skinned_positions(const sparse::CsrMatrix& W, const MatrixX3d& Q)
                         " columns; give one row per coarse vertex"));
     (void)sparse::view(W);  // checks the array sizes
     MatrixX3d x(W.rows, 3);
-    // BEGIN EXERCISE 13.6 skinned_positions #the-skinned-surface
+    // BEGIN EXERCISE 13.7 skinned_positions #the-skinned-surface
     // HINT: Row s of x is Σ A[k] Q.row(JA[k]) over k = IA[s] … IA[s+1]−1: one pass over W for all
     // HINT: three coordinates (three separate SpMVs would read W three times).
     for (int s = 0; s < W.rows; ++s) {
@@ -488,7 +488,7 @@ MatrixX3d vertex_normals(const MatrixX3i& F, const MatrixX3d& x)
         for (int i = 0; i < 3; ++i)
             if (F(f, i) < 0 || F(f, i) >= x.rows())
                 throw Error(str("vertex_normals: triangle ", f, " refers to vertex ", F(f, i), "; there are ", x.rows()));
-    // BEGIN EXERCISE 13.7 vertex_normals #normals
+    // BEGIN EXERCISE 13.6 vertex_normals #normals
     // HINT: Add (b − a) × (c − a) of each triangle (a, b, c) to its three vertices, then normalise
     // HINT: each row that is not zero.
     for (Eigen::Index f = 0; f < F.rows(); ++f) {

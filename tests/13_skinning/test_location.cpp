@@ -91,35 +91,36 @@ TEST_CASE("barycentric weights: chapter 04's shape functions, summing to 1, repr
     }
 }
 
-TEST_CASE("point location by a uniform grid: the brute force's tet for the bunny and for points on vertices, edges, faces",
-          "[ex13.2]")
+namespace {
+
+/// Every vertex of the bunny and the special points of TetGen's tets: the brute force's tet.
+void check_on_bunny(const BarycentricFrames& frames, const PointLocator& locator, double tolerance)
 {
-    const TetMesh mesh = bunny_tets();
-    const BarycentricFrames frames(mesh);
-    const double tolerance = 1e-9;
-    const UniformGrid grid(frames, tolerance);
     const TriMesh surface = bunny();
     std::vector<Eigen::Vector3d> points;
     for (Eigen::Index v = 0; v < surface.V.rows(); ++v)
         points.push_back(surface.V.row(v).transpose());
-    check_against_brute_force(frames, grid, points, tolerance);
-    check_against_brute_force(frames, grid, special_points(mesh, 7), tolerance);
+    check_against_brute_force(frames, locator, points, tolerance);
+    check_against_brute_force(frames, locator, special_points(frames.mesh(), 7), tolerance);
+}
+
+}  // namespace
+
+TEST_CASE("point location by a uniform grid: the brute force's tet for the bunny and for points on vertices, edges, faces",
+          "[ex13.2]")
+{
+    const BarycentricFrames frames(bunny_tets());
+    const UniformGrid grid(frames, 1e-9);
+    check_on_bunny(frames, grid, 1e-9);
     CHECK(grid.mean_tets_per_cell() > 0.0);
 }
 
 TEST_CASE("point location by an AABB tree: the brute force's tet for the bunny and for points on vertices, edges, faces",
           "[ex13.3]")
 {
-    const TetMesh mesh = bunny_tets();
-    const BarycentricFrames frames(mesh);
-    const double tolerance = 1e-9;
-    const AabbTree tree(frames, tolerance);
-    const TriMesh surface = bunny();
-    std::vector<Eigen::Vector3d> points;
-    for (Eigen::Index v = 0; v < surface.V.rows(); ++v)
-        points.push_back(surface.V.row(v).transpose());
-    check_against_brute_force(frames, tree, points, tolerance);
-    check_against_brute_force(frames, tree, special_points(mesh, 7), tolerance);
+    const BarycentricFrames frames(bunny_tets());
+    const AabbTree tree(frames, 1e-9);
+    check_on_bunny(frames, tree, 1e-9);
     CHECK(tree.depth() <= 20);
 }
 

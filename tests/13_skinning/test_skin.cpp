@@ -134,7 +134,7 @@ TEST_CASE("skinning a smooth motion: the error of a quadratic field falls as h^2
     CHECK(errors[2] > 0.0);
 }
 
-TEST_CASE("skinned positions by hand: Eigen's sparse product on a random W, for all three columns at once", "[ex13.6]")
+TEST_CASE("skinned positions by hand: Eigen's sparse product on a random W, for all three columns at once", "[ex13.7]")
 {
     sparse::CooMatrix coo;
     coo.rows = 50;
@@ -148,7 +148,7 @@ TEST_CASE("skinned positions by hand: Eigen's sparse product on a random W, for 
     CHECK_THROWS_AS(skinned_positions(W, MatrixX3d(29, 3)), Error);
 }
 
-TEST_CASE("a skin frame: rest points, the displacement W Q - X, the deformed normals", "[ex13.6]")
+TEST_CASE("a skin frame: rest points, the displacement W Q - X, the deformed normals", "[ex13.7]")
 {
     const TetMesh mesh = box_mesh(2, 2, 2);
     Skin skin;
@@ -233,7 +233,7 @@ TEST_CASE("points outside a cube: the nearest tet, the distances, extrapolated w
     CHECK_THROWS_WITH(build_skin(cube, surface, options), Contains("surface vertex 1") && Contains("0.1 times"));
 }
 
-TEST_CASE("normals: a flat patch points along z, a sphere's radially, and they turn with a rotated surface", "[ex13.7]")
+TEST_CASE("normals: a flat patch points along z, a sphere's radially, and they turn with a rotated surface", "[ex13.6]")
 {
     MatrixX3d flat(4, 3);
     flat << 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0;
