@@ -213,7 +213,7 @@ TEST_CASE("the lattice and the subdivided surface: the shapes the docs promise",
     CHECK(area(refined) == Approx(area(surface)).epsilon(1e-12));
 }
 
-TEST_CASE("bad locator options: a tolerance outside [0, 0.5) is refused", "[ch13]")
+TEST_CASE("bad locator options: a tolerance outside 0 to 0.5 is refused", "[ch13]")
 {
     const TetMesh mesh = box_mesh(1, 1, 1);
     const BarycentricFrames frames(mesh);

@@ -70,7 +70,7 @@ TriMesh fan(const MatrixX3d& V)
 
 }  // namespace
 
-TEST_CASE("W: four weights a row, summing to 1, in [-tol, 1 + tol] for inside points, the rest surface exactly",
+TEST_CASE("W: four weights a row, summing to 1, between -tol and 1 + tol for inside points, the rest surface exactly",
           "[ex13.4]")
 {
     const TetMesh mesh = bunny_tets();
