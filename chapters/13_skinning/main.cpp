@@ -19,7 +19,7 @@
 //
 // Writes (under out/13_skinning): the tables *_table.csv; the chart skinning_pareto (PNG + CSV);
 // skin.pvd (frames skin/skin_NNNN.vtp: displacement, normal) and coarse.pvd (frames
-// coarse/coarse_NNNN.vtu) with PNG frames skin_NNNN.png. docs/13_skinning.md
+// coarse/coarse_NNNN.vtu) with PNG frames skin_NNNN.png and coarse_NNNN.png. docs/13_skinning.md
 
 #include "13_skinning/studies.hpp"
 
