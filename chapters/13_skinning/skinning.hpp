@@ -198,7 +198,8 @@ struct Nearest {
     int tet = -1;
     double distance = 0.0;
 };
-/// The nearest boundary face to p, by testing every face. docs/13_skinning.md#points-outside
+/// The nearest boundary face to p, by testing every face whose bounding box is nearer than the
+/// nearest face found so far. docs/13_skinning.md#points-outside
 Nearest nearest_boundary_tet(const TetMesh& mesh, const Boundary& boundary, const Eigen::Vector3d& p);
 
 // --- The skin ----------------------------------------------------------------------------------

@@ -101,7 +101,7 @@ void check_on_bunny(const BarycentricFrames& frames, const PointLocator& locator
     for (Eigen::Index v = 0; v < surface.V.rows(); ++v)
         points.push_back(surface.V.row(v).transpose());
     check_against_brute_force(frames, locator, points, tolerance);
-    check_against_brute_force(frames, locator, special_points(frames.mesh(), 7), tolerance);
+    check_against_brute_force(frames, locator, special_points(frames.mesh(), 29), tolerance);
 }
 
 }  // namespace
