@@ -317,10 +317,13 @@ Nearest nearest_boundary_tet(const TetMesh& mesh, const Boundary& boundary, cons
 {
     Nearest nearest{-1, std::numeric_limits<double>::infinity()};
     for (Eigen::Index f = 0; f < boundary.faces.rows(); ++f) {
-        const Eigen::Vector3d q =
-            closest_point_on_triangle(p, mesh.V.row(boundary.faces(f, 0)).transpose(), mesh.V.row(boundary.faces(f, 1)).transpose(),
-                                      mesh.V.row(boundary.faces(f, 2)).transpose());
-        const double distance = (p - q).norm();
+        const Eigen::Vector3d a = mesh.V.row(boundary.faces(f, 0)).transpose(), b = mesh.V.row(boundary.faces(f, 1)).transpose(),
+                              c = mesh.V.row(boundary.faces(f, 2)).transpose();
+        // A face whose bounding box is no nearer than the best so far cannot be nearer itself.
+        const Eigen::Vector3d outside_box = (a.cwiseMin(b).cwiseMin(c) - p).cwiseMax(p - a.cwiseMax(b).cwiseMax(c)).cwiseMax(0.0);
+        if (outside_box.norm() >= nearest.distance)
+            continue;
+        const double distance = (p - closest_point_on_triangle(p, a, b, c)).norm();
         if (distance < nearest.distance)
             nearest = Nearest{boundary.tet[f], distance};
     }
