@@ -107,7 +107,7 @@ Location locate_brute_force(const BarycentricFrames& frames, const Eigen::Vector
 /// tet numbers, ascending). A query visits the one cell of p. docs/13_skinning.md#a-uniform-grid
 class UniformGrid final : public PointLocator {
 public:
-    /// fem::Error for a tolerance outside [0, 0.5) or cells_per_tet ≤ 0.
+    /// fem::Error for a tolerance outside [0, 0.5) or cells_per_tet ≤ 0. frames must outlive the grid.
     UniformGrid(const BarycentricFrames& frames, double tolerance, double cells_per_tet = 1.0);
     LocateMethod method() const override { return LocateMethod::grid; }
     Location locate(const Eigen::Vector3d& p) const override;
@@ -133,7 +133,7 @@ private:
 /// docs/13_skinning.md#an-aabb-tree
 class AabbTree final : public PointLocator {
 public:
-    /// fem::Error for a tolerance outside [0, 0.5) or leaf_size < 1.
+    /// fem::Error for a tolerance outside [0, 0.5) or leaf_size < 1. frames must outlive the tree.
     AabbTree(const BarycentricFrames& frames, double tolerance, int leaf_size = 4);
     LocateMethod method() const override { return LocateMethod::tree; }
     Location locate(const Eigen::Vector3d& p) const override;
@@ -161,7 +161,7 @@ private:
 /// The brute-force search as a PointLocator (what the executable times beside the other two).
 class BruteForce final : public PointLocator {
 public:
-    /// fem::Error for a tolerance outside [0, 0.5).
+    /// fem::Error for a tolerance outside [0, 0.5). frames must outlive the locator.
     BruteForce(const BarycentricFrames& frames, double tolerance);
     LocateMethod method() const override { return LocateMethod::brute_force; }
     Location locate(const Eigen::Vector3d& p) const override { return locate_brute_force(frames_, p, tolerance_); }
