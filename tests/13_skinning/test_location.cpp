@@ -178,6 +178,12 @@ TEST_CASE("the coarse lattice encloses the bunny: every vertex inside, brute for
     const BarycentricFrames frames(lattice, "lattice");
     for (Eigen::Index v = 0; v < surface.V.rows(); ++v)
         REQUIRE(locate_brute_force(frames, surface.V.row(v).transpose(), 0.0).tet >= 0);
+    // Every point of every triangle lies in a kept cube: so do the vertices of the refined surface.
+    const TriMesh refined = midpoint_subdivision(surface, 2);
+    int outside = 0;
+    for (Eigen::Index v = surface.V.rows(); v < refined.V.rows(); ++v)
+        outside += locate_brute_force(frames, refined.V.row(v).transpose(), 0.0).tet < 0;
+    CHECK(outside == 0);
     for (Eigen::Index v = 0; v < surface.V.rows(); v += 50) {
         const Eigen::Vector3d p = surface.V.row(v).transpose();
         const tet::PointLocation chapter04 = tet::locate_point(lattice, p, 1e-9);
