@@ -8,8 +8,8 @@
 
 namespace fem::io {
 
-MotionRecorder::MotionRecorder(std::filesystem::path pvd_path, int png_every)
-    : series_(std::move(pvd_path)), png_every_(png_every)
+MotionRecorder::MotionRecorder(std::filesystem::path pvd_path, int png_every, FrameFile file)
+    : series_(std::move(pvd_path)), png_every_(png_every), file_(file)
 {
     if (png_every < 0)
         throw Error(str("png_every must be 0 (no PNG frames) or a frame interval >= 1, got ", png_every));
@@ -18,7 +18,10 @@ MotionRecorder::MotionRecorder(std::filesystem::path pvd_path, int png_every)
 void MotionRecorder::add(double time, const MeshData& frame)
 {
     warped(frame);  // checks the displacement field before anything is written
-    series_.add(time, frame);
+    if (file_ == FrameFile::surface)
+        series_.add_surface(time, frame);
+    else
+        series_.add(time, frame);
     if (png_every_ > 0 && added_ % static_cast<std::size_t>(png_every_) == 0)
         kept_.emplace_back(time, frame);
     ++added_;

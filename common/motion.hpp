@@ -13,12 +13,19 @@
 
 namespace fem::io {
 
+/// What the frames of a series are written as.
+enum class FrameFile {
+    volume,   ///< .vtu (unstructured grids: tets, or any cells)
+    surface,  ///< .vtp (surfaces: triangles or lines), e.g. a skinned render surface
+};
+
 /// Records the frames of one body's motion.
 class MotionRecorder {
 public:
-    /// pvd_path: the series, e.g. out/10_linear_dynamics/beam.pvd (frames in beam/beam_NNNN.vtu).
-    /// png_every: keep every k-th frame (k ≥ 1) for the PNG frames, 0 for none.
-    MotionRecorder(std::filesystem::path pvd_path, int png_every = 0);
+    /// pvd_path: the series, e.g. out/10_linear_dynamics/beam.pvd (frames in beam/beam_NNNN.vtu, or
+    /// .vtp for FrameFile::surface). png_every: keep every k-th frame (k ≥ 1) for the PNG frames, 0
+    /// for none.
+    MotionRecorder(std::filesystem::path pvd_path, int png_every = 0, FrameFile file = FrameFile::volume);
 
     /// Writes the frame (points: rest positions; point field "displacement" required) to the series;
     /// keeps it for the PNGs when it is one of every png_every. fem::Error for a frame without a
@@ -39,6 +46,7 @@ public:
 private:
     PvdSeries series_;
     int png_every_;
+    FrameFile file_;
     std::size_t added_ = 0;
     std::vector<std::pair<double, MeshData>> kept_;  // frames for the PNGs
 };

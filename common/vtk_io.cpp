@@ -400,6 +400,13 @@ void PvdSeries::add(double time, const MeshData& frame)
     record(time, path);
 }
 
+void PvdSeries::add_surface(double time, const MeshData& frame)
+{
+    const auto path = next_frame_path(".vtp");
+    write_vtp(path, frame);
+    record(time, path);
+}
+
 void PvdSeries::add(double time, const ImageGrid& frame)
 {
     const auto path = next_frame_path(".vti");

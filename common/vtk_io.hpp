@@ -99,6 +99,8 @@ public:
 
     void add(double time, const MeshData& frame);
     void add(double time, const ImageGrid& frame);
+    /// Writes the frame (cells: lines or triangles) as a .vtp surface (write_vtp), e.g. a skin.
+    void add_surface(double time, const MeshData& frame);
 
     std::size_t frames() const { return entries_.size(); }
 

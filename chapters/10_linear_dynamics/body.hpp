@@ -75,6 +75,17 @@ void validate(const Scene& scene);
 /// 11 and 12 swing a softer one. docs/10_linear_dynamics.md#scenes
 Scene cantilever_scene(const Material& material, int cells_along, double duration = 1.0);
 
+/// A body standing on the ground: the mesh as given, every vertex with y ≤ ground pinned, gravity
+/// −y (y up), undamped, Δt = 1/60 s, lasting `duration` [s]. Chapter 10's rubber bunny stands on the
+/// lowest 5 % of its height; chapter 13 stands a coarse and a fine mesh of it on the same ground.
+/// docs/10_linear_dynamics.md#scenes
+Scene standing_scene(TetMesh mesh, const Material& material, double ground, double duration = 1.0);
+
+/// A sideways push growing with height: v_x = top_speed · (y − low)/(high − low) at every vertex
+/// that is not pinned, zero elsewhere (3n, vertex-major): an initial velocity for initial_state.
+/// fem::Error unless high > low.
+Eigen::VectorXd sideways_push(const Scene& scene, double low, double high, double top_speed);
+
 /// The vertex with the largest x + y + z: a box's far top corner (a cantilever's tip).
 int far_corner(const TetMesh& mesh);
 

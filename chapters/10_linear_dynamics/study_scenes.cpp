@@ -60,22 +60,11 @@ void demo_scenes(const RunContext& run, const Settings& settings)
 
     // The bunny (TetGen's tets of data/bunny.obj, y up), scaled to 9.7 cm, its lowest 5 % pinned,
     // pushed sideways with a velocity growing with height (0.5 m/s at the top).
-    Scene bunny;
-    bunny.mesh = io::read_tet_mesh(data_path("bunny_coarse.node"));
-    bunny.mesh.V *= 0.01;
-    const double low = bunny.mesh.V.col(1).minCoeff(), high = bunny.mesh.V.col(1).maxCoeff();
-    for (Eigen::Index v = 0; v < bunny.mesh.V.rows(); ++v)
-        if (bunny.mesh.V(v, 1) <= low + 0.05 * (high - low))
-            bunny.pinned.push_back(static_cast<int>(v));
-    bunny.material = settings.bunny;
-    bunny.gravity = Eigen::Vector3d(0.0, -9.81, 0.0);
-    bunny.time_step = 1.0 / 60.0;
-    bunny.duration = settings.duration;
-    Eigen::VectorXd push = Eigen::VectorXd::Zero(3 * bunny.mesh.V.rows());
-    for (Eigen::Index v = 0; v < bunny.mesh.V.rows(); ++v)
-        push[3 * v] = 0.5 * (bunny.mesh.V(v, 1) - low) / (high - low);
-    for (int v : bunny.pinned)
-        push[3 * v] = 0.0;
+    TetMesh bunny_mesh = io::read_tet_mesh(data_path("bunny_coarse.node"));
+    bunny_mesh.V *= 0.01;
+    const double low = bunny_mesh.V.col(1).minCoeff(), high = bunny_mesh.V.col(1).maxCoeff();
+    const Scene bunny = standing_scene(std::move(bunny_mesh), settings.bunny, low + 0.05 * (high - low), settings.duration);
+    const Eigen::VectorXd push = sideways_push(bunny, low, high, 0.5);
     fig::RenderOptions bunny_view;
     bunny_view.title = "Rubber bunny pinned at its base, pushed sideways";
     bunny_view.field = "von Mises stress";

@@ -6,6 +6,7 @@
 #include "common/vtk_io.hpp"
 
 #include <algorithm>
+#include <utility>
 #include <cmath>
 
 namespace fem::dynamics {
@@ -220,6 +221,32 @@ Scene cantilever_scene(const Material& material, int cells_along, double duratio
     scene.time_step = 1.0 / 60.0;
     scene.duration = duration;
     return scene;
+}
+
+Scene standing_scene(TetMesh mesh, const Material& material, double ground, double duration)
+{
+    Scene scene;
+    scene.mesh = std::move(mesh);
+    scene.material = material;
+    for (Eigen::Index v = 0; v < scene.mesh.V.rows(); ++v)
+        if (scene.mesh.V(v, 1) <= ground)
+            scene.pinned.push_back(static_cast<int>(v));
+    scene.gravity = Eigen::Vector3d(0.0, -9.81, 0.0);
+    scene.time_step = 1.0 / 60.0;
+    scene.duration = duration;
+    return scene;
+}
+
+Eigen::VectorXd sideways_push(const Scene& scene, double low, double high, double top_speed)
+{
+    if (!(high > low))
+        throw Error(str("sideways_push: the top ", high, " must lie above the bottom ", low));
+    Eigen::VectorXd push = Eigen::VectorXd::Zero(3 * scene.mesh.V.rows());
+    for (Eigen::Index v = 0; v < scene.mesh.V.rows(); ++v)
+        push[3 * v] = top_speed * (scene.mesh.V(v, 1) - low) / (high - low);
+    for (int v : scene.pinned)
+        push[3 * v] = 0.0;
+    return push;
 }
 
 int far_corner(const TetMesh& mesh)

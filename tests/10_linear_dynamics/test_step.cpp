@@ -116,6 +116,25 @@ TEST_CASE("scenes: every bad field is refused with its name and what is allowed"
     CHECK_THROWS_WITH(initial_state(body, {}, bad), Contains("non-finite"));
 }
 
+TEST_CASE("a standing scene pins what lies on the ground, the sideways push grows with height", "[ch10]")
+{
+    const fem::TetMesh box = fem::box_mesh(2, 4, 2, Eigen::Vector3d(1.0, 2.0, 1.0));
+    const Scene scene = standing_scene(box, Material{}, 0.5, 0.5);
+    validate(scene);
+    CHECK(scene.gravity == Eigen::Vector3d(0.0, -9.81, 0.0));
+    CHECK(scene.pinned.size() == 2u * 9u);  // the layers y = 0 and y = 0.5, 3 × 3 vertices each
+    for (int v : scene.pinned)
+        CHECK(box.V(v, 1) <= 0.5);
+    const Eigen::VectorXd push = sideways_push(scene, 0.0, 2.0, 0.5);
+    for (Eigen::Index v = 0; v < box.V.rows(); ++v) {
+        const bool pinned = box.V(v, 1) <= 0.5;
+        CHECK(push[3 * v] == Approx(pinned ? 0.0 : 0.25 * box.V(v, 1)).margin(1e-15));
+        CHECK(push[3 * v + 1] == 0.0);
+        CHECK(push[3 * v + 2] == 0.0);
+    }
+    CHECK_THROWS_WITH(sideways_push(scene, 1.0, 1.0, 0.5), Contains("above"));
+}
+
 TEST_CASE("free dofs: gather, scatter, reduce and the kept-dofs projection agree with chapter 06's P", "[ch10]")
 {
     const Scene scene = cantilever_scene(3, 1);

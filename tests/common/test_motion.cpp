@@ -68,3 +68,23 @@ TEST_CASE("motion recorder: a frame without displacement is refused and nothing 
     CHECK_FALSE(std::filesystem::exists(dir / "bad.pvd"));
     CHECK_THROWS_AS(fem::io::MotionRecorder(dir / "x.pvd", -1), fem::Error);
 }
+
+TEST_CASE("motion recorder: a surface series writes .vtp frames, a tet frame is refused by the .vtp writer",
+          "[common][vtk]")
+{
+    const auto dir = fem::test::fresh_output_dir("motion_surface");
+    fem::io::MotionRecorder recorder(dir / "skin.pvd", 0, fem::io::FrameFile::surface);
+    fem::MatrixX3d rest(3, 3);
+    rest << 0, 0, 0, 1, 0, 0, 0, 1, 0;
+    fem::MatrixXiR triangle(1, 3);
+    triangle << 0, 1, 2;
+    fem::MatrixX3d u = fem::MatrixX3d::Zero(3, 3);
+    u(2, 2) = 0.25;
+    recorder.add(0.0, fem::io::displaced_mesh(rest, triangle, u));
+    const auto entries = fem::io::read_pvd(dir / "skin.pvd");
+    REQUIRE(entries.size() == 1);
+    CHECK(std::filesystem::path(entries[0].second).extension() == ".vtp");
+    CHECK(std::filesystem::is_regular_file(dir / entries[0].second));
+    CHECK_THROWS_AS(recorder.add(1.0, moving_tet(1.0)), fem::Error);  // tets are no surface
+    CHECK(fem::io::read_pvd(dir / "skin.pvd").size() == 1);
+}

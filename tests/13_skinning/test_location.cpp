@@ -1,0 +1,231 @@
+// Chapter 13: barycentric weights and the three point-location methods, against chapter 04's
+// shape functions and against each other on every vertex of the bunny and on points exactly on
+// vertices, edges and faces and just outside. docs/13_skinning.md
+#include "13_skinning/skinning.hpp"
+
+#include "04_tet_jacobians/tet_jacobians.hpp"
+
+#include "common/error.hpp"
+#include "common/files.hpp"
+#include "common/mesh_io.hpp"
+#include "common/random.hpp"
+
+#include "../common/test_support.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <Eigen/Geometry>
+
+#include <vector>
+
+using namespace fem;
+using namespace fem::skin;
+using fem::test::EntriesNear;
+using fem::test::entries_of;
+
+namespace {
+
+TetMesh bunny_tets() { return io::read_tet_mesh(data_path("bunny_coarse.node")); }
+TriMesh bunny() { return io::read_tri_mesh(data_path("bunny.obj")); }
+
+/// Points exactly on the mesh's vertices, on the midpoints of the edges and the centroids of the
+/// faces of every k-th tet, and the tets' centroids.
+std::vector<Eigen::Vector3d> special_points(const TetMesh& mesh, int every)
+{
+    std::vector<Eigen::Vector3d> points;
+    for (Eigen::Index v = 0; v < mesh.V.rows(); v += every)
+        points.push_back(mesh.V.row(v).transpose());
+    for (Eigen::Index t = 0; t < mesh.T.rows(); t += every) {
+        const tet::TetVertices X = tet::tet_vertices(mesh, mesh.V, static_cast<int>(t));
+        for (int i = 0; i < 4; ++i)
+            for (int j = i + 1; j < 4; ++j) {
+                points.push_back(0.5 * (X.row(i) + X.row(j)).transpose());
+                for (int k = j + 1; k < 4; ++k)
+                    points.push_back((X.row(i) + X.row(j) + X.row(k)).transpose() / 3.0);
+            }
+        points.push_back(X.colwise().mean().transpose());
+    }
+    return points;
+}
+
+/// Checks that every point is found by the locator in the same tet as by brute force, and that
+/// the tet holds it: weights ≥ −tolerance that reproduce the point.
+void check_against_brute_force(const BarycentricFrames& frames, const PointLocator& locator,
+                               const std::vector<Eigen::Vector3d>& points, double tolerance)
+{
+    int differ = 0, wrong = 0, missing = 0;
+    for (const Eigen::Vector3d& p : points) {
+        const Location reference = locate_brute_force(frames, p, tolerance);
+        const Location found = locator.locate(p);
+        missing += found.tet < 0;
+        differ += found.tet != reference.tet;
+        if (found.tet >= 0) {
+            const tet::TetVertices X = tet::tet_vertices(frames.mesh(), frames.mesh().V, found.tet);
+            wrong += !(found.phi.minCoeff() >= -tolerance) || (X.transpose() * found.phi - p).norm() > 1e-12 * (1.0 + p.norm());
+        }
+    }
+    INFO(points.size() << " points, method " << method_name(locator.method()));
+    CHECK(missing == 0);
+    CHECK(differ == 0);
+    CHECK(wrong == 0);
+}
+
+}  // namespace
+
+TEST_CASE("barycentric weights: chapter 04's shape functions, summing to 1, reproducing the point", "[ex13.1]")
+{
+    const TetMesh mesh = bunny_tets();
+    const BarycentricFrames frames(mesh);
+    for (int t = 0; t < mesh.T.rows(); t += 97) {
+        const tet::TetVertices X = tet::tet_vertices(mesh, mesh.V, t);
+        for (unsigned seed = 1; seed <= 3; ++seed) {
+            const Eigen::Vector3d p = X.colwise().mean().transpose() + 3.0 * Eigen::Vector3d(random_vector(3, seed + t));
+            const Eigen::Vector4d phi = frames.weights(t, p);
+            CHECK_THAT(entries_of(phi), EntriesNear(tet::shape_functions(X, p), 1e-11));
+            CHECK(phi.sum() == Approx(1.0).margin(1e-13));
+            CHECK_THAT(entries_of(Eigen::Vector3d(X.transpose() * phi)), EntriesNear(p, 1e-11));
+        }
+        for (int i = 0; i < 4; ++i)  // corner i has φ = e_i
+            CHECK_THAT(entries_of(frames.weights(t, X.row(i).transpose())),
+                       EntriesNear(Eigen::Vector4d::Unit(i), 1e-12));
+    }
+}
+
+namespace {
+
+/// Every vertex of the bunny and the special points of TetGen's tets: the brute force's tet.
+void check_on_bunny(const BarycentricFrames& frames, const PointLocator& locator, double tolerance)
+{
+    const TriMesh surface = bunny();
+    std::vector<Eigen::Vector3d> points;
+    for (Eigen::Index v = 0; v < surface.V.rows(); ++v)
+        points.push_back(surface.V.row(v).transpose());
+    check_against_brute_force(frames, locator, points, tolerance);
+    check_against_brute_force(frames, locator, special_points(frames.mesh(), 29), tolerance);
+}
+
+}  // namespace
+
+TEST_CASE("point location by a uniform grid: the brute force's tet for the bunny and for points on vertices, edges, faces",
+          "[ex13.2]")
+{
+    const BarycentricFrames frames(bunny_tets());
+    const UniformGrid grid(frames, 1e-9);
+    check_on_bunny(frames, grid, 1e-9);
+    CHECK(grid.mean_tets_per_cell() > 0.0);
+}
+
+TEST_CASE("point location by an AABB tree: the brute force's tet for the bunny and for points on vertices, edges, faces",
+          "[ex13.3]")
+{
+    const BarycentricFrames frames(bunny_tets());
+    const AabbTree tree(frames, 1e-9);
+    check_on_bunny(frames, tree, 1e-9);
+    CHECK(tree.depth() <= 20);
+}
+
+namespace {
+
+/// Points just outside boundary faces (on the outward normal through the face centroid) at
+/// `fraction` of the height of the face's tet over it: with tolerance τ, inside for fraction < τ.
+std::vector<Eigen::Vector3d> beyond_faces(const TetMesh& mesh, double fraction)
+{
+    const Boundary boundary = boundary_faces(mesh);
+    std::vector<Eigen::Vector3d> points;
+    for (Eigen::Index f = 0; f < boundary.faces.rows(); f += 11) {
+        const Eigen::Vector3d a = mesh.V.row(boundary.faces(f, 0)), b = mesh.V.row(boundary.faces(f, 1)),
+                              c = mesh.V.row(boundary.faces(f, 2));
+        const Eigen::Vector3d normal = (b - a).cross(c - a).normalized();
+        const int t = boundary.tet[f];
+        const double height = std::abs(6.0 * tet::signed_volume(tet::tet_vertices(mesh, mesh.V, t))) / (b - a).cross(c - a).norm();
+        points.push_back((a + b + c) / 3.0 + fraction * height * normal);
+    }
+    return points;
+}
+
+}  // namespace
+
+namespace {
+
+/// Beyond the tolerance the locator finds no tet (nor does brute force); within it, the face's tet.
+void check_just_outside(const BarycentricFrames& frames, const PointLocator& locator, double tolerance)
+{
+    for (const Eigen::Vector3d& p : beyond_faces(frames.mesh(), 3.0 * tolerance)) {
+        CHECK(locate_brute_force(frames, p, tolerance).tet == -1);
+        CHECK(locator.locate(p).tet == -1);
+    }
+    check_against_brute_force(frames, locator, beyond_faces(frames.mesh(), 0.25 * tolerance), tolerance);
+}
+
+}  // namespace
+
+TEST_CASE("points just outside, by the grid: none beyond the tolerance, the face's tet within it", "[ex13.2]")
+{
+    const BarycentricFrames frames(bunny_tets());
+    check_just_outside(frames, UniformGrid(frames, 1e-3), 1e-3);
+}
+
+TEST_CASE("points just outside, by the tree: none beyond the tolerance, the face's tet within it", "[ex13.3]")
+{
+    const BarycentricFrames frames(bunny_tets());
+    check_just_outside(frames, AabbTree(frames, 1e-3), 1e-3);
+}
+
+TEST_CASE("the coarse lattice encloses the bunny: every vertex inside, brute force and chapter 04 agree", "[ex13.1]")
+{
+    const TriMesh surface = bunny();
+    const TetMesh lattice = enclosing_lattice(surface, 6);
+    const BarycentricFrames frames(lattice, "lattice");
+    for (Eigen::Index v = 0; v < surface.V.rows(); ++v)
+        REQUIRE(locate_brute_force(frames, surface.V.row(v).transpose(), 0.0).tet >= 0);
+    // Every point of every triangle lies in a kept cube: so do the vertices of the refined surface.
+    const TriMesh refined = midpoint_subdivision(surface, 2);
+    int outside = 0;
+    for (Eigen::Index v = surface.V.rows(); v < refined.V.rows(); ++v)
+        outside += locate_brute_force(frames, refined.V.row(v).transpose(), 0.0).tet < 0;
+    CHECK(outside == 0);
+    for (Eigen::Index v = 0; v < surface.V.rows(); v += 50) {
+        const Eigen::Vector3d p = surface.V.row(v).transpose();
+        const tet::PointLocation chapter04 = tet::locate_point(lattice, p, 1e-9);
+        CHECK(chapter04.inside);
+        CHECK(chapter04.tet == locate_brute_force(frames, p, 1e-9).tet);
+    }
+}
+
+TEST_CASE("the lattice and the subdivided surface: the shapes the docs promise", "[ch13]")
+{
+    const TriMesh surface = bunny();
+    const TetMesh lattice = enclosing_lattice(surface, 6);
+    CHECK(total_volume(lattice) > 0.0);
+    CHECK(lattice.T.rows() % 6 == 0);
+    // The lattice holds the surface's box.
+    for (int c = 0; c < 3; ++c) {
+        CHECK(lattice.V.col(c).minCoeff() <= surface.V.col(c).minCoeff());
+        CHECK(lattice.V.col(c).maxCoeff() >= surface.V.col(c).maxCoeff());
+    }
+    // The winding number is 1 at the bunny's centre of mass region and 0 far away.
+    CHECK(winding_number(surface, Eigen::Vector3d(100.0, 0.0, 0.0)) == Approx(0.0).margin(1e-9));
+    CHECK(winding_number(surface, surface.V.colwise().mean().transpose()) == Approx(1.0).margin(1e-9));
+    // Midpoint subdivision: V + E vertices (E = 3F/2 on a closed surface), 4F triangles, the same area.
+    const TriMesh refined = midpoint_subdivision(surface, 1);
+    CHECK(refined.F.rows() == 4 * surface.F.rows());
+    CHECK(refined.V.rows() == surface.V.rows() + 3 * surface.F.rows() / 2);
+    const auto area = [](const TriMesh& m) {
+        double a = 0.0;
+        for (Eigen::Index f = 0; f < m.F.rows(); ++f)
+            a += 0.5 * (m.V.row(m.F(f, 1)) - m.V.row(m.F(f, 0))).cross(m.V.row(m.F(f, 2)) - m.V.row(m.F(f, 0))).norm();
+        return a;
+    };
+    CHECK(area(refined) == Approx(area(surface)).epsilon(1e-12));
+}
+
+TEST_CASE("bad locator options: a tolerance outside 0 to 0.5 is refused", "[ch13]")
+{
+    const TetMesh mesh = box_mesh(1, 1, 1);
+    const BarycentricFrames frames(mesh);
+    CHECK_THROWS_AS(UniformGrid(frames, -1e-3), Error);
+    CHECK_THROWS_AS(AabbTree(frames, 0.5), Error);
+    CHECK_THROWS_AS(BruteForce(frames, std::nan("")), Error);
+    CHECK_THROWS_AS(AabbTree(frames, 1e-9, 0), Error);
+    CHECK_THROWS_WITH(parse_method("octree"), Catch::Matchers::Contains("brute-force, grid or tree"));
+}
