@@ -121,7 +121,7 @@ struct OutputSpec {
     Eigen::Vector3d view_direction{0.3, 1.0, -0.3};   ///< the camera looks along this
     Eigen::Vector3d view_up{0.0, 0.0, 1.0};
     double warp = 1.0;                  ///< displacement scale of the PNGs
-    int width = 800, height = 600;      ///< PNG size [pixels]
+    int width = 900, height = 700;      ///< PNG size [pixels]
 };
 
 /// An optional fine surface carried by the tets (chapter 13). docs/scenes.md#skin
