@@ -41,12 +41,41 @@ std::string joined(const std::vector<std::string>& names)
     return out;
 }
 
+/// Where the fields being read come from: the scene file, and the overrides that replaced some of
+/// them (the field path as given, e.g. "body.material.model", and the option that set it).
+struct Source {
+    std::string file;
+    std::vector<std::pair<std::string, std::string>> overrides;
+
+    /// The option that set a field (e.g. "--set body.0.material.poisson_ratio=0.5"), matched on the
+    /// path without array indices; empty when none did.
+    std::string override_of(const std::string& field) const
+    {
+        const auto plain = [](std::string path) {
+            std::string out;
+            std::string part;
+            std::replace(path.begin(), path.end(), '[', '.');
+            path.erase(std::remove(path.begin(), path.end(), ']'), path.end());
+            std::istringstream in(path);
+            while (std::getline(in, part, '.'))
+                if (!part.empty() && !std::all_of(part.begin(), part.end(), ::isdigit))
+                    out += (out.empty() ? "" : ".") + part;
+            return out;
+        };
+        std::string found;
+        for (const auto& [key, option] : overrides)
+            if (plain(key) == plain(field))
+                found = option;  // the last one set it
+        return found;
+    }
+};
+
 /// One table of the scene file being read: its dotted name (body[0].material), the file it came
 /// from, and the check that it holds only the allowed fields (no check when none are given).
 class Fields {
 public:
-    Fields(const toml::table& table, std::string name, const std::string& file, std::vector<std::string> allowed)
-        : table_(table), name_(std::move(name)), file_(file)
+    Fields(const toml::table& table, std::string name, const Source& source, std::vector<std::string> allowed)
+        : table_(table), name_(std::move(name)), source_(source), file_(source.file)
     {
         for (auto&& [key, node] : table_) {
             if (!allowed.empty() && std::find(allowed.begin(), allowed.end(), key.str()) == allowed.end())
@@ -54,21 +83,21 @@ public:
         }
     }
 
-    /// "file:line:column" of a node, or the --set option it came from.
-    std::string where(const toml::node& node) const
+    /// "file:line:column" of a node; for a node an override put there, "file: <the option>".
+    std::string where(const toml::node& node, const std::string& key = "") const
     {
         const toml::source_region& source = node.source();
-        if (source.path && *source.path != file_)
-            return *source.path;
-        if (source.begin.line == 0)
-            return file_;
+        if (source.begin.line == 0) {
+            const std::string option = source_.override_of(field(key));
+            return option.empty() ? file_ : str(file_, ": ", option);
+        }
         return str(file_, ":", source.begin.line, ":", source.begin.column);
     }
     std::string field(const std::string& key) const { return name_.empty() ? key : name_ + "." + key; }
 
     [[noreturn]] void fail(const toml::node& node, const std::string& key, const std::string& message) const
     {
-        throw Error(str(where(node), ": ", field(key), ": ", message));
+        throw Error(str(where(node, key), ": ", field(key), ": ", message));
     }
     [[noreturn]] void missing(const std::string& key, const std::string& message) const
     {
@@ -79,7 +108,7 @@ public:
     bool has(const std::string& key) const { return get(key) != nullptr; }
     const toml::table& table() const { return table_; }
     const std::string& name() const { return name_; }
-    const std::string& file() const { return file_; }
+    const Source& source() const { return source_; }
 
     /// A number (an integer is taken as a real) that must satisfy ok, whose failure says allowed.
     template <typename Check>
@@ -233,6 +262,7 @@ public:
 private:
     const toml::table& table_;
     std::string name_;
+    const Source& source_;
     const std::string& file_;
 };
 
@@ -282,14 +312,14 @@ Selector read_selector(const Fields& fields)
         s.kind = Selector::Kind::box;
         const toml::array& corners = fields.array("box", 2, "two corners [[x0, y0, z0], [x1, y1, z1]]");
         const toml::table corner_table{{"low", *corners.get(0)}, {"high", *corners.get(1)}};
-        const Fields corner(corner_table, fields.field("box"), fields.file(), {"low", "high"});
+        const Fields corner(corner_table, fields.field("box"), fields.source(), {"low", "high"});
         s.low = corner.vector("low", Eigen::Vector3d::Zero());
         s.high = corner.vector("high", Eigen::Vector3d::Zero());
         if ((s.low.array() > s.high.array()).any())
             fields.fail(*fields.get("box"), "box", "the first corner must be below the second in x, y and z");
     } else if (fields.has("plane")) {
         s.kind = Selector::Kind::plane;
-        const Fields plane(*fields.subtable("plane"), fields.field("plane"), fields.file(), {"point", "normal", "side"});
+        const Fields plane(*fields.subtable("plane"), fields.field("plane"), fields.source(), {"point", "normal", "side"});
         s.point = plane.vector("point", Eigen::Vector3d::Zero());
         s.normal = plane.vector("normal", Eigen::Vector3d::UnitX(), true).normalized();
         s.below = plane.text("side", "on", {"on", "below"}) == "below";
@@ -411,7 +441,7 @@ TetMesh build_mesh(const Fields& fields, const std::filesystem::path& scene_file
     return mesh;
 }
 
-BodySpec read_body(const toml::table& table, const std::string& name, const std::string& file,
+BodySpec read_body(const toml::table& table, const std::string& name, const Source& file,
                    const std::filesystem::path& scene_file, double duration, int index)
 {
     const Fields fields(table, name, file,
@@ -606,29 +636,35 @@ SceneSpec read_scene(const std::filesystem::path& path, const std::vector<std::s
         throw Error(str(file, ":", e.source().begin.line, ":", e.source().begin.column, ": TOML syntax error: ",
                         e.description()));
     }
+    Source source{file, {}};
     if (quick) {
         if (const toml::node* node = root.get("quick")) {
             if (!node->is_table())
-                Fields(root, "", file, {}).fail(*node, "quick", "must be a table of overrides (field = value)");
+                Fields(root, "", source, {}).fail(*node, "quick", "must be a table of overrides (field = value)");
             std::vector<std::pair<std::string, const toml::node*>> leaves;
             flatten(*node->as_table(), "", leaves);
             toml::table copy = root;
-            for (const auto& [key, value] : leaves)
-                assign(copy, split_path(key), 0, *value, str(Fields(root, "", file, {}).where(*value), ": quick.", key));
+            for (const auto& [key, value] : leaves) {
+                const std::string option = str("[quick] ", key, " (line ", value->source().begin.line, ")");
+                assign(copy, split_path(key), 0, *value, str(file, ": ", option));
+                source.overrides.emplace_back(key, option);
+            }
             root = std::move(copy);
         }
     }
-    for (const std::string& setting : overrides)
+    for (const std::string& setting : overrides) {
         apply_override(root, setting, "--set " + setting);
+        source.overrides.emplace_back(setting.substr(0, setting.find('=')), "--set " + setting);
+    }
 
-    const Fields top(root, "", file, {"title", "gravity", "body", "time", "solver", "auto", "output", "skin", "quick"});
+    const Fields top(root, "", source, {"title", "gravity", "body", "time", "solver", "auto", "output", "skin", "quick"});
     SceneSpec scene;
     scene.file = path;
     scene.title = top.text("title", path.stem().string());
     scene.gravity = top.vector("gravity", scene.gravity);
 
     if (const toml::table* time_table = top.subtable("time")) {
-        const Fields time(*time_table, "time", file, {"step", "duration", "integrator"});
+        const Fields time(*time_table, "time", source, {"step", "duration", "integrator"});
         scene.time_step = time_step_field(time, "step", scene.time_step);
         scene.duration = time.number("duration", scene.duration, [](double d) { return d > 0.0 && d <= 3600.0; },
                                      "a number in (0, 3600] (seconds)");
@@ -640,13 +676,13 @@ SceneSpec read_scene(const std::filesystem::path& path, const std::vector<std::s
         }
     }
     if (const toml::table* solver_table = top.subtable("solver")) {
-        const Fields solver(*solver_table, "solver", file, {"name", "newton_tolerance"});
+        const Fields solver(*solver_table, "solver", source, {"name", "newton_tolerance"});
         scene.solver = solver.text("name", scene.solver);
         scene.newton_tolerance = solver.number("newton_tolerance", scene.newton_tolerance,
                                                [](double t) { return t > 0.0 && t < 1.0; }, "a number in (0, 1)");
     }
     if (const toml::table* auto_table = top.subtable("auto")) {
-        const Fields a(*auto_table, "auto", file, {"rotation", "strain", "volume_ratio", "hysteresis", "hyperelastic"});
+        const Fields a(*auto_table, "auto", source, {"rotation", "strain", "volume_ratio", "hysteresis", "hyperelastic"});
         const double degrees = std::acos(-1.0) / 180.0;
         scene.thresholds.rotation =
             a.number("rotation", scene.thresholds.rotation / degrees, [](double x) { return x > 0.0 && x < 90.0; },
@@ -661,7 +697,7 @@ SceneSpec read_scene(const std::filesystem::path& path, const std::vector<std::s
             a.text("hyperelastic", scene.thresholds.hyperelastic, {"stvk", "neo-hookean", "stable-neo-hookean"});
     }
     if (const toml::table* output_table = top.subtable("output")) {
-        const Fields o(*output_table, "output", file,
+        const Fields o(*output_table, "output", source,
                        {"frame_rate", "pvd", "png", "video", "csv", "fields", "colour", "view_direction", "view_up",
                         "warp", "width", "height"});
         OutputSpec& out = scene.output;
@@ -695,13 +731,13 @@ SceneSpec read_scene(const std::filesystem::path& path, const std::vector<std::s
     for (std::size_t i = 0; i < items.size(); ++i) {
         const std::string name = str("body[", i, "]");
         scene.bodies.push_back(
-            read_body(table_in_array(top, *items.get(i), "body"), name, file, path, scene.duration, static_cast<int>(i)));
+            read_body(table_in_array(top, *items.get(i), "body"), name, source, path, scene.duration, static_cast<int>(i)));
         if (!names.insert(scene.bodies.back().name).second)
             top.fail(*items.get(i), name + ".name", str("'", scene.bodies.back().name, "' is the name of an earlier body"));
     }
 
     if (const toml::table* skin_table = top.subtable("skin")) {
-        const Fields s(*skin_table, "skin", file, {"file", "body"});
+        const Fields s(*skin_table, "skin", source, {"file", "body"});
         SkinSpec skin;
         if (!s.has("file"))
             s.missing("file", "the fine surface (.obj, .stl, .ply) the tets carry");
@@ -844,15 +880,24 @@ TetMesh tetrahedralize(const TriMesh& surface, const std::string& switches, cons
     const int status = ::pclose(pipe);
     const std::filesystem::path node = folder / "surface.1.node";
     if (status != 0 || !std::filesystem::exists(node)) {
-        std::string reason;
+        // TetGen's own words: its error or failed assertion if it printed one, else its last line.
+        std::string reason, last;
         std::istringstream lines(output);
-        for (std::string line; std::getline(lines, line);)
+        for (std::string line; std::getline(lines, line);) {
             if (!line.empty())
+                last = line;
+            const std::size_t assertion = line.find("Assertion");
+            if (reason.empty() && assertion != std::string::npos)
+                reason = line.substr(assertion);
+            else if (reason.empty() && line.find("rror") != std::string::npos)
                 reason = line;
+        }
+        if (reason.empty())
+            reason = last;
         if (WIFEXITED(status) && WEXITSTATUS(status) == 127)
             reason = "the tetgen program is not installed (tools/setup.sh installs it)";
-        throw Error(str(what, ": TetGen could not tetrahedralise the surface (is it closed and free of ",
-                        "self-intersections?): ", reason.empty() ? "no output" : reason));
+        throw Error(str(what, ": TetGen could not tetrahedralise the surface (does it enclose a volume, closed and ",
+                        "free of self-intersections?): ", reason.empty() ? "no output" : reason));
     }
     return io::read_tet_mesh(node);
 }

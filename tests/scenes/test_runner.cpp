@@ -1,0 +1,222 @@
+// The runner: loads and prescribed motion against closed forms, determinism, an interrupted run,
+// and bad scene files refused by fem_scene before it writes anything. docs/scenes.md#the-runner
+#include "scenes/runner.hpp"
+
+#include "06_assembly/assembly.hpp"
+
+#include "common/error.hpp"
+#include "common/vtk_io.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+#include <sys/wait.h>
+#include <unistd.h>
+
+using namespace fem;
+using namespace fem::scenes;
+
+namespace {
+
+const std::filesystem::path gallery = FEM_SCENES_DIR;
+const std::filesystem::path output = FEM_TEST_OUTPUT_DIR;
+
+/// A scene from its text, written into the tests' output folder first.
+SceneSpec scene_from(const std::string& name, const std::string& text)
+{
+    std::filesystem::create_directories(output);
+    const std::filesystem::path file = output / (name + ".toml");
+    std::ofstream(file) << text;
+    return read_scene(file);
+}
+
+RunResult positions_of(const SceneSpec& scene, const std::string& model = "")
+{
+    RunOptions options;
+    options.model = model;
+    options.keep_positions = true;
+    options.print_models = false;
+    return run_scene(scene, options);
+}
+
+/// A free 0.1 m cube (no pin, no gravity) pushed by one load for 0.2 s at Δt = 0.02 s.
+std::string pushed_cube(const std::string& model, const std::string& load)
+{
+    return "gravity = [0.0, 0.0, 0.0]\n[[body]]\n"
+           "mesh = { generator = \"box\", size = [0.1, 0.1, 0.1], cells = [2, 2, 2] }\n"
+           "material = { model = \"" + model + "\", youngs_modulus = 1e5, poisson_ratio = 0.3, density = 500.0 }\n"
+           "[[body.load]]\n" + load + "\n"
+           "[time]\nstep = 0.02\nduration = 0.2\n";
+}
+
+std::string read_text(const std::filesystem::path& path)
+{
+    std::ifstream file(path, std::ios::binary);
+    std::ostringstream text;
+    text << file.rdbuf();
+    return text.str();
+}
+
+}  // namespace
+
+TEST_CASE("a point or surface load moves the centre of mass as F t^2 / 2m does under backward Euler", "[scenes]")
+{
+    // Internal forces sum to zero, so backward Euler gives the total momentum Σ m v = F t_k exactly
+    // and the centre of mass Σ m u / m = Δt² F/m · n(n+1)/2 after n steps.
+    struct Case {
+        std::string model, load;
+        Eigen::Vector3d total;  // the load's total force [N]
+    };
+    const std::vector<Case> cases{
+        {"linear", "type = \"point\"\nvertices = [0]\nforce = [0.0, 0.0, 3.0]", {0.0, 0.0, 3.0}},
+        {"corotational", "type = \"point\"\nvertices = [0, 26]\nforce = [1.0, -2.0, 0.5]", {1.0, -2.0, 0.5}},
+        // 100 Pa on the 0.1 × 0.1 face x = 0.1: 1 N along x.
+        {"linear", "type = \"surface\"\nplane = { point = [0.1, 0.0, 0.0], normal = [1.0, 0.0, 0.0] }\n"
+                   "traction = [100.0, 0.0, 0.0]", {1.0, 0.0, 0.0}},
+    };
+    for (const Case& c : cases) {
+        INFO(c.model << " " << c.load);
+        const SceneSpec scene = scene_from("pushed_cube", pushed_cube(c.model, c.load));
+        const RunResult run = positions_of(scene);
+        const TetMesh& mesh = scene.bodies[0].mesh;
+        const Eigen::VectorXd m = assembly::vertex_masses(mesh, scene.bodies[0].material.density);
+        const MatrixX3d u = run.frames[0].back() - mesh.V;
+        const Eigen::Vector3d weighted = (u.array().colwise() * m.array()).colwise().sum().transpose();
+        const int n = run.steps;
+        REQUIRE(n == 10);
+        const Eigen::Vector3d expected = 0.02 * 0.02 * c.total * (n * (n + 1) / 2.0);
+        CHECK((weighted - expected).norm() < 1e-12 * expected.norm());
+    }
+}
+
+TEST_CASE("the twisted bar's moving end is where a half turn puts it, and the bar follows", "[scenes]")
+{
+    const SceneSpec scene = read_scene(gallery / "twisted_bar.toml", {"body.material.model=corotational"}, true);
+    const BodySpec& bar = scene.bodies[0];
+    const RunResult run = positions_of(scene);
+    // [quick] ends the turn at 0.25 s = the last frame: a half turn about the axis y = z = 0.
+    const MatrixX3d& x = run.frames[0].back();
+    int moved = 0;
+    for (Eigen::Index v = 0; v < bar.mesh.V.rows(); ++v) {
+        if (std::abs(bar.mesh.V(v, 0) - 0.2) > 1e-12)
+            continue;
+        ++moved;
+        const Eigen::RowVector3d turned(bar.mesh.V(v, 0), -bar.mesh.V(v, 1), -bar.mesh.V(v, 2));
+        CHECK((x.row(v) - turned).norm() < 1e-15);
+    }
+    CHECK(moved == 9);
+    // The free middle of the bar turned by about a quarter turn with it (the bar twists evenly).
+    const Eigen::Index middle = [&] {
+        for (Eigen::Index v = 0; v < bar.mesh.V.rows(); ++v)
+            if (std::abs(bar.mesh.V(v, 0) - 0.1) < 1e-12 && std::abs(bar.mesh.V(v, 1) - 0.02) < 1e-12 &&
+                std::abs(bar.mesh.V(v, 2) - 0.02) < 1e-12)
+                return v;
+        return Eigen::Index(-1);
+    }();
+    REQUIRE(middle >= 0);
+    const double angle = std::atan2(x(middle, 2), x(middle, 1)) - std::atan2(0.02, 0.02);
+    CHECK(angle > 0.3 * std::acos(-1.0));
+    CHECK(angle < 0.7 * std::acos(-1.0));
+}
+
+TEST_CASE("determinism: the same scene twice gives the same numbers to the last bit", "[scenes]")
+{
+    const SceneSpec scene = read_scene(gallery / "stiff_soft_pair.toml", {}, true);
+    const RunResult first = positions_of(scene), second = positions_of(scene);
+    REQUIRE(first.frames.size() == 2);
+    for (std::size_t b = 0; b < 2; ++b)
+        for (std::size_t f = 0; f < first.frames[b].size(); ++f)
+            CHECK((first.frames[b][f].array() == second.frames[b][f].array()).all());
+}
+
+TEST_CASE("determinism: fem_scene with 1 and 2 threads writes identical frames and energies", "[scenes]")
+{
+    const std::filesystem::path base = output / "threads";
+    std::filesystem::remove_all(base);
+    for (int threads : {1, 2}) {
+        const std::string command = "OMP_NUM_THREADS=" + std::to_string(threads) + " '" FEM_SCENE_EXE "' '" +
+                                    (gallery / "stiff_soft_pair.toml").string() + "' --quick --no-figures --out '" +
+                                    (base / std::to_string(threads)).string() + "' >/dev/null 2>&1";
+        REQUIRE(std::system(command.c_str()) == 0);
+    }
+    int frames = 0;
+    for (const auto& entry : std::filesystem::recursive_directory_iterator(base / "1")) {
+        if (entry.path().extension() != ".vtu" && entry.path().extension() != ".pvd")
+            continue;
+        ++frames;
+        const std::filesystem::path twin = base / "2" / std::filesystem::relative(entry.path(), base / "1");
+        CHECK(read_text(entry.path()) == read_text(twin));
+    }
+    CHECK(frames > 2);
+    // steps.csv: every column but the measured step time.
+    const auto without_time = [](const std::filesystem::path& path) {
+        std::istringstream lines(read_text(path));
+        std::string kept;
+        for (std::string line; std::getline(lines, line);)
+            kept += line.substr(0, line.rfind(',')) + '\n';
+        return kept;
+    };
+    CHECK(without_time(base / "1" / "steps.csv") == without_time(base / "2" / "steps.csv"));
+}
+
+TEST_CASE("an interrupted run (SIGINT) leaves a valid .pvd of the frames written so far", "[scenes]")
+{
+    const std::filesystem::path out = output / "interrupted";
+    std::filesystem::remove_all(out);
+    const std::string scene = (gallery / "cantilever.toml").string();
+    const pid_t child = ::fork();
+    REQUIRE(child >= 0);
+    if (child == 0) {
+        std::freopen("/dev/null", "w", stdout);
+        std::freopen("/dev/null", "w", stderr);
+        ::execl(FEM_SCENE_EXE, FEM_SCENE_EXE, scene.c_str(), "--no-figures", "--set", "time.duration=600",
+                "--set", "body.material.model=stable-neo-hookean", "--out", out.c_str(), static_cast<char*>(nullptr));
+        std::_Exit(127);
+    }
+    // Wait until the run is stepping: its first frames are in the staging folder.
+    bool stepping = false;
+    for (int poll = 0; poll < 600 && !stepping; ++poll) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        std::error_code ignored;
+        for (const auto& entry : std::filesystem::directory_iterator(out, ignored))
+            stepping = stepping || std::filesystem::exists(entry.path() / "cantilever" / "cantilever_0002.vtu");
+    }
+    REQUIRE(stepping);
+    ::kill(child, SIGINT);
+    int status = 0;
+    ::waitpid(child, &status, 0);
+    REQUIRE(WIFEXITED(status));
+    CHECK(WEXITSTATUS(status) == 130);
+    const auto frames = io::read_pvd(out / "cantilever.pvd");
+    CHECK(frames.size() >= 3);
+    CHECK(frames.size() < 600 * 30);
+    for (const auto& [time, file] : frames)
+        CHECK(io::read_vtu(out / file).points.rows() > 0);
+    CHECK(std::filesystem::exists(out / "steps.csv"));
+}
+
+TEST_CASE("fem_scene refuses bad scene files with one error line and writes nothing", "[scenes]")
+{
+    const std::filesystem::path bad = FEM_SCENE_BAD_DIR;
+    for (const std::string file : {"missing.toml", "syntax.toml", "unknown_field.toml", "wrong_type.toml", "nu_half.toml",
+                                   "dt_zero.toml", "no_tets.toml", "pins_nothing.toml", "tetgen_fails.toml", "skin.toml"}) {
+        INFO(file);
+        const std::filesystem::path out = output / "refused";
+        std::filesystem::remove_all(out);
+        const std::filesystem::path log = output / "refused.log";
+        const std::string command = "'" FEM_SCENE_EXE "' '" + (bad / file).string() + "' --out '" + out.string() +
+                                    "' >'" + log.string() + "' 2>&1";
+        const int status = std::system(command.c_str());
+        CHECK(WEXITSTATUS(status) == 1);
+        CHECK(!std::filesystem::exists(out));
+        const std::string printed = read_text(log);
+        CHECK(printed.rfind("error: ", 0) == 0);
+        if (file == "skin.toml")
+            CHECK(printed.find("skin needs chapter 13") != std::string::npos);
+    }
+}
