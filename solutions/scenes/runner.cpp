@@ -516,8 +516,9 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
     if (result.interrupted)
         std::cout << "interrupted after step " << result.steps << ": " << result.frame_count
                   << " frames written, the .pvd lists them; no PNGs or video\n";
-    if (scene.output.csv) {
+    if (scene.output.csv)
         history.write_csv(run->file("steps.csv"));
+    if (scene.output.charts) {
         const auto chart = [&](const std::string& what, const std::string& y_label) {
             fig::LineChart c;
             c.title = str(scene.title, ": ", what);
@@ -526,7 +527,7 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
             return c;
         };
         fig::LineChart energies = chart("energies", "energy (J)");
-        fig::LineChart cost = chart("wall time per step", "time per step (ms)");
+        fig::LineChart cost = chart("wall time per step", "time per step [ms]");
         fig::LineChart newton = chart("Newton iterations per step", "iterations");
         bool any_newton = false;
         for (std::size_t i = 0; i < bodies.size(); ++i) {

@@ -698,7 +698,7 @@ SceneSpec read_scene(const std::filesystem::path& path, const std::vector<std::s
     }
     if (const toml::table* output_table = top.subtable("output")) {
         const Fields o(*output_table, "output", source,
-                       {"frame_rate", "pvd", "png", "video", "csv", "fields", "colour", "view_direction", "view_up",
+                       {"frame_rate", "pvd", "png", "video", "csv", "charts", "fields", "colour", "view_direction", "view_up",
                         "warp", "width", "height"});
         OutputSpec& out = scene.output;
         out.frame_rate = o.number("frame_rate", out.frame_rate, [](double f) { return f > 0.0 && f <= 1000.0; },
@@ -707,6 +707,11 @@ SceneSpec read_scene(const std::filesystem::path& path, const std::vector<std::s
         out.png = o.flag("png", out.png);
         out.video = o.text("video", out.video, {"mp4", "gif", "none"});
         out.csv = o.flag("csv", out.csv);
+        out.charts = o.flag("charts", out.charts);
+        if (out.charts && !out.csv)
+            o.fail(*o.get(o.has("charts") ? "charts" : "csv"), "charts", "are drawn from steps.csv: set csv = true or charts = false");
+        if (out.png && !out.pvd)
+            o.fail(*o.get(o.has("png") ? "png" : "pvd"), "png", "frames are rendered from the .pvd frames: set pvd = true or png = false");
         const std::vector<std::string> fields{"displacement", "velocity", "von Mises stress", "model"};
         out.fields = o.texts("fields", out.fields, fields);
         out.colour = o.text("colour", out.colour, fields);

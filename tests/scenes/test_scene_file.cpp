@@ -78,7 +78,7 @@ TEST_CASE("every gallery scene reads, with and without its quick overrides", "[s
     CHECK(count >= 5);
 }
 
-TEST_CASE("--set overrides are checked like the file and reach every body without an index", "[scenes]")
+TEST_CASE("overrides of --set are checked like the file and reach every body without an index", "[scenes]")
 {
     const std::filesystem::path pair = gallery / "stiff_soft_pair.toml";
     const SceneSpec all = read_scene(pair, {"body.material.model=corotational", "time.step=1/120"});
