@@ -19,34 +19,36 @@
 #include "common/error.hpp"
 
 #include <iostream>
-#include <optional>
 
 using namespace fem;
 using namespace fem::scenes;
 
 namespace {
 
-/// The scene named on the command line (the first argument ending in .toml), for the default --out.
-std::string scene_stem(int argc, char** argv)
+/// The default --out: out/scenes/<scene> for one scene file (an argument ending in .toml),
+/// out/scenes/compare for several.
+std::string default_out(int argc, char** argv)
 {
+    std::vector<std::string> stems;
     for (int i = 1; i < argc; ++i) {
         const std::filesystem::path arg(argv[i]);
         if (arg.extension() == ".toml")
-            return arg.stem().string();
+            stems.push_back(arg.stem().string());
     }
-    return "scene";
+    return "scenes/" + (stems.size() == 1 ? stems.front() : stems.empty() ? std::string("scene") : std::string("compare"));
 }
 
 }  // namespace
 
 int main(int argc, char** argv)
 {
-    ChapterCli cli("fem_scene", "scenes/" + scene_stem(argc, argv),
+    ChapterCli cli("fem_scene", default_out(argc, argv),
                    "Runs a scene file with the cheapest model that is accurate enough (docs/scenes.md)");
-    std::string file;
+    std::vector<std::string> files;
     std::vector<std::string> settings;
     bool compare = false, progress = true;
-    cli.app.add_option("scene", file, "The scene file (TOML), e.g. scenes/cantilever.toml")->required();
+    cli.app.add_option("scene", files, "The scene file (TOML), e.g. scenes/cantilever.toml; several with --compare")
+        ->required();
     cli.app.add_option("--set", settings,
                        "Override a field: key=value in TOML syntax, e.g. body.material.model=auto, time.step=1/120, "
                        "body.0.material.youngs_modulus=2e5 (no index: every body)")
@@ -54,33 +56,40 @@ int main(int argc, char** argv)
     cli.app.add_flag("--compare", compare,
                      "Run every model and auto against the stable neo-Hookean reference and print the table (models.csv)");
     cli.app.add_flag("!--no-progress", progress, "No progress bar on stderr");
-    std::optional<SceneSpec> scene;
-    // The whole scene is read and checked before the output folder is touched.
+    std::vector<SceneSpec> scenes;
+    // Every scene is read and checked before the output folder is touched.
     cli.check_options([&] {
         bool quick = false;
         for (int i = 1; i < argc; ++i)
             quick = quick || std::string(argv[i]) == "--quick";
-        scene = read_scene(file, settings, quick);
-        if (scene->skin)
-            make_skin_observer(*scene->skin, scene->bodies.front().mesh);
+        if (files.size() > 1 && !compare)
+            throw Error(str("scene: give one scene file, or several with --compare (got ", files.size(), ")"));
+        for (const std::string& file : files) {
+            scenes.push_back(read_scene(file, settings, quick));
+            if (scenes.back().skin)
+                make_skin_observer(*scenes.back().skin, scenes.back().bodies.front().mesh);
+        }
     });
     bool stopped = false;
     const int code = cli.run(argc, argv, [&](const RunContext& run) {
         cg::set_blas_threads(1);
-        std::cout << scene->title << " (" << scene->file.string() << "): " << scene->bodies.size() << " bodies, dt = "
-                  << scene->time_step << " s, " << scene->duration << " s, solver " << scene->solver << "\n";
-        for (const BodySpec& body : scene->bodies)
-            std::cout << "  " << body.name << ": " << body.mesh.V.rows() << " vertices, " << body.mesh.T.rows()
-                      << " tets, " << body.pinned.size() << " pinned, model " << body.model << '\n';
-        if (compare) {
-            compare_models(*scene, run);
-            return;
+        for (const SceneSpec& scene : scenes) {
+            std::cout << scene.title << " (" << scene.file.filename().string() << "): " << scene.bodies.size()
+                      << " bodies, dt = " << scene.time_step << " s, " << scene.duration << " s, solver " << scene.solver
+                      << "\n";
+            for (const BodySpec& body : scene.bodies)
+                std::cout << "  " << body.name << ": " << body.mesh.V.rows() << " vertices, " << body.mesh.T.rows()
+                          << " tets, " << body.pinned.size() << " pinned, model " << body.model << '\n';
+            if (compare)
+                compare_models(scene, run);
         }
+        if (compare)
+            return;
         catch_interrupt();
         RunOptions options;
         options.run = &run;
         options.progress = progress;
-        const RunResult result = run_scene(*scene, options);
+        const RunResult result = run_scene(scenes.front(), options);
         std::cout << result.steps << " steps in " << result.seconds << " s ("
                   << (result.steps > 0 ? 1e3 * result.seconds / result.steps : 0.0) << " ms per step), "
                   << result.frame_count << " frames, " << result.newton_iterations << " Newton iterations\n";

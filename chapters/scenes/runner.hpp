@@ -147,7 +147,7 @@ void catch_interrupt();
 
 /// Each fixed model and auto against the stable-neo-Hookean reference at the same Δt: RMS and max
 /// over frames of the position error of the tet vertices and of the boundary (surface) vertices,
-/// time per step and total time; printed, and written to <out>/models.csv. fem::Error for a scene
+/// time per step and total time; printed, and written to <out>/models_<scene>.csv. fem::Error for a scene
 /// with damping (the reference steps without it). docs/scenes.md#what-each-model-costs
 void compare_models(const SceneSpec& scene, const RunContext& run);
 

@@ -630,15 +630,16 @@ void compare_models(const SceneSpec& scene, const RunContext& run)
             }
         }
         std::string used;
+        const std::string hyperelastic = model == "auto" ? scene.thresholds.hyperelastic : model;
         for (std::size_t b = 0; b < result.segments.size(); ++b)
-            used += (b ? "; " : "") + describe_segments(result.segments[b], scene.thresholds.hyperelastic);
+            used += (b ? "; " : "") + describe_segments(result.segments[b], hyperelastic);
         table.add_row({model, std::sqrt(tet_sum / std::max(tet_count, 1L)), tet_max,
                        std::sqrt(surf_sum / std::max(surf_count, 1L)), surf_max, largest > 0.0 ? tet_max / largest : 0.0,
                        double(result.newton_iterations), 1e3 * result.seconds / std::max(result.steps, 1), result.seconds,
                        used});
     }
     table.print(std::cout);
-    table.write_csv(run.file("models.csv"));
+    table.write_csv(run.file("models_" + scene.file.stem().string() + ".csv"));
 }
 
 }  // namespace fem::scenes
