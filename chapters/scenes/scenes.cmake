@@ -34,3 +34,11 @@ if(FEM_BUILD_TESTS)
     set_tests_properties(scenes_quick_run_${scene} PROPERTIES LABELS "scenes;run")
   endforeach()
 endif()
+
+if(FEM_BUILD_TESTS)
+  # docs/scenes.md names only what exists and quotes the tables fem_scene --compare prints.
+  add_test(NAME scenes_docs
+           COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/check_docs.py --root ${FEM_ROOT}
+                   --chapter scenes --bin ${CMAKE_BINARY_DIR}/bin --out ${CMAKE_BINARY_DIR}/check_docs/scenes)
+  set_tests_properties(scenes_docs PROPERTIES LABELS "scenes;docs")
+endif()
