@@ -157,6 +157,10 @@ struct SceneSpec {
 SceneSpec read_scene(const std::filesystem::path& path, const std::vector<std::string>& overrides = {},
                      bool quick = false);
 
+/// Chapter 10's Scene of one body of a scene: its mesh, material, pinned vertices, damping and mass,
+/// the scene's gravity, Δt and duration.
+dynamics::Scene dynamics_scene(const SceneSpec& scene, const BodySpec& body);
+
 /// The vertices of mesh a selector selects, ascending. fem::Error (naming selector.where) if none.
 std::vector<int> select_vertices(const TetMesh& mesh, const Selector& selector);
 

@@ -222,19 +222,10 @@ BodyRun start_body(const BodySpec& spec, const SceneSpec& scene, const std::stri
     const std::string chosen = model.empty() ? spec.model : model;
     b.automatic = chosen == "auto";
     const std::string hyperelastic = b.automatic || level_of(chosen) != Level::hyperelastic ? scene.thresholds.hyperelastic : chosen;
-    dynamics::Scene s;
-    s.mesh = spec.mesh;
-    s.material = spec.material;
-    s.pinned = spec.pinned;
-    s.gravity = scene.gravity;
-    s.damping = spec.damping;
-    s.mass = spec.mass;
-    s.time_step = scene.time_step;
-    s.duration = scene.duration;
     auto forces = std::make_unique<SceneForces>(spec.mesh, spec.material, hyperelastic,
                                                 b.automatic ? Level::linear : level_of(chosen));
     b.forces = forces.get();
-    b.body = std::make_unique<dynamics::Body>(s, std::move(forces));
+    b.body = std::make_unique<dynamics::Body>(dynamics_scene(scene, spec), std::move(forces));
     for (const Pin& pin : spec.pins)
         b.time_dependent = b.time_dependent || pin.motion.kind != Motion::Kind::fixed;
     for (const Load& load : spec.loads)

@@ -763,21 +763,20 @@ SceneSpec read_scene(const std::filesystem::path& path, const std::vector<std::s
         if (hyper && scene.integrator != "backward-euler")
             throw Error(str(file, ": time.integrator: model '", body.model, "' of ", body.name,
                             " steps with Newton backward Euler only; integrator must be backward-euler"));
-        dynamics::Scene check;
-        check.mesh = body.mesh;
-        check.material = body.material;
-        check.pinned = body.pinned;
-        check.gravity = scene.gravity;
-        check.damping = body.damping;
-        check.time_step = scene.time_step;
-        check.duration = scene.duration;
         try {
-            dynamics::validate(check);
+            dynamics::validate(dynamics_scene(scene, body));
         } catch (const Error& e) {
             throw Error(str(file, ": ", body.name, ": ", e.what()));
         }
     }
     return scene;
+}
+
+dynamics::Scene dynamics_scene(const SceneSpec& scene, const BodySpec& body)
+{
+    return dynamics::Scene{.mesh = body.mesh, .material = body.material, .pinned = body.pinned,
+                           .gravity = scene.gravity, .damping = body.damping, .mass = body.mass,
+                           .time_step = scene.time_step, .duration = scene.duration};
 }
 
 std::vector<int> select_vertices(const TetMesh& mesh, const Selector& selector)
