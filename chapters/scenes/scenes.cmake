@@ -41,4 +41,9 @@ if(FEM_BUILD_TESTS)
            COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/check_docs.py --root ${FEM_ROOT}
                    --chapter scenes --bin ${CMAKE_BINARY_DIR}/bin --out ${CMAKE_BINARY_DIR}/check_docs/scenes)
   set_tests_properties(scenes_docs PROPERTIES LABELS "scenes;docs")
+  # Bad command lines: refused before anything is computed or written.
+  add_test(NAME scenes_bad_options
+           COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/check_bad_options.py
+                   --exe $<TARGET_FILE:fem_scene> --table ${FEM_ROOT}/tests/scenes/bad_options.txt)
+  set_tests_properties(scenes_bad_options PROPERTIES LABELS "scenes;run")
 endif()
