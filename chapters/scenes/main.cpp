@@ -19,6 +19,7 @@
 #include "common/error.hpp"
 
 #include <iostream>
+#include <memory>
 
 using namespace fem;
 using namespace fem::scenes;
@@ -56,6 +57,13 @@ int main(int argc, char** argv)
     cli.app.add_flag("--compare", compare,
                      "Run every model and auto against the stable neo-Hookean reference and print the table (models.csv)");
     cli.app.add_flag("!--no-progress", progress, "No progress bar on stderr");
+    bool view = false;
+    int screenshot = -1;
+    cli.app.add_flag("--view", view,
+                     "Play the run live in a window (space: pause, right arrow: step, r: restart, c: colour field, "
+                     "q: stop); without a display the run goes on headless");
+    cli.app.add_option("--screenshot", screenshot, "With --view: save the window at this step as view_<step>.png in --out")
+        ->check(check::at_least<int>(0));
     std::vector<SceneSpec> scenes;
     // Every scene is read and checked before the output folder is touched.
     cli.check_options([&] {
@@ -64,6 +72,10 @@ int main(int argc, char** argv)
             quick = quick || std::string(argv[i]) == "--quick";
         if (files.size() > 1 && !compare)
             throw Error(str("scene: give one scene file, or several with --compare (got ", files.size(), ")"));
+        if (screenshot >= 0 && !view)
+            throw Error("--screenshot: needs --view");
+        if (view && compare)
+            throw Error("--view: plays one run; --compare runs many without frames");
         for (const std::string& file : files) {
             scenes.push_back(read_scene(file, settings, quick));
             if (scenes.back().skin)
@@ -89,7 +101,23 @@ int main(int argc, char** argv)
         RunOptions options;
         options.run = &run;
         options.progress = progress;
-        const RunResult result = run_scene(scenes.front(), options);
+        std::unique_ptr<LiveView> live;
+        if (view && fig::display_available()) {
+            live = std::make_unique<LiveView>(scenes.front(), run.file(str("view_", screenshot, ".png")), screenshot);
+            options.on_frame = [&](const io::MeshData& frame, int step, double time) { live->frame(frame, step, time); };
+        } else if (view) {
+            std::cout << "note: no display for --view (set DISPLAY); the run goes on headless\n";
+        }
+        RunResult result;
+        for (;;) {
+            try {
+                result = run_scene(scenes.front(), options);
+                break;
+            } catch (const LiveView::Restart&) {  // the live view's r: the run starts over
+                std::cout << "restarted\n";
+                std::filesystem::remove_all(run.file(scenes.front().file.stem().string()));
+            }
+        }
         std::cout << result.steps << " steps in " << result.seconds << " s ("
                   << (result.steps > 0 ? 1e3 * result.seconds / result.steps : 0.0) << " ms per step), "
                   << result.frame_count << " frames, " << result.newton_iterations << " Newton iterations\n";

@@ -25,10 +25,14 @@
 #include "10_linear_dynamics/time_integration.hpp"
 
 #include "common/cli.hpp"
+#include "common/figures.hpp"
+#include "common/timer.hpp"
 
 #include <Eigen/Core>
 
 #include <array>
+#include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -126,8 +130,12 @@ struct RunResult {
     int frame_count = 0;
 };
 
+/// Called with every frame written (the merged mesh of every body), its step and time.
+using FrameObserver = std::function<void(const io::MeshData& frame, int step, double time)>;
+
 /// How to run a scene.
 struct RunOptions {
+    FrameObserver on_frame;            ///< e.g. the live view; may throw to abandon the run
     const RunContext* run = nullptr;   ///< where files go; nullptr: write nothing
     std::string model;                 ///< when set, every body uses this model instead of its own
     bool keep_positions = false;       ///< keep every frame's positions (for the model comparison)
@@ -144,6 +152,42 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options);
 
 /// Installs the SIGINT handler run_scene watches (a second SIGINT kills as usual).
 void catch_interrupt();
+
+/// Asks run_scene to stop after the current step, as SIGINT does (the live view's 'q').
+void request_stop();
+
+/// How a scene's frames are drawn: title, colour field, camera, size, and the frame box and colour
+/// range when the scene fixes them. The PNG frames and the live view use it alike.
+fig::RenderOptions frame_view(const SceneSpec& scene);
+
+/// The title of the frame at time t, as the PNG frames write it.
+std::string frame_title(const SceneSpec& scene, double time);
+
+/// The live view of --view: a window that plays the run's frames as they come, one frame interval
+/// (1/frame_rate) apart at least,
+/// drawn as the PNG frames are. Keys: space pauses and resumes, the right arrow steps one frame
+/// while paused, r restarts the run (throws Restart), c switches the colour field, q stops the run.
+/// docs/scenes.md#the-live-view
+class LiveView {
+public:
+    /// Thrown by frame() when r is pressed: the caller runs the scene again.
+    struct Restart {};
+    /// Opens the window (fem::Error without a display). screenshot_step ≥ 0: save the window at that
+    /// step to screenshot (for the test against the PNG frame of the same step).
+    LiveView(const SceneSpec& scene, std::filesystem::path screenshot = {}, int screenshot_step = -1);
+    /// Shows one frame and handles the keys pressed since the last one.
+    void frame(const io::MeshData& frame, int step, double time);
+
+private:
+    const SceneSpec& scene_;
+    fig::MeshWindow window_;
+    std::vector<std::string> fields_;
+    std::size_t field_ = 0;
+    bool paused_ = false;
+    std::filesystem::path screenshot_;
+    int screenshot_step_;
+    Timer clock_;  // since the last frame shown
+};
 
 /// Each fixed model and auto against the stable-neo-Hookean reference at the same Δt: RMS and max
 /// over frames of the position error of the tet vertices and of the boundary (surface) vertices,

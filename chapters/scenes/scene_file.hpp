@@ -18,6 +18,9 @@
 
 #include <Eigen/Core>
 
+#include <array>
+#include <utility>
+
 #include <filesystem>
 #include <limits>
 #include <optional>
@@ -122,6 +125,11 @@ struct OutputSpec {
     Eigen::Vector3d view_direction{0.3, 1.0, -0.3};   ///< the camera looks along this
     Eigen::Vector3d view_up{0.0, 0.0, 1.0};
     double warp = 1.0;                  ///< displacement scale of the PNGs
+    /// The box the camera frames [m] (xmin, xmax, ymin, ymax, zmin, zmax); default: the union of
+    /// the frames' bounds, known only at the end, so a live view (--view) frames the rest shape.
+    /// Set it (and colour_range) for a live view with exactly the PNGs' camera and colours.
+    std::optional<std::array<double, 6>> frame_box;
+    std::optional<std::pair<double, double>> colour_range;  ///< default: the run's range
     int width = 900, height = 700;      ///< PNG size [pixels]
 };
 

@@ -698,7 +698,7 @@ SceneSpec read_scene(const std::filesystem::path& path, const std::vector<std::s
     }
     if (const toml::table* output_table = top.subtable("output")) {
         const Fields o(*output_table, "output", source,
-                       {"frame_rate", "pvd", "png", "video", "csv", "charts", "fields", "colour", "view_direction", "view_up",
+                       {"frame_rate", "pvd", "png", "video", "csv", "charts", "frame_box", "colour_range", "fields", "colour", "view_direction", "view_up",
                         "warp", "width", "height"});
         OutputSpec& out = scene.output;
         out.frame_rate = o.number("frame_rate", out.frame_rate, [](double f) { return f > 0.0 && f <= 1000.0; },
@@ -718,6 +718,23 @@ SceneSpec read_scene(const std::filesystem::path& path, const std::vector<std::s
         out.view_direction = o.vector("view_direction", out.view_direction, true);
         out.view_up = o.vector("view_up", out.view_up, true);
         out.warp = o.positive("warp", out.warp);
+        if (o.has("frame_box")) {
+            const toml::array& corners = o.array("frame_box", 2, "two corners [[x0, y0, z0], [x1, y1, z1]]");
+            const toml::table corner_table{{"low", *corners.get(0)}, {"high", *corners.get(1)}};
+            const Fields corner(corner_table, o.field("frame_box"), o.source(), {"low", "high"});
+            const Eigen::Vector3d low = corner.vector("low", Eigen::Vector3d::Zero());
+            const Eigen::Vector3d high = corner.vector("high", Eigen::Vector3d::Zero());
+            if ((low.array() >= high.array()).any())
+                o.fail(*o.get("frame_box"), "frame_box", "the first corner must be below the second in x, y and z");
+            out.frame_box = std::array<double, 6>{low.x(), high.x(), low.y(), high.y(), low.z(), high.z()};
+        }
+        if (o.has("colour_range")) {
+            const toml::array& range = o.array("colour_range", 2, "[low, high] with low < high");
+            const double low = o.number_of(*range.get(0), "colour_range[0]", [](double) { return true; }, "a finite number");
+            const double high = o.number_of(*range.get(1), "colour_range[1]", [low](double h) { return h > low; },
+                                            "a finite number above colour_range[0]");
+            out.colour_range = std::make_pair(low, high);
+        }
         out.width = o.integer("width", out.width, 64, 4096);
         out.height = o.integer("height", out.height, 64, 4096);
         if (out.colour != "displacement" && std::find(out.fields.begin(), out.fields.end(), out.colour) == out.fields.end())
