@@ -220,3 +220,38 @@ TEST_CASE("fem_scene refuses bad scene files with one error line and writes noth
             CHECK(printed.find("skin needs chapter 13") != std::string::npos);
     }
 }
+
+TEST_CASE("the live view shows the PNG frame of the same step, pixel for pixel", "[scenes]")
+{
+    if (std::getenv("DISPLAY") == nullptr) {
+        WARN("no X display: run the tests under xvfb-run -a to check the live view");
+        return;
+    }
+    const std::filesystem::path base = output / "view";
+    std::filesystem::remove_all(base);
+    const std::string scene = (gallery / "cantilever.toml").string();
+    const std::string files = "'" FEM_SCENE_EXE "' '" + scene + "' --quick --no-progress --out '" + (base / "files").string() +
+                              "' >/dev/null 2>&1";
+    const std::string view = "'" FEM_SCENE_EXE "' '" + scene + "' --quick --no-progress --view --screenshot 5 --out '" +
+                             (base / "view").string() + "' >/dev/null 2>&1";
+    REQUIRE(std::system(files.c_str()) == 0);
+    REQUIRE(std::system(view.c_str()) == 0);
+    // [quick]: 12 frames per second at dt = 1/60 s, a frame every 5 steps: step 5 is frame 1.
+    const std::string png = read_text(base / "files" / "cantilever_0001.png");
+    REQUIRE(png.size() > 1000);
+    CHECK(read_text(base / "view" / "view_5.png") == png);
+    CHECK(read_text(base / "view" / "cantilever_0002.png") != png);  // another step is another picture
+}
+
+TEST_CASE("--view without a display: one line says so and the run goes on headless", "[scenes]")
+{
+    const std::filesystem::path out = output / "headless";
+    std::filesystem::remove_all(out);
+    const std::filesystem::path log = output / "headless.log";
+    const std::string command = "env -u DISPLAY '" FEM_SCENE_EXE "' '" + (gallery / "hanging_cube.toml").string() +
+                                "' --quick --view --no-progress --out '" + out.string() + "' >'" + log.string() + "' 2>&1";
+    CHECK(std::system(command.c_str()) == 0);
+    const std::string printed = read_text(log);
+    CHECK(printed.find("note: no display for --view (set DISPLAY); the run goes on headless") != std::string::npos);
+    CHECK(std::filesystem::exists(out / "hanging_cube.pvd"));
+}
