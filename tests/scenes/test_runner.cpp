@@ -243,7 +243,7 @@ TEST_CASE("the live view shows the PNG frame of the same step, pixel for pixel",
     CHECK(read_text(base / "view" / "cantilever_0002.png") != png);  // another step is another picture
 }
 
-TEST_CASE("--view without a display: one line says so and the run goes on headless", "[scenes]")
+TEST_CASE("the live view without a display: one line says so and the run goes on headless", "[scenes]")
 {
     const std::filesystem::path out = output / "headless";
     std::filesystem::remove_all(out);
@@ -254,4 +254,38 @@ TEST_CASE("--view without a display: one line says so and the run goes on headle
     const std::string printed = read_text(log);
     CHECK(printed.find("note: no display for --view (set DISPLAY); the run goes on headless") != std::string::npos);
     CHECK(std::filesystem::exists(out / "hanging_cube.pvd"));
+}
+
+TEST_CASE("the video: ffmpeg makes it from the PNG frames, or one line says it is missing", "[scenes]")
+{
+    if (std::getenv("DISPLAY") == nullptr) {
+        WARN("no X display, so no PNG frames to make a video of: run the tests under xvfb-run -a");
+        return;
+    }
+    const std::string scene = (gallery / "cantilever.toml").string();
+    for (bool with_ffmpeg : {true, false}) {
+        if (with_ffmpeg && std::system("command -v ffmpeg >/dev/null 2>&1") != 0) {
+            WARN("ffmpeg is not installed (tools/setup.sh installs it)");
+            continue;
+        }
+        const std::filesystem::path out = output / (with_ffmpeg ? "video" : "no_video");
+        std::filesystem::remove_all(out);
+        const std::filesystem::path log = output / "video.log";
+        // Without ffmpeg: a PATH that holds none (the runner needs no other program here).
+        const std::string command = std::string(with_ffmpeg ? "" : "PATH=/nonexistent ") + "'" FEM_SCENE_EXE "' '" + scene +
+                                    "' --quick --no-progress --set output.video=mp4 --set output.charts=false --out '" +
+                                    out.string() + "' >'" + log.string() + "' 2>&1";
+        CHECK(std::system(command.c_str()) == 0);
+        const std::string printed = read_text(log);
+        if (with_ffmpeg) {
+            CHECK(printed.find("video: cantilever.mp4") != std::string::npos);
+            const std::string mp4 = read_text(out / "cantilever.mp4");
+            CHECK(mp4.size() > 1000);
+            CHECK(mp4.substr(4, 4) == "ftyp");  // an MP4 container
+        } else {
+            CHECK(printed.find("video: skipped, ffmpeg is not installed") != std::string::npos);
+            CHECK(!std::filesystem::exists(out / "cantilever.mp4"));
+            CHECK(std::filesystem::exists(out / "cantilever_0003.png"));
+        }
+    }
 }
