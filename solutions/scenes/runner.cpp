@@ -262,7 +262,9 @@ void step_body(BodyRun& b, const SceneSpec& scene)
     dynamics::State& state = b.state;
     const double dt = scene.time_step, t_next = state.time + dt;
     bool changed = false;
-    const double before = scene_energies(b).total();
+    // The energy before a change of boundary conditions or model, to book what the change put in
+    // (a body with neither pays for no energy evaluation here).
+    const double before = b.time_dependent || b.automatic ? scene_energies(b).total() : 0.0;
     if (b.time_dependent) {
         if (!b.spec->loads.empty())
             b.forces->set_loads(applied_loads(*b.spec, b.boundary, t_next));
