@@ -9,6 +9,9 @@
 
 #include <catch2/catch.hpp>
 
+#include <X11/Xlib.h>
+#include <X11/keysym.h>
+
 #include <chrono>
 #include <csignal>
 #include <filesystem>
@@ -288,4 +291,104 @@ TEST_CASE("the video: ffmpeg makes it from the PNG frames, or one line says it i
             CHECK(std::filesystem::exists(out / "cantilever_0003.png"));
         }
     }
+}
+
+namespace {
+
+/// The top-level window whose name starts with prefix, searched from root (0: none).
+Window find_window(Display* display, Window root, const std::string& prefix)
+{
+    char* name = nullptr;
+    if (XFetchName(display, root, &name) && name != nullptr) {
+        const bool found = std::string(name).rfind(prefix, 0) == 0;
+        XFree(name);
+        if (found)
+            return root;
+    }
+    Window parent = 0, *children = nullptr;
+    unsigned int count = 0;
+    Window found = 0;
+    if (XQueryTree(display, root, &root, &parent, &children, &count)) {
+        for (unsigned int i = 0; i < count && found == 0; ++i)
+            found = find_window(display, children[i], prefix);
+        if (children != nullptr)
+            XFree(children);
+    }
+    return found;
+}
+
+/// Sends a key press (an X key symbol, e.g. XK_space) to a window, as a user would.
+void press(Display* display, Window window, KeySym key)
+{
+    XKeyEvent event{};
+    event.type = KeyPress;
+    event.display = display;
+    event.window = window;
+    event.root = DefaultRootWindow(display);
+    event.same_screen = True;
+    event.keycode = XKeysymToKeycode(display, key);
+    XSendEvent(display, window, True, KeyPressMask, reinterpret_cast<XEvent*>(&event));
+    event.type = KeyRelease;
+    XSendEvent(display, window, True, KeyReleaseMask, reinterpret_cast<XEvent*>(&event));
+    XFlush(display);
+}
+
+/// The .vtu frames a running fem_scene has written so far into its staging folder.
+int frames_so_far(const std::filesystem::path& out, const std::string& stem)
+{
+    int count = 0;
+    std::error_code ignored;
+    for (const auto& staging : std::filesystem::directory_iterator(out, ignored))
+        for (const auto& frame : std::filesystem::directory_iterator(staging.path() / stem, ignored))
+            count += frame.path().extension() == ".vtu";
+    return count;
+}
+
+}  // namespace
+
+TEST_CASE("the live view's keys: space pauses, the right arrow steps, space resumes, q stops with the files", "[scenes]")
+{
+    Display* display = std::getenv("DISPLAY") ? XOpenDisplay(nullptr) : nullptr;
+    if (display == nullptr) {
+        WARN("no X display: run the tests under xvfb-run -a to check the live view's keys");
+        return;
+    }
+    const std::filesystem::path out = output / "keys";
+    std::filesystem::remove_all(out);
+    const std::string scene = (gallery / "cantilever.toml").string();
+    const pid_t child = ::fork();
+    REQUIRE(child >= 0);
+    if (child == 0) {
+        std::freopen("/dev/null", "w", stdout);
+        std::freopen("/dev/null", "w", stderr);
+        ::execl(FEM_SCENE_EXE, FEM_SCENE_EXE, scene.c_str(), "--quick", "--view", "--no-figures", "--no-progress", "--set",
+                "time.duration=600", "--out", out.c_str(), static_cast<char*>(nullptr));
+        std::_Exit(127);
+    }
+    Window window = 0;
+    for (int poll = 0; poll < 600 && (window == 0 || frames_so_far(out, "cantilever") < 3); ++poll) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        if (window == 0)
+            window = find_window(display, DefaultRootWindow(display), "fem_scene: ");
+    }
+    REQUIRE(window != 0);
+    press(display, window, XK_space);  // pause
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    const int paused = frames_so_far(out, "cantilever");
+    std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+    CHECK(frames_so_far(out, "cantilever") == paused);
+    press(display, window, XK_Right);  // one frame on, still paused
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    CHECK(frames_so_far(out, "cantilever") == paused + 1);
+    press(display, window, XK_c);  // another colour field: the run goes on drawing
+    press(display, window, XK_space);  // resume: 12 frames a second
+    std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+    CHECK(frames_so_far(out, "cantilever") > paused);
+    press(display, window, XK_q);  // stop, as Ctrl-C does
+    int status = 0;
+    ::waitpid(child, &status, 0);
+    XCloseDisplay(display);
+    REQUIRE(WIFEXITED(status));
+    CHECK(WEXITSTATUS(status) == 130);
+    CHECK(io::read_pvd(out / "cantilever.pvd").size() > static_cast<std::size_t>(paused));
 }
