@@ -47,16 +47,17 @@ int main(int argc, char** argv)
                    "Runs a scene file with the cheapest model that is accurate enough (docs/scenes.md)");
     std::vector<std::string> files;
     std::vector<std::string> settings;
-    bool compare = false, progress = true;
+    bool compare = false, no_progress = false;
     cli.app.add_option("scene", files, "The scene file (TOML), e.g. scenes/cantilever.toml; several with --compare")
         ->required();
     cli.app.add_option("--set", settings,
                        "Override a field: key=value in TOML syntax, e.g. body.material.model=auto, time.step=1/120, "
                        "body.0.material.youngs_modulus=2e5 (no index: every body)")
-        ->take_all();
+        ->allow_extra_args(false)  // one key=value per --set (a scene file after it stays the scene)
+        ->take_all();              // and every --set kept
     cli.app.add_flag("--compare", compare,
-                     "Run every model and auto against the stable neo-Hookean reference and print the table (models.csv)");
-    cli.app.add_flag("!--no-progress", progress, "No progress bar on stderr");
+                     "Run every model and auto against the stable neo-Hookean reference and print the table (models_<scene>.csv)");
+    cli.app.add_flag("--no-progress", no_progress, "No progress bar on stderr (it shows only on a terminal anyway)");
     bool view = false;
     int screenshot = -1;
     cli.app.add_flag("--view", view,
@@ -100,7 +101,7 @@ int main(int argc, char** argv)
         catch_interrupt();
         RunOptions options;
         options.run = &run;
-        options.progress = progress;
+        options.progress = !no_progress;
         std::unique_ptr<LiveView> live;
         if (view && fig::display_available()) {
             live = std::make_unique<LiveView>(scenes.front(), run.file(str("view_", screenshot, ".png")), screenshot);
