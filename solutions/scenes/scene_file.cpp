@@ -771,15 +771,16 @@ SceneSpec read_scene(const std::filesystem::path& path, const std::vector<std::s
             s.fail(*s.get("body"), "body", str("no body is called '", skin.body, "'"));
         scene.skin = skin;
     }
-    for (BodySpec& body : scene.bodies) {
+    for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
+        const BodySpec& body = scene.bodies[i];
         const bool hyper = body.model != "linear" && body.model != "corotational";
         if (hyper && (body.damping.alpha != 0.0 || body.damping.beta != 0.0))
-            throw Error(str(file, ": ", body.name, ": model '", body.model,
-                            "' steps with chapter 12's Newton backward Euler, which has no Rayleigh damping: set damping "
-                            "to 0 or the model to linear or corotational"));
+            throw Error(str(file, ": body[", i, "].damping: not with body[", i, "].material.model = '", body.model,
+                            "', which steps with chapter 12's Newton backward Euler, which has no Rayleigh damping: set "
+                            "damping to 0 or the model to linear or corotational"));
         if (hyper && scene.integrator != "backward-euler")
-            throw Error(str(file, ": time.integrator: model '", body.model, "' of ", body.name,
-                            " steps with Newton backward Euler only; integrator must be backward-euler"));
+            throw Error(str(file, ": time.integrator: '", scene.integrator, "' is not for body[", i, "].material.model = '",
+                            body.model, "', which steps with Newton backward Euler only: use backward-euler"));
         try {
             dynamics::validate(dynamics_scene(scene, body));
         } catch (const Error& e) {
