@@ -14,4 +14,6 @@ with_display() {
     fi
 }
 
-step() { printf '\n=== %s\n' "$*"; }
+# Prints a stage's title with the minutes and seconds since the script started (bash's SECONDS), so
+# that a run's log shows what each stage cost.
+step() { printf '\n=== [%d:%02d] %s\n' $((SECONDS / 60)) $((SECONDS % 60)) "$*"; }

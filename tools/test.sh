@@ -42,3 +42,5 @@ with_display ctest --preset release
 
 step "5/5 the file readers fuzzed: each libFuzzer target 25 s from its seeds, no crash, sanitizer report, stray exception or runaway allocation"
 tools/fuzz.sh --seconds 25
+
+step "done: every stage passed"

@@ -108,6 +108,9 @@ std::string factorization_name(Factorization factorization);
 struct CholeskyOptions {
     Ordering ordering = Ordering::nested_dissection;
     Factorization factorization = Factorization::supernodal;
+    /// Also keep L rounded to single precision after every factorization, for
+    /// solve_single_precision (supernodal only): a preconditioner's cheaper solve.
+    bool single_precision_copy = false;
 };
 
 /// Times of the phases of the last analysis and factorization (wall clock, seconds).
@@ -150,6 +153,12 @@ public:
     /// X with A X = B, one column per right-hand side (blocked: L is read once for all columns).
     /// fem::Error if B has not rows() rows or is not finite.
     Eigen::MatrixXd solve_many(const Eigen::MatrixXd& B) const;
+    /// x ≈ A⁻¹ b with the single-precision copy of L (options.single_precision_copy): b is rounded
+    /// to float, both substitutions run in float (half the bytes of solve's), x is returned in
+    /// double. Its relative error is of order 1e-7 κ(A): for a preconditioner, not for an answer.
+    /// fem::Error without the copy, or if b has not rows() entries or is not finite.
+    /// docs/08_direct_solvers.md#single-precision-solves
+    Eigen::VectorXd solve_single_precision(const Eigen::VectorXd& b) const;
 
     int rows() const;
     const CholeskyOptions& options() const;

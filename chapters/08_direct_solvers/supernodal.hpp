@@ -57,6 +57,15 @@ public:
     /// X has not n rows.
     void solve_in_place(Eigen::Ref<Eigen::MatrixXd> X) const;
 
+    /// Keeps a copy of the blocks rounded to single precision (made now, dropped by the next
+    /// factorize()), for solve_in_place_single. fem::Error before factorize().
+    void round_to_single();
+    /// x ← L⁻ᵀ L⁻¹ x with the single-precision blocks (one right-hand side, permuted numbering):
+    /// the same substitutions as solve_in_place reading half the bytes, with errors of order
+    /// 1e-7 κ(L) — what a preconditioner can afford. fem::Error without round_to_single() since
+    /// the last factorize(), or if x has not n entries.
+    void solve_in_place_single(Eigen::Ref<Eigen::VectorXf> x) const;
+
     int supernodes() const { return static_cast<int>(first_.size()) - 1; }
     /// Columns first(s) … first(s+1)−1 form supernode s.
     int first(int s) const { return first_[s]; }
@@ -78,8 +87,13 @@ private:
     std::vector<int> rows_;               // sorted; the first ns_s are s's own columns
     std::vector<long long> value_start_;  // s's m_s×ns_s column-major block at values_[value_start_[s]]
     std::vector<double> values_;
+    std::vector<float> single_values_;    // values_ rounded to float (round_to_single), or empty
     std::vector<int> column_to_supernode_;
     bool factored_ = false;
+
+    /// The two substitutions with one right-hand side, for the double blocks or their float copy.
+    template <class Scalar>
+    void solve_vector(const Scalar* values, Scalar* x) const;
 };
 
 }  // namespace fem::direct

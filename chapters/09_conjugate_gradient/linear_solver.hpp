@@ -91,8 +91,16 @@ public:
     /// n of the prepared matrix (0 before prepare()).
     Eigen::Index size() const { return A_.rows(); }
 
+    /// The tolerance and cap of an iterative solver (a direct one ignores them).
+    const SolverOptions& options() const { return options_; }
+    /// The relative tolerance τ of the next solves of an iterative solver (a direct one ignores
+    /// it): Newton's method solves loosely far from its answer and tightly near it (inexact
+    /// Newton, chapter 12). fem::Error for τ outside (0, 1).
+    void set_relative_tolerance(double tolerance);
+
 protected:
-    explicit LinearSolver(std::string name) : name_(std::move(name)) {}
+    /// fem::Error for options outside their ranges (τ in (0, 1), cap ≥ 0).
+    explicit LinearSolver(std::string name, const SolverOptions& options = {});
     /// Factor or set up for A (already checked; the solver's own copy, alive until the next
     /// prepare()). same_pattern: A has the sparsity pattern of the previous prepare(), so a
     /// symbolic analysis may be reused.
@@ -102,6 +110,7 @@ protected:
 
 private:
     std::string name_;
+    SolverOptions options_;
     Eigen::SparseMatrix<double> A_;  // for the residual check and the pattern comparison
     std::vector<Eigen::Index> mirror_;  // per entry of A_, where its transpose entry is (or −1)
     SolveStats stats_;

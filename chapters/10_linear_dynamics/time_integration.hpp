@@ -39,6 +39,7 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -81,6 +82,40 @@ Energies energies(const Body& body, const State& state);
 /// docs/10_linear_dynamics.md#the-implicit-step
 SparseMatrix step_matrix(const SparseMatrix& M, const SparseMatrix& K, const Damping& damping, double time_step,
                          double theta = 1.0);
+
+/// The step matrix of a body whose stiffness changes every step (chapters 11 and 12), assembled on
+/// the free dofs in one fixed pattern: A_ff = Pᵀ (a M + k K) P, with a = 1 + θΔt α and
+/// k = θΔt β + θ²Δt² as in step_matrix. The pattern of A_ff and the slot of every entry of M and K
+/// in it (or none, for a pinned row or column) are found once; each assemble() is then one pass
+/// over M's and K's values, where reduce(step_matrix(M, K)) would build two new matrices.
+/// docs/10_linear_dynamics.md#the-implicit-step
+class ReducedStepMatrix {
+public:
+    /// The pattern of Pᵀ (M + K) P (both n×n, n = dofs.full_size()). fem::Error on sizes.
+    ReducedStepMatrix(const SparseMatrix& M, const SparseMatrix& K, const FreeDofs& dofs);
+
+    /// True when M and K have the patterns this was built for (one pass over their indices).
+    bool fits(const SparseMatrix& M, const SparseMatrix& K) const;
+
+    /// A_ff = Pᵀ (a M + k K) P in the fixed pattern (size dofs.size(), CSC, both triangles).
+    /// fem::Error unless fits(M, K).
+    const SparseMatrix& assemble(const SparseMatrix& M, const SparseMatrix& K, double a, double k);
+
+    /// assemble with a and k of the θ-step: step_matrix's weights for damping, Δt and θ.
+    const SparseMatrix& assemble(const SparseMatrix& M, const SparseMatrix& K, const Damping& damping,
+                                 double time_step, double theta = 1.0);
+
+private:
+    /// The pattern of one n×n input, kept to check that a later M or K still has it.
+    struct Pattern {
+        std::vector<int> outer, inner;
+        explicit Pattern(const SparseMatrix& A);
+        bool matches(const SparseMatrix& A) const;
+    };
+    SparseMatrix A_;                            // A_ff, its pattern fixed
+    Pattern M_pattern_, K_pattern_;
+    std::vector<Eigen::Index> M_slot_, K_slot_; // entry k of M or K (compressed order) → entry of A_ff, or −1
+};
 
 /// The lecture's right-hand side b = M v + Δt (f + f_ext), i.e. M v − Δt [K u − f_ext] with the
 /// internal forces f = −K u (all vectors of M's size). The θ < 1 correction is added by ThetaMethod.
@@ -170,6 +205,7 @@ private:
     double theta_;
     ImplicitOptions options_;
     std::unique_ptr<cg::LinearSolver> solver_;
+    std::optional<ReducedStepMatrix> reduced_;  // the eliminate route's A_ff, its pattern fixed
     double prepared_time_step_ = 0.0;   // Δt of the prepared matrix (0: none yet)
     const Body* prepared_body_ = nullptr;
     Eigen::VectorXd rhs_, solution_;    // work vectors (free or full size, by route); solution_

@@ -144,11 +144,11 @@ private:
     PolarAlgorithm algorithm_;
     assembly::ElementMatrices K_e_;
     assembly::AssemblyPattern pattern_;
-    assembly::CsrMatrix K_R_csr_;
-    dynamics::SparseMatrix K_R_;
+    dynamics::SparseMatrix K_R_;                  // the pattern's arrays, values rewritten per call
     Eigen::VectorXd volumes_;                     // rest volume of every tet
     Eigen::VectorXd rotated_at_;                  // the u of rotations_
     std::vector<Eigen::Matrix3d> rotations_;
+    std::vector<Eigen::Matrix3d> rest_edges_inverse_;  // T_X⁻¹ of every tet (chapter 04), for F
 };
 
 /// The rotations of the free vertices of `dofs` (vertex_rotations of those whose three dofs are

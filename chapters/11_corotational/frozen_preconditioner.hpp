@@ -26,6 +26,11 @@ namespace fem::corot {
 /// reduced step matrix, the free vertices in order). Asked for at every prepare().
 using BlockRotations = std::function<std::vector<Eigen::Matrix3d>()>;
 
+/// The precision the frozen factor is applied in: its substitutions read L from memory, so a copy
+/// rounded to float (chapter 08's solve_single_precision) halves their cost, and CG in double
+/// corrects the rounding as it corrects the factor's age.
+enum class FactorPrecision { single_precision, double_precision };
+
 /// PCG preconditioned by a frozen sparse Cholesky factor (chapter 08's supernodal factorization), behind
 /// chapter 09's solver interface so that chapter 10's ThetaMethod can use it
 /// (ImplicitOptions::make_solver). docs/11_corotational.md#solving-a-changing-matrix
@@ -39,9 +44,11 @@ class FrozenFactorPcg final : public cg::LinearSolver {
 public:
     /// options: CG's relative tolerance and cap; refresh_iterations: refactor the preconditioner
     /// when a solve needed more iterations than this (0: never); rotations: the blocks' rotations
-    /// (empty: a plain frozen factor). fem::Error for a tolerance outside (0, 1) or negative counts.
+    /// (empty: a plain frozen factor); precision: of the factor's substitutions.
+    /// fem::Error for a tolerance outside (0, 1) or negative counts.
     explicit FrozenFactorPcg(const cg::SolverOptions& options = {}, int refresh_iterations = 0,
-                             BlockRotations rotations = {});
+                             BlockRotations rotations = {},
+                             FactorPrecision precision = FactorPrecision::single_precision);
 
     bool is_direct() const override { return false; }
     /// How many times the preconditioner was factored (1 after the first prepare()).
@@ -54,9 +61,12 @@ protected:
     int do_solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) override;
 
 private:
-    cg::SolverOptions options_;
+    /// A₀⁻¹ r with the frozen factor, in the chosen precision.
+    Eigen::VectorXd apply_factor(const Eigen::VectorXd& r) const;
+
     int refresh_iterations_;
     BlockRotations rotations_;
+    FactorPrecision precision_;
     std::optional<direct::SparseCholesky> factor_;   // used directly: no residual check per application
     const Eigen::SparseMatrix<double>* A_ = nullptr;  // the base class's copy, alive until the next prepare
     std::vector<Eigen::Matrix3d> frozen_rotations_;   // R₀ᵢ, when the factor was made

@@ -22,7 +22,7 @@ const std::vector<std::string>& solver_option_names()
 {
     static const std::vector<std::string> names{"refactor", "pcg-ic0 v+ from zero", "pcg-ic0 v+ from v",
                                                 "pcg-ic0 dv from last dv", "frozen-factor-pcg",
-                                                "rotated-frozen-factor-pcg"};
+                                                "rotated-frozen-factor-pcg double", "rotated-frozen-factor-pcg"};
     return names;
 }
 
@@ -46,14 +46,17 @@ dynamics::ImplicitOptions solver_option(const std::string& name, double toleranc
             pcg.relative_tolerance = tolerance;
             return std::make_unique<FrozenFactorPcg>(pcg, 30);
         };
-    } else if (name == "rotated-frozen-factor-pcg") {
+    } else if (name == "rotated-frozen-factor-pcg" || name == "rotated-frozen-factor-pcg double") {
         auto* model = dynamic_cast<CorotationalElasticity*>(&body.model());
         if (model == nullptr)
-            throw Error("rotated-frozen-factor-pcg: the body's force model is not corotational");
-        options.make_solver = [tolerance, model, &dofs = body.dofs()] {
+            throw Error(str(name, ": the body's force model is not corotational"));
+        const FactorPrecision precision =
+            name == "rotated-frozen-factor-pcg" ? FactorPrecision::single_precision : FactorPrecision::double_precision;
+        options.make_solver = [tolerance, model, precision, &dofs = body.dofs()] {
             cg::SolverOptions pcg;
             pcg.relative_tolerance = tolerance;
-            return std::make_unique<FrozenFactorPcg>(pcg, 30, [model, &dofs] { return free_vertex_rotations(*model, dofs); });
+            return std::make_unique<FrozenFactorPcg>(
+                pcg, 30, [model, &dofs] { return free_vertex_rotations(*model, dofs); }, precision);
         };
     } else {
         throw Error(str("unknown solver option '", name, "'"));

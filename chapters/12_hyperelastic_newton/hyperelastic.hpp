@@ -77,7 +77,6 @@ private:
     std::vector<tet::ShapeGradients> gradients_;
     Eigen::VectorXd volumes_;
     assembly::AssemblyPattern pattern_;
-    assembly::CsrMatrix K_csr_;
     dynamics::SparseMatrix K_;
 };
 

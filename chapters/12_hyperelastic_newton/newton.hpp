@@ -20,6 +20,7 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -44,7 +45,15 @@ struct NewtonOptions {
     double smallest_step = 1e-10;      ///< a line search that needs α below this fails (fem::Error)
     bool line_search = true;           ///< false: plain Newton, α = 1 always (to show what it risks)
     HessianChoice hessian = HessianChoice::exact_then_definite;
+    /// Inexact Newton: an iterative solver solves H d = −∇E only to the relative residual
+    /// max(its own tolerance, min(forcing, ‖∇E‖/scale)) — loose far from the answer, tight near it,
+    /// where η = O(‖∇E‖) keeps the convergence quadratic (Eisenstat and Walker 1996). 0: always to
+    /// its own tolerance. A direct solver solves exactly either way. In [0, 1).
+    double forcing = 0.01;
     std::string solver = "default";    ///< chapter 09's solver of H d = −∇E
+    /// When set, the solver is made by this instead of cg::make_solver(solver): e.g. chapter 11's
+    /// frozen-factor PCG, which keeps one factorization across Newton iterations and steps.
+    std::function<std::unique_ptr<cg::LinearSolver>()> make_solver;
 };
 
 /// The relative round-off of the objective: the line search accepts a trial whose E misses the
@@ -119,10 +128,14 @@ public:
     /// What the last step's Newton iterations did (gradient norms relative to the momentum scale,
     /// step lengths, fallbacks to the definite Hessian).
     const NewtonResult& last() const { return last_; }
+    /// The solver of Newton's systems (made from the options).
+    const cg::LinearSolver& solver() const { return *solver_; }
 
 private:
     NewtonOptions options_;
     std::unique_ptr<cg::LinearSolver> solver_;
+    std::optional<dynamics::ReducedStepMatrix> reduced_;  // M + Δt² K on the free dofs, pattern fixed
+    const dynamics::Body* reduced_body_ = nullptr;
     NewtonResult last_;
 };
 

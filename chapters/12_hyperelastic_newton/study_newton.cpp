@@ -38,6 +38,37 @@ SlammedCube slammed_cube()
     return cube;
 }
 
+/// What one Newton step of the slammed cube did, in the tables' words.
+struct SlamOutcome {
+    std::string outcome;       ///< "converged" or "failed: …"
+    NewtonResult newton;       ///< its iterations, fallbacks and step lengths
+    double smallest_det = 0.0; ///< smallest det F of the converged step (0 if it failed)
+};
+
+/// One step of the slammed cube with `material` (Y = 1e4, ν = 0.4), the element Hessians projected
+/// by `projection`, Newton with `options` (its cap raised to 200).
+SlamOutcome slam(const SlammedCube& cube, const std::string& material, Projection projection, NewtonOptions options)
+{
+    auto model = std::make_unique<HyperelasticElasticity>(cube.scene.mesh, make_material(material, 1e4, 0.4), projection);
+    const HyperelasticElasticity& view = *model;
+    dynamics::Body body(cube.scene, std::move(model));
+    options.max_iterations = 200;
+    NewtonBackwardEuler newton(options);
+    dynamics::State state = dynamics::initial_state(body, {}, cube.v0);
+    SlamOutcome result{"converged", {}, 0.0};
+    try {
+        newton.step(body, cube.scene.time_step, state);
+        result.smallest_det = view.smallest_volume_ratio(state.u);
+    } catch (const Error& e) {
+        const std::string what = e.what();
+        result.outcome = what.find("det F") != std::string::npos               ? "failed: a tet inverted"
+                         : what.find("positive definite") != std::string::npos ? "failed: indefinite Hessian"
+                                                                               : "failed: no convergence";
+    }
+    result.newton = newton.last();
+    return result;
+}
+
 }  // namespace
 
 void newton_study(const RunContext& run, const Settings& settings)
@@ -88,28 +119,12 @@ void newton_study(const RunContext& run, const Settings& settings)
                                  Choice{"projected (absolute)", HessianChoice::definite, Projection::absolute, true},
                                  Choice{"exact", HessianChoice::exact, Projection::clamp, true},
                                  Choice{"exact, projected where needed (clamp)", HessianChoice::exact_then_definite, Projection::clamp, false}}) {
-        auto model = std::make_unique<HyperelasticElasticity>(cube.scene.mesh, make_material("neo-hookean", 1e4, 0.4),
-                                                              choice.projection);
-        const HyperelasticElasticity& view = *model;
-        dynamics::Body body(cube.scene, std::move(model));
         NewtonOptions options;
         options.hessian = choice.hessian;
         options.line_search = choice.line_search;
-        options.max_iterations = 200;
-        NewtonBackwardEuler newton(options);
-        dynamics::State state = dynamics::initial_state(body, {}, cube.v0);
-        std::string outcome = "converged";
-        try {
-            newton.step(body, cube.scene.time_step, state);
-        } catch (const Error& e) {
-            const std::string what = e.what();
-            outcome = what.find("det F") != std::string::npos        ? "failed: a tet inverted"
-                      : what.find("positive definite") != std::string::npos ? "failed: indefinite Hessian"
-                                                                            : "failed: no convergence";
-        }
-        hessians.add_row({choice.name, std::string(choice.line_search ? "Armijo" : "none (plain Newton)"), outcome,
-                          double(newton.last().iterations), double(newton.last().definite_fallbacks),
-                          outcome == "converged" ? view.smallest_volume_ratio(state.u) : 0.0});
+        const SlamOutcome step = slam(cube, "neo-hookean", choice.projection, options);
+        hessians.add_row({choice.name, std::string(choice.line_search ? "Armijo" : "none (plain Newton)"), step.outcome,
+                          double(step.newton.iterations), double(step.newton.definite_fallbacks), step.smallest_det});
     }
     hessians.print(std::cout);
     hessians.write_csv(run.file("hessian_table.csv"));
@@ -148,6 +163,63 @@ void newton_study(const RunContext& run, const Settings& settings)
     }
     tolerances.print(std::cout);
     tolerances.write_csv(run.file("tolerance_table.csv"));
+
+    // Why: neo-Hookean's log J is undefined for an inverted tet, so only a line search that rejects
+    // inverting steps (E = +∞ there) keeps it alive; the stable neo-Hookean is defined everywhere and
+    // needs no such filter. Both on the same slammed cube, with and without the line search.
+    Table inversion("Inversion on the slammed cube: neo-Hookean needs the line search's filter, stable "
+                    "neo-Hookean does not",
+                    {{"material", Format::text}, {"line search", Format::text}, {"outcome", Format::text},
+                     {"Newton iterations", Format::integer}, {"rejected trial steps", Format::integer},
+                     {"smallest det F", Format::fixed, 3}});
+    for (const std::string material : {"neo-hookean", "stable-neo-hookean"})
+        for (const bool line_search : {true, false}) {
+            NewtonOptions options;
+            options.line_search = line_search;
+            const SlamOutcome step = slam(cube, material, Projection::clamp, options);
+            int rejected = 0;  // each α < 1 took log2(1/α) halvings
+            for (const double alpha : step.newton.step_lengths)
+                rejected += static_cast<int>(std::lround(std::log2(1.0 / alpha)));
+            inversion.add_row({material, std::string(line_search ? "Armijo" : "none (plain Newton)"), step.outcome,
+                               double(step.newton.iterations), double(rejected), step.smallest_det});
+        }
+    inversion.print(std::cout);
+    inversion.write_csv(run.file("inversion_table.csv"));
+
+    // Why: as ν → ½ the material resists any change of volume, and linear tets, which can bend only
+    // by changing volume somewhere, lock: the beam sags less than its bending stiffness (Y I, with
+    // no ν in it) says. Newton itself keeps converging; the iterations and the sag show the cost.
+    Table locking("Locking: the swinging beam (stable neo-Hookean, 0.5 s) as the Poisson ratio nears 1/2",
+                  {{"Poisson ratio", Format::fixed, 3}, {"Newton iterations per step", Format::fixed, 2},
+                   {"most Newton iterations", Format::integer}, {"max tip drop [m]", Format::scientific, 3},
+                   {"tip drop / tip drop at nu = 0.3", Format::fixed, 3}, {"max |V/V0 - 1|", Format::scientific, 2}});
+    double reference_drop = 0.0;
+    for (const double poisson : {0.3, 0.45, 0.49, 0.499}) {
+        dynamics::Material material = settings.soft;
+        material.poisson_ratio = poisson;
+        const dynamics::Scene beam = dynamics::cantilever_scene(material, run.quick ? 10 : settings.swing_cells, 0.5);
+        dynamics::Body body(beam, force_model("stable-neo-hookean", beam));
+        NewtonBackwardEuler newton;
+        dynamics::Simulation simulation(body, newton, dynamics::initial_state(body), beam.time_step);
+        const int tip = dynamics::far_corner(beam.mesh);
+        const double rest_volume = total_volume(beam.mesh);
+        double drop = 0.0, volume_change = 0.0, mean = 0.0;
+        int most = 0;
+        simulation.run(dynamics::step_count(beam.duration, beam.time_step),
+                       [&](const dynamics::State& state, const dynamics::StepRecord& record) {
+                           const MatrixX3d x = body.positions(state.u);
+                           drop = std::max(drop, beam.mesh.V(tip, 2) - x(tip, 2));
+                           volume_change = std::max(volume_change, std::abs(total_volume(TetMesh{x, beam.mesh.T}) / rest_volume - 1.0));
+                           mean += record.newton_iterations;
+                           most = std::max(most, record.newton_iterations);
+                       });
+        if (poisson == 0.3)
+            reference_drop = drop;
+        locking.add_row({poisson, mean / dynamics::step_count(beam.duration, beam.time_step), double(most), drop,
+                         drop / reference_drop, volume_change});
+    }
+    locking.print(std::cout);
+    locking.write_csv(run.file("locking_table.csv"));
 }
 
 }  // namespace fem::hyper::study

@@ -262,6 +262,8 @@ struct SparseCholesky::Impl {
             C_lower.rows = C_lower.cols = C_upper.cols;
             sparse::transpose_compressed(sparse::view(C_upper), C_lower.A, C_lower.IA, C_lower.JA);
             supernodal->factorize(C_lower);
+            if (options.single_precision_copy)
+                supernodal->round_to_single();
         }
         times.numeric = timer.seconds();
     }
@@ -376,6 +378,28 @@ Eigen::MatrixXd SparseCholesky::solve_many(const Eigen::MatrixXd& B) const
     for (int k = 0; k < n; ++k)
         result.row(perm[k]) = X.row(k);  // x = Pᵀ z
     return result;
+}
+
+Eigen::VectorXd SparseCholesky::solve_single_precision(const Eigen::VectorXd& b) const
+{
+    const Impl& m = *impl_;
+    const int n = m.symbolic.n;
+    if (!m.supernodal || !m.options.single_precision_copy)
+        throw Error("sparse Cholesky: single-precision solves need the supernodal factorization with "
+                    "single_precision_copy set");
+    if (b.size() != n)
+        throw Error(str("sparse Cholesky: the right-hand side has ", b.size(), " rows, the matrix ", n));
+    if (!b.allFinite())
+        throw Error("sparse Cholesky: the right-hand side has a non-finite entry");
+    const Permutation& perm = m.symbolic.perm;
+    Eigen::VectorXf z(n);
+    for (int k = 0; k < n; ++k)
+        z[k] = static_cast<float>(b[perm[k]]);  // P b
+    m.supernodal->solve_in_place_single(z);
+    Eigen::VectorXd x(n);
+    for (int k = 0; k < n; ++k)
+        x[perm[k]] = z[k];  // x = Pᵀ z
+    return x;
 }
 
 Eigen::VectorXd SparseCholesky::solve(const Eigen::VectorXd& b) const

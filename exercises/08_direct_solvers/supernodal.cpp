@@ -406,6 +406,7 @@ void SupernodalCholesky::factorize(const sparse::CscMatrix& C_lower)
         throw Error(str("supernodal factorization: the matrix is ", C_lower.rows, "×", C_lower.cols,
                         ", the analysis was for ", n, "×", n));
     factored_ = false;
+    single_values_.clear();
     const int S = supernodes();
     // Sizes of the work areas: the largest update matrix, and the peak of the update stack.
     long long largest_update = 0, peak_stack = 0;
@@ -504,48 +505,75 @@ void SupernodalCholesky::factorize(const sparse::CscMatrix& C_lower)
     factored_ = true;
 }
 
+template <class Scalar>
+void SupernodalCholesky::solve_vector(const Scalar* values, Scalar* x) const
+{
+    // One right-hand side: triangular solves and matrix-vector products on plain vectors.
+    using Vector = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;
+    using Block = Eigen::Map<const Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>, 0, Eigen::OuterStride<>>;
+    const int S = supernodes();
+    int largest = 0;
+    for (int s = 0; s < S; ++s)
+        largest = std::max(largest, rows(s) - (first_[s + 1] - first_[s]));
+    Vector work(largest);
+    for (int s = 0; s < S; ++s) {  // forward: L y = b
+        const int f = first_[s], ns = first_[s + 1] - f, m = rows(s), r = m - ns;
+        const Block L(values + value_start_[s], m, ns, Eigen::OuterStride<>(m));
+        Eigen::Map<Vector> xs(x + f, ns);
+        L.topRows(ns).template triangularView<Eigen::Lower>().solveInPlace(xs);
+        if (r > 0) {
+            auto t = work.head(r);
+            t.noalias() = L.bottomRows(r) * xs;
+            const int* const below = rows_.data() + row_start_[s] + ns;
+            for (int i = 0; i < r; ++i)
+                x[below[i]] -= t[i];
+        }
+    }
+    for (int s = S - 1; s >= 0; --s) {  // backward: Lᵀ x = y
+        const int f = first_[s], ns = first_[s + 1] - f, m = rows(s), r = m - ns;
+        const Block L(values + value_start_[s], m, ns, Eigen::OuterStride<>(m));
+        Eigen::Map<Vector> xs(x + f, ns);
+        if (r > 0) {
+            auto t = work.head(r);
+            const int* const below = rows_.data() + row_start_[s] + ns;
+            for (int i = 0; i < r; ++i)
+                t[i] = x[below[i]];
+            xs.noalias() -= L.bottomRows(r).transpose() * t;
+        }
+        L.topRows(ns).template triangularView<Eigen::Lower>().transpose().solveInPlace(xs);
+    }
+}
+
+void SupernodalCholesky::round_to_single()
+{
+    if (!factored_)
+        throw Error("supernodal factorization: round_to_single() before factorize()");
+    single_values_.assign(values_.begin(), values_.end());
+}
+
+void SupernodalCholesky::solve_in_place_single(Eigen::Ref<Eigen::VectorXf> x) const
+{
+    if (!factored_ || single_values_.size() != values_.size())
+        throw Error("supernodal solve: no single-precision factor (call round_to_single() after factorize())");
+    if (x.size() != n_)
+        throw Error(str("supernodal solve: the right-hand side has ", x.size(), " rows, the matrix ", n_));
+    solve_vector(single_values_.data(), x.data());
+}
+
 void SupernodalCholesky::solve_in_place(Eigen::Ref<Eigen::MatrixXd> X) const
 {
     if (!factored_)
         throw Error("supernodal solve: the matrix has not been factored (or its factorization failed)");
     if (X.rows() != n_)
         throw Error(str("supernodal solve: the right-hand side has ", X.rows(), " rows, the matrix ", n_));
+    if (X.cols() == 1) {
+        solve_vector(values_.data(), X.data());
+        return;
+    }
     const int S = supernodes();
     int largest = 0;
     for (int s = 0; s < S; ++s)
         largest = std::max(largest, rows(s) - (first_[s + 1] - first_[s]));
-    if (X.cols() == 1) {
-        // One right-hand side: triangular solves and matrix-vector products on plain vectors.
-        Eigen::VectorXd work(largest);
-        double* const x = X.data();
-        for (int s = 0; s < S; ++s) {  // forward: L y = b
-            const int f = first_[s], ns = first_[s + 1] - f, m = rows(s), r = m - ns;
-            const ConstBlock L(values_.data() + value_start_[s], m, ns, Eigen::OuterStride<>(m));
-            Eigen::Map<Eigen::VectorXd> xs(x + f, ns);
-            L.topRows(ns).triangularView<Eigen::Lower>().solveInPlace(xs);
-            if (r > 0) {
-                auto t = work.head(r);
-                t.noalias() = L.bottomRows(r) * xs;
-                const int* const below = rows_.data() + row_start_[s] + ns;
-                for (int i = 0; i < r; ++i)
-                    x[below[i]] -= t[i];
-            }
-        }
-        for (int s = S - 1; s >= 0; --s) {  // backward: Lᵀ x = y
-            const int f = first_[s], ns = first_[s + 1] - f, m = rows(s), r = m - ns;
-            const ConstBlock L(values_.data() + value_start_[s], m, ns, Eigen::OuterStride<>(m));
-            Eigen::Map<Eigen::VectorXd> xs(x + f, ns);
-            if (r > 0) {
-                auto t = work.head(r);
-                const int* const below = rows_.data() + row_start_[s] + ns;
-                for (int i = 0; i < r; ++i)
-                    t[i] = x[below[i]];
-                xs.noalias() -= L.bottomRows(r).transpose() * t;
-            }
-            L.topRows(ns).triangularView<Eigen::Lower>().transpose().solveInPlace(xs);
-        }
-        return;
-    }
     Eigen::MatrixXd work(largest, X.cols());
     for (int s = 0; s < S; ++s) {  // forward: L Y = B
         const int f = first_[s], ns = first_[s + 1] - f, m = rows(s), r = m - ns;

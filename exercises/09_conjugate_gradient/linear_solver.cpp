@@ -28,6 +28,15 @@
 namespace fem::cg {
 namespace {
 
+/// fem::Error naming `who` unless τ lies in (0, 1) and the cap is ≥ 0.
+void require_valid(const SolverOptions& options, const std::string& who)
+{
+    if (!(options.relative_tolerance > 0.0 && options.relative_tolerance < 1.0))
+        throw Error(str(who, ": the relative tolerance must lie in (0, 1), got ", options.relative_tolerance));
+    if (options.max_iterations < 0)
+        throw Error(str(who, ": the iteration cap must be ≥ 0 (0: the default), got ", options.max_iterations));
+}
+
 using SparseMatrix = Eigen::SparseMatrix<double>;
 
 /// fem::Error unless A is square, not empty and finite; returns max |A_ij|.
@@ -132,12 +141,7 @@ private:
 class OursCg final : public LinearSolver {
 public:
     enum class Kind { plain, jacobi, ic0 };
-    OursCg(std::string name, Kind kind, const SolverOptions& options)
-        : LinearSolver(std::move(name)), kind_(kind)
-    {
-        settings_.relative_tolerance = options.relative_tolerance;
-        settings_.max_iterations = options.max_iterations;
-    }
+    OursCg(std::string name, Kind kind, const SolverOptions& options) : LinearSolver(std::move(name), options), kind_(kind) {}
     bool is_direct() const override { return false; }
 
 private:
@@ -153,15 +157,17 @@ private:
     }
     int do_solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) override
     {
+        CgSettings settings;
+        settings.relative_tolerance = options().relative_tolerance;
+        settings.max_iterations = options().max_iterations;
         const CgResult result = preconditioner_
-                                    ? preconditioned_conjugate_gradient(*operator_, *preconditioner_, b, x, settings_)
-                                    : conjugate_gradient(*operator_, b, x, settings_);
-        require_converged(name(), result.iterations, result.residual_history.back(), settings_.relative_tolerance,
+                                    ? preconditioned_conjugate_gradient(*operator_, *preconditioner_, b, x, settings)
+                                    : conjugate_gradient(*operator_, b, x, settings);
+        require_converged(name(), result.iterations, result.residual_history.back(), settings.relative_tolerance,
                           result.converged);
         return result.iterations;
     }
     Kind kind_;
-    CgSettings settings_;
     std::optional<SymmetricCsrOperator> operator_;
     std::unique_ptr<LinearOperator> preconditioner_;
 };
@@ -205,27 +211,26 @@ private:
 
 class EigenCg final : public LinearSolver {
 public:
-    explicit EigenCg(const SolverOptions& options) : LinearSolver("eigen-cg"), options_(options) {}
+    explicit EigenCg(const SolverOptions& options) : LinearSolver("eigen-cg", options) {}
     bool is_direct() const override { return false; }
 
 private:
     void do_prepare(const SparseMatrix& A, bool) override
     {
-        cg_.setTolerance(options_.relative_tolerance);
-        if (options_.max_iterations > 0)
-            cg_.setMaxIterations(options_.max_iterations);
+        if (options().max_iterations > 0)
+            cg_.setMaxIterations(options().max_iterations);
         else
             cg_.setMaxIterations(iteration_cap_per_unknown * A.rows());
         cg_.compute(A);
     }
     int do_solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) override
     {
+        cg_.setTolerance(options().relative_tolerance);
         x = cg_.solveWithGuess(b, x);
-        require_converged(name(), static_cast<int>(cg_.iterations()), cg_.error(), options_.relative_tolerance,
+        require_converged(name(), static_cast<int>(cg_.iterations()), cg_.error(), options().relative_tolerance,
                           cg_.info() == Eigen::Success);
         return static_cast<int>(cg_.iterations());
     }
-    SolverOptions options_;
     Eigen::ConjugateGradient<SparseMatrix> cg_;
 };
 
@@ -237,6 +242,19 @@ const std::vector<std::string>& all_names()
 }
 
 }  // namespace
+
+LinearSolver::LinearSolver(std::string name, const SolverOptions& options) : name_(std::move(name)), options_(options)
+{
+    require_valid(options, name_);
+}
+
+void LinearSolver::set_relative_tolerance(double tolerance)
+{
+    SolverOptions changed = options_;
+    changed.relative_tolerance = tolerance;
+    require_valid(changed, name_);
+    options_ = changed;
+}
 
 void LinearSolver::prepare(const Eigen::SparseMatrix<double>& A)
 {
@@ -287,10 +305,7 @@ void LinearSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x)
 
 std::unique_ptr<LinearSolver> make_solver(std::string_view name, const SolverOptions& options)
 {
-    if (!(options.relative_tolerance > 0.0 && options.relative_tolerance < 1.0))
-        throw Error(str("make_solver: the relative tolerance must lie in (0, 1), got ", options.relative_tolerance));
-    if (options.max_iterations < 0)
-        throw Error(str("make_solver: the iteration cap must be ≥ 0 (0: the default), got ", options.max_iterations));
+    require_valid(options, "make_solver");
     const std::string resolved = name == "default" ? default_solver_name() : std::string(name);
     if (resolved == "ours-cholesky")
         return std::make_unique<OursCholesky>();

@@ -143,10 +143,14 @@ CorotationalElasticity::CorotationalElasticity(const TetMesh& mesh, const dynami
                                                PolarAlgorithm algorithm)
     : mesh_(mesh), lame_(elastic::lame_parameters(material.youngs_modulus, material.poisson_ratio)), fit_(fit),
       algorithm_(algorithm), K_e_(assembly::element_stiffnesses(mesh, lame_)), pattern_(mesh),
-      K_R_csr_(pattern_.zero_matrix()), volumes_(mesh.T.rows())
+      K_R_(assembly::csc_of_symmetric(pattern_.zero_matrix())), volumes_(mesh.T.rows()),
+      rest_edges_inverse_(static_cast<std::size_t>(mesh.T.rows()))
 {
-    for (Eigen::Index t = 0; t < mesh.T.rows(); ++t)
+    for (Eigen::Index t = 0; t < mesh.T.rows(); ++t) {
         volumes_[t] = std::abs(tet_signed_volume6(mesh, static_cast<int>(t))) / 6.0;
+        rest_edges_inverse_[static_cast<std::size_t>(t)] =
+            tet::edge_matrix(tet::tet_vertices(mesh, mesh.V, static_cast<int>(t))).inverse();
+    }
 }
 
 std::vector<Eigen::Matrix3d> CorotationalElasticity::rotations(const Eigen::VectorXd& u) const
@@ -161,7 +165,8 @@ std::vector<Eigen::Matrix3d> CorotationalElasticity::rotations(const Eigen::Vect
         Eigen::Matrix3d& R_t = R[static_cast<std::size_t>(t)];
         switch (fit_) {
         case RotationFit::polar: {
-            const Eigen::Matrix3d F = tet::deformation_gradient(rest, now);
+            // F = T_x T_X⁻¹ (chapter 04's deformation_gradient, with the rest inverse kept)
+            const Eigen::Matrix3d F = tet::edge_matrix(now) * rest_edges_inverse_[static_cast<std::size_t>(t)];
             R_t = algorithm_ == PolarAlgorithm::newton ? polar_rotation_newton(F) : polar_rotation(F);
             break;
         }
@@ -204,11 +209,13 @@ double CorotationalElasticity::evaluate(const Eigen::VectorXd& u, Eigen::VectorX
         const Matrix12d& K = K_e_[static_cast<std::size_t>(t)];
         const Vector12d x_e = element_vector(mesh_, x, t), X_e = element_vector(mesh_, mesh_.V, t);
         const Eigen::Matrix3d& R_t = R[static_cast<std::size_t>(t)];
-        const Vector12d d = corotated_displacement(R_t, x_e, X_e);
-        energy += 0.5 * d.dot(K * d);  // U_e = ½ dᵀ K_e d
         const Vector12d f_e = corotated_force(K, R_t, x_e, X_e);
-        for (int i = 0; i < 4; ++i)
+        // U_e = ½ dᵀ K_e d = −½ Σᵢ (R dᵢ)·f_e,i, since f_e,i = −R (K_e d)ᵢ: no second product with K_e
+        const Vector12d d = corotated_displacement(R_t, x_e, X_e);
+        for (int i = 0; i < 4; ++i) {
+            energy -= 0.5 * (R_t * d.segment<3>(3 * i)).dot(f_e.segment<3>(3 * i));
             forces.segment<3>(3 * mesh_.T(t, i)) += f_e.segment<3>(3 * i);
+        }
     }
     return energy;
 }
@@ -216,13 +223,14 @@ double CorotationalElasticity::evaluate(const Eigen::VectorXd& u, Eigen::VectorX
 const dynamics::SparseMatrix& CorotationalElasticity::stiffness(const Eigen::VectorXd& u)
 {
     const std::vector<Eigen::Matrix3d>& R = rotations_at(u);
-    double* values = K_R_csr_.valuePtr();
-    std::fill(values, values + K_R_csr_.nonZeros(), 0.0);
+    // K_R_ is a CSC copy of the pattern's CSR arrays (csc_of_symmetric): for a symmetric matrix
+    // the two layouts coincide, so the pattern's offsets address K_R_'s values directly.
+    double* values = K_R_.valuePtr();
+    std::fill(values, values + K_R_.nonZeros(), 0.0);
     // EXERCISE 11.6 (warped_stiffness): see docs/11_corotational.md#forces-and-warped-stiffness
     // HINT: per tet t, rotated_stiffness(K_e_[t], R[t]) added into the fixed pattern's values by
     // HINT: pattern_.add_element (chapter 06's route c, one element at a time: nothing stored).
     throw fem::NotImplemented("11.6", "warped_stiffness", "docs/11_corotational.md#forces-and-warped-stiffness");
-    K_R_ = assembly::csc_of_symmetric(K_R_csr_);
     return K_R_;
 }
 

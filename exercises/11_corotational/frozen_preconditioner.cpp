@@ -5,18 +5,19 @@
 #include "09_conjugate_gradient/conjugate_gradient.hpp"
 #include "09_conjugate_gradient/linear_operator.hpp"
 
+#include "07_sparse_storage/sparse_formats.hpp"
+
 #include "common/error.hpp"
 
 namespace fem::corot {
 
-FrozenFactorPcg::FrozenFactorPcg(const cg::SolverOptions& options, int refresh_iterations, BlockRotations rotations)
-    : cg::LinearSolver(rotations ? "rotated-frozen-cholesky-pcg" : "frozen-cholesky-pcg"), options_(options),
-      refresh_iterations_(refresh_iterations), rotations_(std::move(rotations))
+FrozenFactorPcg::FrozenFactorPcg(const cg::SolverOptions& options, int refresh_iterations, BlockRotations rotations,
+                                 FactorPrecision precision)
+    : cg::LinearSolver(rotations ? "rotated-frozen-cholesky-pcg" : "frozen-cholesky-pcg", options),
+      refresh_iterations_(refresh_iterations), rotations_(std::move(rotations)), precision_(precision)
 {
-    if (!(options.relative_tolerance > 0.0 && options.relative_tolerance < 1.0))
-        throw Error(str(name(), ": the tolerance must lie in (0, 1), got ", options.relative_tolerance));
-    if (options.max_iterations < 0 || refresh_iterations < 0)
-        throw Error(str(name(), ": the iteration cap and the refresh count must be >= 0"));
+    if (refresh_iterations < 0)
+        throw Error(str(name(), ": the refresh count must be >= 0, got ", refresh_iterations));
 }
 
 void FrozenFactorPcg::do_prepare(const Eigen::SparseMatrix<double>& A, bool same_pattern)
@@ -30,7 +31,13 @@ void FrozenFactorPcg::do_prepare(const Eigen::SparseMatrix<double>& A, bool same
                             " matrix; expected one per 3 unknowns"));
     }
     if (refresh_ || !same_pattern || !factor_) {
-        factor_.emplace(A);
+        if (factor_ && same_pattern) {
+            factor_->factorize(sparse::csc_from_eigen(A));  // the ordering and analysis are kept
+        } else {
+            direct::CholeskyOptions factor_options;
+            factor_options.single_precision_copy = precision_ == FactorPrecision::single_precision;
+            factor_.emplace(A, factor_options);
+        }
         ++factorizations_;
         refresh_ = false;
         frozen_rotations_ = current;
@@ -40,20 +47,25 @@ void FrozenFactorPcg::do_prepare(const Eigen::SparseMatrix<double>& A, bool same
         turn_[i] = current[i] * frozen_rotations_[i].transpose();
 }
 
+Eigen::VectorXd FrozenFactorPcg::apply_factor(const Eigen::VectorXd& r) const
+{
+    return precision_ == FactorPrecision::single_precision ? factor_->solve_single_precision(r) : factor_->solve(r);
+}
+
 int FrozenFactorPcg::do_solve(const Eigen::VectorXd& b, Eigen::VectorXd& x)
 {
     cg::CgSettings settings;
-    settings.relative_tolerance = options_.relative_tolerance;
-    settings.max_iterations = options_.max_iterations;
+    settings.relative_tolerance = options().relative_tolerance;
+    settings.max_iterations = options().max_iterations;
     cg::CgResult result;
     // EXERCISE 11.7 (frozen_factor_pcg): see docs/11_corotational.md#solving-a-changing-matrix
     // HINT: chapter 09's preconditioned_conjugate_gradient on the current matrix (cg::EigenOperator of
     // HINT: *A_) from x, with a cg::FunctionOperator preconditioner that applies the frozen factor,
     // HINT: turned by the blocks' rotations when there are any: z = Q A₀⁻¹ Qᵀ r (turn_[i] = Qᵢ),
-    // HINT: else z = factor_->solve(r).
+    // HINT: else z = apply_factor(r) (A₀⁻¹ r in the factor's precision).
     throw fem::NotImplemented("11.7", "frozen_factor_pcg", "docs/11_corotational.md#solving-a-changing-matrix");
     if (!result.converged)
-        throw Error(str(name(), ": CG missed its tolerance ", options_.relative_tolerance, " within ",
+        throw Error(str(name(), ": CG missed its tolerance ", options().relative_tolerance, " within ",
                         result.iterations, " iterations"));
     if (refresh_iterations_ > 0 && result.iterations > refresh_iterations_)
         refresh_ = true;  // the next prepare() factors the current matrix

@@ -41,7 +41,7 @@ Matrix12d element_hessian(const Material& material, double volume, const tet::Ja
 HyperelasticElasticity::HyperelasticElasticity(const TetMesh& mesh, std::unique_ptr<Material> material,
                                                Projection projection)
     : mesh_(mesh), material_(std::move(material)), projection_(projection), volumes_(mesh.T.rows()), pattern_(mesh),
-      K_csr_(pattern_.zero_matrix())
+      K_(assembly::csc_of_symmetric(pattern_.zero_matrix()))
 {
     if (!material_)
         throw Error("HyperelasticElasticity: no material");
@@ -115,13 +115,14 @@ const dynamics::SparseMatrix& HyperelasticElasticity::assemble_hessian(const Eig
                                                                        std::optional<Projection> projection)
 {
     const MatrixX3d x = displacement_rows(u);
-    double* values = K_csr_.valuePtr();
-    std::fill(values, values + K_csr_.nonZeros(), 0.0);
+    // K_ is a CSC copy of the pattern's CSR arrays (csc_of_symmetric): for a symmetric matrix the
+    // two layouts coincide, so the pattern's offsets address K_'s values directly.
+    double* values = K_.valuePtr();
+    std::fill(values, values + K_.nonZeros(), 0.0);
     for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t)
         pattern_.add_element(t, element_hessian(*material_, volumes_[t], B_[static_cast<std::size_t>(t)],
                                                 displacement_gradient(x, t), projection),
                              values);
-    K_ = assembly::csc_of_symmetric(K_csr_);
     return K_;
 }
 

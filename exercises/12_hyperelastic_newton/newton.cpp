@@ -58,8 +58,11 @@ double momentum_scale(const dynamics::Body& body, const dynamics::State& state, 
 }
 
 NewtonBackwardEuler::NewtonBackwardEuler(NewtonOptions options)
-    : options_(std::move(options)), solver_(cg::make_solver(options_.solver))
+    : options_(std::move(options)),
+      solver_(options_.make_solver ? options_.make_solver() : cg::make_solver(options_.solver))
 {
+    if (!solver_)
+        throw Error("Newton: the solver factory of the options returned no solver");
     const auto require_in = [](double value, double low, double high, const char* what) {
         if (!(value > low && value < high))
             throw Error(str("Newton: ", what, " must lie in (", low, ", ", high, "), got ", value));
@@ -68,6 +71,8 @@ NewtonBackwardEuler::NewtonBackwardEuler(NewtonOptions options)
     require_in(options_.armijo, 0.0, 0.5, "the Armijo constant c");
     require_in(options_.shrink, 0.0, 1.0, "the shrink factor");
     require_in(options_.smallest_step, 0.0, 1.0, "the smallest step");
+    if (!(options_.forcing >= 0.0 && options_.forcing < 1.0))
+        throw Error(str("Newton: the forcing term must lie in [0, 1), got ", options_.forcing));
     if (options_.max_iterations < 1)
         throw Error(str("Newton: the iteration cap must be >= 1, got ", options_.max_iterations));
 }
@@ -100,12 +105,22 @@ NewtonResult newton_minimize(const NewtonProblem& problem, Eigen::VectorXd x0, c
     NewtonResult result;
     result.x = std::move(x0);
     Eigen::VectorXd& x = result.x;
+    // Inexact Newton: an iterative solver's tolerance follows the gradient, never below its own.
+    const double solver_tolerance = solver.options().relative_tolerance;
+    const struct Restore {
+        cg::LinearSolver& solver;
+        double tolerance;
+        ~Restore() { solver.set_relative_tolerance(tolerance); }
+    } restore{solver, solver_tolerance};
     for (int iteration = 0;; ++iteration) {
         const Eigen::VectorXd gradient = problem.gradient(x);
         const double norm = gradient.norm();
-        result.gradient_history.push_back(problem.scale > 0.0 ? norm / problem.scale : norm);
+        const double relative = problem.scale > 0.0 ? norm / problem.scale : norm;
+        result.gradient_history.push_back(relative);
         if (norm <= options.relative_tolerance * problem.scale)
             return result;
+        if (options.forcing > 0.0)
+            solver.set_relative_tolerance(std::max(solver_tolerance, std::min(options.forcing, relative)));
         if (iteration == options.max_iterations)
             throw Error(str("Newton: ", problem.what, " did not converge in ", options.max_iterations,
                             " iterations: |gradient| / scale = ", norm / problem.scale, " (tolerance ",
@@ -195,7 +210,12 @@ dynamics::StepInfo NewtonBackwardEuler::step(dynamics::Body& body, double time_s
     problem.hessian = [&](const Eigen::VectorXd& x, bool definite) {
         const Eigen::VectorXd u = state.u + time_step * full(x);
         const dynamics::SparseMatrix& K = definite ? body.model().definite_stiffness(u) : body.model().stiffness(u);
-        return dofs.reduce(dynamics::step_matrix(body.mass_matrix(), K, dynamics::Damping{}, time_step, 1.0));
+        const dynamics::SparseMatrix& M = body.mass_matrix();
+        if (!reduced_ || reduced_body_ != &body || !reduced_->fits(M, K)) {
+            reduced_.emplace(M, K, dofs);
+            reduced_body_ = &body;
+        }
+        return reduced_->assemble(M, K, dynamics::Damping{}, time_step, 1.0);
     };
     problem.scale = momentum_scale(body, state, time_step);
     problem.what = str("step ", state.step + 1, " (t = ", state.time + time_step, " s)");

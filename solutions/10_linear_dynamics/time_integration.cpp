@@ -2,6 +2,7 @@
 
 #include "common/error.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace fem::dynamics {
@@ -103,6 +104,91 @@ SparseMatrix step_matrix(const SparseMatrix& M, const SparseMatrix& K, const Dam
     // END EXERCISE
 }
 
+// --- ReducedStepMatrix --------------------------------------------------------------------------
+
+ReducedStepMatrix::Pattern::Pattern(const SparseMatrix& A)
+{
+    if (!A.isCompressed())
+        throw Error("ReducedStepMatrix: the matrices must be compressed");
+    outer.assign(A.outerIndexPtr(), A.outerIndexPtr() + A.outerSize() + 1);
+    inner.assign(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros());
+}
+
+bool ReducedStepMatrix::Pattern::matches(const SparseMatrix& A) const
+{
+    return A.isCompressed() && static_cast<std::size_t>(A.outerSize()) + 1 == outer.size() &&
+           static_cast<std::size_t>(A.nonZeros()) == inner.size() &&
+           std::equal(outer.begin(), outer.end(), A.outerIndexPtr()) &&
+           std::equal(inner.begin(), inner.end(), A.innerIndexPtr());
+}
+
+ReducedStepMatrix::ReducedStepMatrix(const SparseMatrix& M, const SparseMatrix& K, const FreeDofs& dofs)
+    : M_pattern_(M), K_pattern_(K)
+{
+    const Eigen::Index n = dofs.full_size();
+    if (M.rows() != n || M.cols() != n || K.rows() != n || K.cols() != n)
+        throw Error(str("ReducedStepMatrix: M (", M.rows(), "x", M.cols(), ") and K (", K.rows(), "x", K.cols(),
+                        ") must both be ", n, "x", n));
+    // The pattern: reduce the pattern of M + K (ones, so that no entry cancels).
+    SparseMatrix ones_M = M, ones_K = K;
+    ones_M.coeffs().setOnes();
+    ones_K.coeffs().setOnes();
+    A_ = dofs.reduce(SparseMatrix(ones_M + ones_K));
+    A_.makeCompressed();
+    // Where each entry of M and K lands: column j of the input is free column renumbered[j], and
+    // its row i lands in that column at row renumbered[i] (found by binary search once).
+    std::vector<int> renumbered(static_cast<std::size_t>(n), -1);
+    for (std::size_t f = 0; f < dofs.indices().size(); ++f)
+        renumbered[static_cast<std::size_t>(dofs.indices()[f])] = static_cast<int>(f);
+    const auto slots = [&](const SparseMatrix& B) {
+        std::vector<Eigen::Index> slot(static_cast<std::size_t>(B.nonZeros()), -1);
+        for (Eigen::Index j = 0; j < n; ++j) {
+            const int column = renumbered[static_cast<std::size_t>(j)];
+            if (column < 0)
+                continue;
+            const int* first = A_.innerIndexPtr() + A_.outerIndexPtr()[column];
+            const int* last = A_.innerIndexPtr() + A_.outerIndexPtr()[column + 1];
+            for (Eigen::Index k = B.outerIndexPtr()[j]; k < B.outerIndexPtr()[j + 1]; ++k)
+                if (const int row = renumbered[static_cast<std::size_t>(B.innerIndexPtr()[k])]; row >= 0)
+                    slot[static_cast<std::size_t>(k)] = std::lower_bound(first, last, row) - A_.innerIndexPtr();
+        }
+        return slot;
+    };
+    M_slot_ = slots(M);
+    K_slot_ = slots(K);
+}
+
+bool ReducedStepMatrix::fits(const SparseMatrix& M, const SparseMatrix& K) const
+{
+    return M_pattern_.matches(M) && K_pattern_.matches(K);
+}
+
+const SparseMatrix& ReducedStepMatrix::assemble(const SparseMatrix& M, const SparseMatrix& K, double a, double k)
+{
+    if (!fits(M, K))
+        throw Error("ReducedStepMatrix: M or K no longer has the pattern the step matrix was built for");
+    double* values = A_.valuePtr();
+    std::fill(values, values + A_.nonZeros(), 0.0);
+    const auto add = [values](const SparseMatrix& B, const std::vector<Eigen::Index>& slot, double weight) {
+        const double* b = B.valuePtr();
+        for (std::size_t e = 0; e < slot.size(); ++e)
+            if (slot[e] >= 0)
+                values[slot[e]] += weight * b[e];
+    };
+    add(M, M_slot_, a);
+    add(K, K_slot_, k);
+    return A_;
+}
+
+const SparseMatrix& ReducedStepMatrix::assemble(const SparseMatrix& M, const SparseMatrix& K, const Damping& damping,
+                                                double time_step, double theta)
+{
+    require_positive(time_step, "time step dt [s]");
+    require_theta(theta);
+    const double h = theta * time_step;
+    return assemble(M, K, 1.0 + h * damping.alpha, h * damping.beta + h * h);
+}
+
 Eigen::VectorXd step_right_hand_side(const SparseMatrix& M, const Eigen::VectorXd& v, const Eigen::VectorXd& forces,
                                      const Eigen::VectorXd& external_forces, double time_step)
 {
@@ -163,8 +249,13 @@ StepInfo ThetaMethod::step(Body& body, double time_step, State& state)
 
     if (solver_->size() == 0 || options_.refactor_every_step || !model.constant_stiffness() ||
         time_step != prepared_time_step_ || &body != prepared_body_) {
-        const SparseMatrix A = step_matrix(M, K, body.scene().damping, time_step, theta_);
-        solver_->prepare(eliminate ? dofs.reduce(A) : dofs.project(A));
+        if (eliminate) {
+            if (!reduced_ || prepared_body_ != &body || !reduced_->fits(M, K))
+                reduced_.emplace(M, K, dofs);
+            solver_->prepare(reduced_->assemble(M, K, body.scene().damping, time_step, theta_));
+        } else {
+            solver_->prepare(dofs.project(step_matrix(M, K, body.scene().damping, time_step, theta_)));
+        }
         prepared_time_step_ = time_step;
         prepared_body_ = &body;
         info.prepared = true;

@@ -257,3 +257,30 @@ TEST_CASE("supernodes: fundamental ones follow the column counts, and relaxed on
     }
     CHECK(lower == S.nonzeros);
 }
+
+TEST_CASE("single-precision solves: float's accuracy for a preconditioner, refused without the copy", "[ex08.7]")
+{
+    // An elastic box's stiffness (κ about 1e4) plus a mass-like shift: what chapter 11 factors.
+    sparse::CscMatrix A = box_stiffness(4, rubber);
+    const Eigen::SparseMatrix<double> E = sparse::to_eigen(A);
+    CholeskyOptions options;
+    options.single_precision_copy = true;
+    SparseCholesky chol(A, options);
+    const Eigen::VectorXd b = random_vector(A.rows, 21);
+    const Eigen::VectorXd exact = chol.solve(b), rounded = chol.solve_single_precision(b);
+    // float rounds to 6e-8; the error grows with the conditioning, far below a preconditioner's needs
+    const double error = (rounded - exact).norm() / exact.norm();
+    CAPTURE(error);
+    CHECK(error > 1e-12);  // not double's accuracy: the substitutions ran in float
+    CHECK(error <= 1e-5);
+    // A new factorization refreshes the copy.
+    for (double& v : A.A)
+        v *= 2.0;
+    chol.factorize(A);
+    CHECK((chol.solve_single_precision(b) - 0.5 * rounded).norm() <= 1e-3 * rounded.norm());
+    const SparseCholesky without(A);
+    CHECK_THROWS_WITH(without.solve_single_precision(b), Contains("single_precision_copy"));
+    const SparseCholesky up_looking(A, {Ordering::nested_dissection, Factorization::up_looking, true});
+    CHECK_THROWS_WITH(up_looking.solve_single_precision(b), Contains("supernodal"));
+    CHECK_THROWS_AS(chol.solve_single_precision(b.head(3)), fem::Error);
+}

@@ -167,3 +167,31 @@ TEST_CASE("prepare again with new values on the same pattern", "[ex09.5]")
         CHECK(solver->solve(Eigen::VectorXd::Ones(36)).allFinite());
     }
 }
+
+TEST_CASE("the tolerance of an iterative solver can change between solves (inexact Newton's need)", "[ex09.5]")
+{
+    const Eigen::SparseMatrix<double> A = fem::sparse::to_eigen(fem::direct::laplacian_2d(30));
+    const Eigen::VectorXd b = random_vector(A.rows(), 8u);
+    for (const char* name : {"ours-cg", "ours-pcg-jacobi", "ours-pcg-ic0", "eigen-cg"}) {
+        CAPTURE(name);
+        const std::unique_ptr<LinearSolver> solver = make_solver(name);
+        solver->prepare(A);
+        std::vector<int> iterations;
+        for (const double tolerance : {1e-2, 1e-5, 1e-10}) {
+            solver->set_relative_tolerance(tolerance);
+            CHECK(solver->options().relative_tolerance == tolerance);
+            (void)solver->solve(b);
+            CHECK(solver->stats().relative_residual <= 1.01 * tolerance);
+            iterations.push_back(solver->stats().iterations);
+        }
+        CHECK(iterations[0] < iterations[1]);
+        CHECK(iterations[1] < iterations[2]);
+        CHECK_THROWS_WITH(solver->set_relative_tolerance(1.0), Contains("(0, 1)"));
+        CHECK_THROWS_AS(solver->set_relative_tolerance(std::nan("")), fem::Error);
+        CHECK(solver->options().relative_tolerance == 1e-10);  // a refused value changes nothing
+    }
+    const std::unique_ptr<LinearSolver> direct = make_solver("ours-cholesky");
+    direct->prepare(A);
+    direct->set_relative_tolerance(1e-2);  // ignored: a factorization solves exactly
+    CHECK(relative_error(A * direct->solve(b), b) <= 1e-12);
+}

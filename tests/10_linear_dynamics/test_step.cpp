@@ -143,3 +143,35 @@ TEST_CASE("free dofs: gather, scatter, reduce and the kept-dofs projection agree
     CHECK_THROWS_AS(dofs.gather(q.head(5)), fem::Error);
     CHECK_THROWS_AS(FreeDofs(4, {0, 4}), fem::Error);
 }
+
+TEST_CASE("reduced step matrix: P^T (a M + k K) P refilled in one fixed pattern, and refused for another",
+          "[ch10]")
+{
+    Scene scene = cantilever_scene(3, 1);
+    Body body(scene);
+    const FreeDofs& dofs = body.dofs();
+    const SparseMatrix& M = body.mass_matrix();
+    const SparseMatrix K = body.model().stiffness(Eigen::VectorXd::Zero(dofs.full_size()));
+    ReducedStepMatrix reduced(M, K, dofs);
+    // Each refill against the matrices built from scratch: the same sums, entry by entry.
+    for (const double k : {1e-4, 3e-3}) {
+        const SparseMatrix K_changed = (1.0 + 1e3 * k) * K;  // new values, same pattern
+        const SparseMatrix expected = dofs.reduce(SparseMatrix(1.02 * M + k * K_changed));
+        const SparseMatrix& A = reduced.assemble(M, K_changed, 1.02, k);
+        REQUIRE(A.rows() == dofs.size());
+        CHECK(A.nonZeros() == expected.nonZeros());
+        CHECK((A - expected).norm() <= 1e-15 * expected.norm());
+    }
+    // The θ-step's weights: a = 1 + θΔtα, k = θΔtβ + θ²Δt².
+    const Damping damping{0.01, 0.002};
+    const double dt = 0.01, theta = 0.5, h = theta * dt;
+    const SparseMatrix expected = dofs.reduce(SparseMatrix((1.0 + h * damping.alpha) * M + (h * damping.beta + h * h) * K));
+    CHECK((reduced.assemble(M, K, damping, dt, theta) - expected).norm() <= 1e-15 * expected.norm());
+    CHECK_THROWS_AS(reduced.assemble(M, K, damping, 0.0, theta), fem::Error);
+    // Another pattern (the consistent mass couples neighbours) is refused, not misread.
+    scene.mass = MassModel::consistent;
+    const Body consistent(scene);
+    CHECK(reduced.fits(M, K));
+    CHECK_FALSE(reduced.fits(consistent.mass_matrix(), K));
+    CHECK_THROWS_WITH(reduced.assemble(consistent.mass_matrix(), K, 1.0, 1.0), Contains("pattern"));
+}
