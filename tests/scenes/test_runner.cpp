@@ -57,6 +57,23 @@ std::string pushed_cube(const std::string& model, const std::string& load)
            "[time]\nstep = 0.02\nduration = 0.2\n";
 }
 
+/// Starts fem_scene with these arguments in a child process (its output discarded); returns its id.
+pid_t start_scene(const std::vector<std::string>& arguments)
+{
+    const pid_t child = ::fork();
+    if (child == 0) {
+        std::freopen("/dev/null", "w", stdout);
+        std::freopen("/dev/null", "w", stderr);
+        std::vector<char*> argv{const_cast<char*>(FEM_SCENE_EXE)};
+        for (const std::string& argument : arguments)
+            argv.push_back(const_cast<char*>(argument.c_str()));
+        argv.push_back(nullptr);
+        ::execv(FEM_SCENE_EXE, argv.data());
+        std::_Exit(127);
+    }
+    return child;
+}
+
 std::string read_text(const std::filesystem::path& path)
 {
     std::ifstream file(path, std::ios::binary);
@@ -172,15 +189,9 @@ TEST_CASE("an interrupted run (SIGINT) leaves a valid .pvd of the frames written
     const std::filesystem::path out = output / "interrupted";
     std::filesystem::remove_all(out);
     const std::string scene = (gallery / "cantilever.toml").string();
-    const pid_t child = ::fork();
-    REQUIRE(child >= 0);
-    if (child == 0) {
-        std::freopen("/dev/null", "w", stdout);
-        std::freopen("/dev/null", "w", stderr);
-        ::execl(FEM_SCENE_EXE, FEM_SCENE_EXE, scene.c_str(), "--no-figures", "--set", "time.duration=600",
-                "--set", "body.material.model=stable-neo-hookean", "--out", out.c_str(), static_cast<char*>(nullptr));
-        std::_Exit(127);
-    }
+    const pid_t child = start_scene({scene, "--no-figures", "--set", "time.duration=600", "--set",
+                                     "body.material.model=stable-neo-hookean", "--out", out.string()});
+    REQUIRE(child > 0);
     // Wait until the run is stepping: its first frames are in the staging folder.
     bool stepping = false;
     for (int poll = 0; poll < 600 && !stepping; ++poll) {
@@ -356,15 +367,9 @@ TEST_CASE("the live view's keys: space pauses, the right arrow steps, space resu
     const std::filesystem::path out = output / "keys";
     std::filesystem::remove_all(out);
     const std::string scene = (gallery / "cantilever.toml").string();
-    const pid_t child = ::fork();
-    REQUIRE(child >= 0);
-    if (child == 0) {
-        std::freopen("/dev/null", "w", stdout);
-        std::freopen("/dev/null", "w", stderr);
-        ::execl(FEM_SCENE_EXE, FEM_SCENE_EXE, scene.c_str(), "--quick", "--view", "--no-figures", "--no-progress", "--set",
-                "time.duration=600", "--out", out.c_str(), static_cast<char*>(nullptr));
-        std::_Exit(127);
-    }
+    const pid_t child = start_scene({scene, "--quick", "--view", "--no-figures", "--no-progress", "--set", "time.duration=600",
+                                     "--out", out.string()});
+    REQUIRE(child > 0);
     Window window = 0;
     for (int poll = 0; poll < 600 && (window == 0 || frames_so_far(out, "cantilever") < 3); ++poll) {
         std::this_thread::sleep_for(std::chrono::milliseconds(50));
