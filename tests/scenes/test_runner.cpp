@@ -357,7 +357,7 @@ int frames_so_far(const std::filesystem::path& out, const std::string& stem)
 
 }  // namespace
 
-TEST_CASE("the live view's keys: space pauses, the right arrow steps, space resumes, q stops with the files", "[scenes]")
+TEST_CASE("the live view's keys: space pauses, the right arrow steps, space resumes, r restarts, q stops", "[scenes]")
 {
     Display* display = std::getenv("DISPLAY") ? XOpenDisplay(nullptr) : nullptr;
     if (display == nullptr) {
@@ -389,11 +389,21 @@ TEST_CASE("the live view's keys: space pauses, the right arrow steps, space resu
     press(display, window, XK_space);  // resume: 12 frames a second
     std::this_thread::sleep_for(std::chrono::milliseconds(1000));
     CHECK(frames_so_far(out, "cantilever") > paused);
+    // r: the run starts over (its frames so far are dropped and written again from the start).
+    for (int poll = 0; poll < 600 && frames_so_far(out, "cantilever") < paused + 8; ++poll)
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    const int before_restart = frames_so_far(out, "cantilever");
+    press(display, window, XK_r);
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    CHECK(frames_so_far(out, "cantilever") < before_restart);
     press(display, window, XK_q);  // stop, as Ctrl-C does
     int status = 0;
     ::waitpid(child, &status, 0);
     XCloseDisplay(display);
     REQUIRE(WIFEXITED(status));
     CHECK(WEXITSTATUS(status) == 130);
-    CHECK(io::read_pvd(out / "cantilever.pvd").size() > static_cast<std::size_t>(paused));
+    const auto frames = io::read_pvd(out / "cantilever.pvd");
+    REQUIRE(!frames.empty());
+    CHECK(frames.front().first == 0.0);
+    CHECK(frames.size() < static_cast<std::size_t>(before_restart));  // the restarted run's frames only
 }
