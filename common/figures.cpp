@@ -31,7 +31,10 @@
 #include <vtkPointData.h>
 #include <vtkPolyDataMapper.h>
 #include <vtkProperty.h>
+#include <vtkCallbackCommand.h>
 #include <vtkRenderWindow.h>
+#include <vtkRenderWindowInteractor.h>
+#include <vtkRendererCollection.h>
 #include <vtkRenderer.h>
 #include <vtkScalarBarActor.h>
 #include <vtkStringArray.h>
@@ -398,11 +401,12 @@ io::MeshData cut_away(const io::MeshData& mesh, const CutPlane& plane)
     return out;
 }
 
-/// Draws a data set's surface coloured by a field into a PNG. A mesh (lit = true) is lit by a key,
-/// a fill and a back light, with ambient light so that no face is black, and shows its edges if
-/// asked; a flat grid is drawn unlit, in the colour map's own colours.
-bool render_dataset(const std::filesystem::path& path, vtkDataSet* data, bool cell_field, bool lit,
-                    const RenderOptions& options)
+/// Adds to window the renderers that draw a data set's surface coloured by a field: a white
+/// backdrop, the data (lit and framed as options say) and the texts (title, colour bar or legend).
+/// A mesh (lit = true) is lit by a key, a fill and a back light, with ambient light so that no face
+/// is black, and shows its edges if asked; a flat grid is drawn unlit, in the colour map's own
+/// colours. The PNGs and an on-screen MeshWindow share it, so they show the same picture.
+void add_renderers(vtkRenderWindow* window, vtkDataSet* data, bool cell_field, bool lit, const RenderOptions& options)
 {
     vtkNew<vtkDataSetSurfaceFilter> surface;
     surface->SetInputData(data);
@@ -539,17 +543,35 @@ bool render_dataset(const std::filesystem::path& path, vtkDataSet* data, bool ce
     }
     camera->Zoom(1.1);
 
-    vtkNew<vtkRenderWindow> window;
-    window->SetDisplayId(shared_display());
-    window->SetOffScreenRendering(1);
-    window->SetSize(options.width, options.height);
     window->SetNumberOfLayers(2);
     window->AddRenderer(backdrop);
     window->AddRenderer(renderer);
     window->AddRenderer(texts);
+}
+
+/// Draws a data set's surface coloured by a field into a PNG (add_renderers, offscreen).
+bool render_dataset(const std::filesystem::path& path, vtkDataSet* data, bool cell_field, bool lit,
+                    const RenderOptions& options)
+{
+    vtkNew<vtkRenderWindow> window;
+    window->SetDisplayId(shared_display());
+    window->SetOffScreenRendering(1);
+    window->SetSize(options.width, options.height);
+    add_renderers(window, data, cell_field, lit, options);
     window->Render();
     write_png(window, path);
     return true;
+}
+
+/// The grid of a mesh to draw with options (cut if asked), and whether its field is a cell field.
+/// fem::Error if the mesh has no such field.
+std::pair<vtkSmartPointer<vtkUnstructuredGrid>, bool> drawable(const io::MeshData& mesh, const RenderOptions& options)
+{
+    auto grid = io::detail::to_vtk(options.cut ? cut_away(mesh, *options.cut) : mesh);
+    const bool point_field = grid->GetPointData()->HasArray(options.field.c_str());
+    if (!point_field && !grid->GetCellData()->HasArray(options.field.c_str()))
+        throw Error(str("cannot render field '", options.field, "': the mesh has no such field"));
+    return {grid, !point_field};
 }
 
 }  // namespace
@@ -732,13 +754,62 @@ bool save_chart(const LineChart& chart, const std::filesystem::path& stem, bool 
 bool render_mesh_png(const std::filesystem::path& path, const io::MeshData& mesh,
                      const RenderOptions& options)
 {
-    const auto grid = io::detail::to_vtk(options.cut ? cut_away(mesh, *options.cut) : mesh);
-    const bool point_field = grid->GetPointData()->HasArray(options.field.c_str());
-    if (!point_field && !grid->GetCellData()->HasArray(options.field.c_str()))
-        throw Error(str("cannot render field '", options.field, "': the mesh has no such field"));
+    const auto [grid, cell_field] = drawable(mesh, options);
     if (!can_draw(true))
         return false;
-    return render_dataset(path, grid, !point_field, true, options);
+    return render_dataset(path, grid, cell_field, true, options);
+}
+
+// --- MeshWindow --------------------------------------------------------------------------------
+
+struct MeshWindow::Impl {
+    vtkNew<vtkRenderWindow> window;
+    vtkNew<vtkRenderWindowInteractor> interactor;
+    vtkNew<vtkCallbackCommand> on_key;
+    std::string keys;  // pressed since the last poll
+};
+
+MeshWindow::MeshWindow(const RenderOptions& options, const std::string& window_name) : impl_(std::make_unique<Impl>())
+{
+    if (!display_available())
+        throw Error("no X display for a window (set DISPLAY, or run under xvfb-run -a)");
+    impl_->window->SetDisplayId(shared_display());
+    impl_->window->SetSize(options.width, options.height);
+    impl_->window->SetWindowName(window_name.c_str());
+    impl_->interactor->SetRenderWindow(impl_->window);
+    impl_->interactor->SetInteractorStyle(nullptr);  // the camera stays the PNGs' one
+    impl_->on_key->SetClientData(impl_.get());
+    impl_->on_key->SetCallback([](vtkObject* caller, unsigned long, void* client, void*) {
+        auto* interactor = static_cast<vtkRenderWindowInteractor*>(caller);
+        const std::string key = interactor->GetKeySym() ? interactor->GetKeySym() : "";
+        static_cast<Impl*>(client)->keys += key == "space" ? ' ' : key == "Right" ? '>' : key.size() == 1 ? key[0] : '\0';
+    });
+    impl_->interactor->AddObserver(vtkCommand::KeyPressEvent, impl_->on_key);
+    impl_->interactor->Initialize();
+}
+
+MeshWindow::~MeshWindow() = default;
+
+void MeshWindow::show(const io::MeshData& mesh, const RenderOptions& options)
+{
+    const auto [grid, cell_field] = drawable(mesh, options);
+    impl_->window->GetRenderers()->RemoveAllItems();
+    add_renderers(impl_->window, grid, cell_field, true, options);
+    impl_->window->Render();
+}
+
+std::string MeshWindow::poll_keys()
+{
+    impl_->interactor->ProcessEvents();
+    std::string keys;
+    keys.swap(impl_->keys);
+    keys.erase(std::remove(keys.begin(), keys.end(), '\0'), keys.end());
+    return keys;
+}
+
+void MeshWindow::save_png(const std::filesystem::path& path)
+{
+    write_png(impl_->window, path);
 }
 
 bool render_grid_png(const std::filesystem::path& path, const io::ImageGrid& grid,

@@ -11,6 +11,7 @@
 
 #include <array>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -94,6 +95,30 @@ struct RenderOptions {
 /// Returns false (and writes nothing) without a display; fem::Error if the field is missing.
 bool render_mesh_png(const std::filesystem::path& path, const io::MeshData& mesh,
                      const RenderOptions& options);
+
+/// An on-screen window showing a mesh coloured by a field, redrawn frame by frame: the same picture
+/// (camera, lights, colour bar, title) render_mesh_png writes for the same options, so a frame on
+/// screen and its PNG agree. For a lecture: the scenes runner's --view (docs/scenes.md#the-live-view).
+class MeshWindow {
+public:
+    /// Opens the window, options.width × options.height pixels. fem::Error without a display.
+    MeshWindow(const RenderOptions& options, const std::string& window_name);
+    ~MeshWindow();
+    MeshWindow(const MeshWindow&) = delete;
+    MeshWindow& operator=(const MeshWindow&) = delete;
+
+    /// Draws mesh as render_mesh_png would (fem::Error if the field is missing).
+    void show(const io::MeshData& mesh, const RenderOptions& options);
+    /// Handles the window's pending events and returns the keys pressed since the last call: one
+    /// character each, ' ' for space, '>' for the right arrow, letters as typed.
+    std::string poll_keys();
+    /// Writes what the window shows to a PNG.
+    void save_png(const std::filesystem::path& path);
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
 
 /// Renders a 2D or 3D regular grid coloured by a point field (a heat map for a 2D grid), unlit, so
 /// that its colours are exactly the colour map's.

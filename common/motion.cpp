@@ -54,7 +54,8 @@ int MotionRecorder::render_png_frames(const std::filesystem::path& stem, const f
         low = std::min(low, values.cols() == 1 ? values.minCoeff() : shown.minCoeff());
         high = std::max(high, values.cols() == 1 ? values.maxCoeff() : shown.maxCoeff());
     }
-    shared.frame_bounds = box;
+    if (!shared.frame_bounds)  // a box the caller fixed (e.g. a live view's) is kept
+        shared.frame_bounds = box;
     if (!shared.range)
         shared.range = std::make_pair(low, high);
     int written = 0;

@@ -35,8 +35,9 @@ public:
     std::size_t frames() const { return series_.frames(); }
 
     /// Renders the kept frames, warped by warp_scale × their displacement (1: true scale), to
-    /// <stem>_0000.png, …: one camera framing the union of the deformed bodies' bounds, and one
-    /// colour range for options.field over all kept frames (unless options.range is set). The title
+    /// <stem>_0000.png, …: one camera framing the union of the deformed bodies' bounds (unless
+    /// options.frame_bounds is set), and one colour range for options.field over all kept frames
+    /// (unless options.range is set). The title
     /// gets ", t = … s" appended (and "displacement × k" when warp_scale ≠ 1). Returns the number of
     /// PNGs written (0 without a display, see figures.hpp). fem::Error if the field is missing from
     /// a frame or warp_scale is not finite.

@@ -10,7 +10,8 @@ Checks:
      `central_difference(f, x, h)` and qualified names like `fem::fd::HeatRod`) is declared in the
      headers of this chapter, an earlier one, or common/;
   3. the tables between <!-- fem:table NAME.csv --> and <!-- /fem:table --> hold the numbers the
-     executable prints today: the page's <!-- fem:run chNN_name [args] --> line says how to run it;
+     executable prints today: the page's <!-- fem:run chNN_name [args] --> line says how to run it
+     ({root} in args: the project's folder);
      measured columns (times, rates) are skipped (see csv_compare.py);
   4. every number a sentence quotes from a table, marked
          <!-- fem:value NAME.csv KEY=VALUE … "COLUMN" -->6·10⁻³<!-- /fem:value -->
@@ -139,11 +140,17 @@ def check_quotes(text, out):
     return problems
 
 
+def chapter_order(name):
+    """A chapter's place in the course: its number; the scenes capstone (chapters/scenes, docs/scenes.md)
+    comes after every chapter."""
+    return 99 if name == "scenes" else int(name[:2]) if name[:2].isdigit() else None
+
+
 def declared_names(root, chapter):
-    number = int(chapter[:2])
+    number = chapter_order(chapter)
     headers = list((root / "common").glob("*.hpp"))
     for folder in (root / "chapters").iterdir():
-        if folder.is_dir() and int(folder.name[:2]) <= number:
+        if folder.is_dir() and chapter_order(folder.name) is not None and chapter_order(folder.name) <= number:
             headers += list(folder.glob("*.hpp"))
     return "\n".join(h.read_text() for h in headers)
 
@@ -197,13 +204,15 @@ def check_exercises(text, root, chapter):
     return problems
 
 
-def run_executable(text, bin_dir, out):
+def run_executable(text, bin_dir, out, root):
     match = RUN.search(text)
     if not match:
         return None, ["the page has tables but no <!-- fem:run chNN_name [args] --> line"]
     if out.exists():
         shutil.rmtree(out)
-    command = [str(bin_dir / match["exe"]), *match["args"].split(), "--out", str(out)]
+    # {root} in the arguments stands for the project's folder (e.g. the scene files of docs/scenes.md).
+    arguments = match["args"].replace("{root}", str(root)).split()
+    command = [str(bin_dir / match["exe"]), *arguments, "--out", str(out)]
     result = subprocess.run(command, capture_output=True, text=True, timeout=3000)
     if result.returncode != 0:
         return None, [f"`{' '.join(command)}` failed ({result.returncode}):\n{result.stdout}{result.stderr}"]
@@ -279,7 +288,7 @@ def main():
         if not (args.bin and args.out):
             problems.append("--bin and --out are needed to check the tables and quoted numbers")
         else:
-            out, run_problems = run_executable(text, args.bin, args.out)
+            out, run_problems = run_executable(text, args.bin, args.out, args.root)
             problems += run_problems
             if out and args.update:
                 update(doc, text, out, args.root, args.chapter)

@@ -12,6 +12,8 @@ packages=(
   libsuitesparse-dev libopenblas0-pthread # CHOLMOD, the speed reference of chapters 08-09
   tetgen                                  # tetrahedral meshes from surfaces
   libspectra-dev                          # sparse eigenvalues (chapter 10: modes)
+  libtomlplusplus-dev                     # scene files (scenes/*.toml, docs/scenes.md)
+  ffmpeg                                  # the scenes' videos from their PNG frames (optional)
   clang-14 libclang-rt-14-dev             # the readers' fuzz targets (libFuzzer; tools/fuzz.sh)
 )
 

@@ -1,0 +1,129 @@
+// fem_scene: runs a scene file (scenes/*.toml) with chapters 10–12 — a body, its material and
+// model, what is pinned and how it moves, what pushes, for how long — and writes a .pvd time series,
+// PNG frames, a video, the energies and the cost of each step. Read chapters 10–12 first.
+//
+// Sample runs:
+//   fem_scene scenes/cantilever.toml                       the scene as written
+//   fem_scene scenes/cantilever.toml --quick               the small run ctest checks
+//   fem_scene scenes/twisted_bar.toml --set body.material.model=auto --set time.step=1/120
+//   fem_scene scenes/bunny.toml --compare                  every model against the reference
+//
+// Writes (under out/scenes/<scene>): <scene>.pvd with <scene>/<scene>_NNNN.vtu frames, PNG frames
+// <scene>_NNNN.png and <scene>.mp4 (ffmpeg), steps.csv with the charts energies, step_time and
+// newton_iterations; with --compare, models.csv. docs/scenes.md
+#include "scenes/runner.hpp"
+
+#include "09_conjugate_gradient/linear_solver.hpp"
+
+#include "common/cli.hpp"
+#include "common/error.hpp"
+
+#include <iostream>
+#include <memory>
+
+using namespace fem;
+using namespace fem::scenes;
+
+namespace {
+
+/// The default --out: out/scenes/<scene> for one scene file (an argument ending in .toml),
+/// out/scenes/compare for several.
+std::string default_out(int argc, char** argv)
+{
+    std::vector<std::string> stems;
+    for (int i = 1; i < argc; ++i) {
+        const std::filesystem::path arg(argv[i]);
+        if (arg.extension() == ".toml")
+            stems.push_back(arg.stem().string());
+    }
+    return "scenes/" + (stems.size() == 1 ? stems.front() : stems.empty() ? std::string("scene") : std::string("compare"));
+}
+
+}  // namespace
+
+int main(int argc, char** argv)
+{
+    ChapterCli cli("fem_scene", default_out(argc, argv),
+                   "Runs a scene file with the cheapest model that is accurate enough (docs/scenes.md)");
+    std::vector<std::string> files;
+    std::vector<std::string> settings;
+    bool compare = false, no_progress = false;
+    cli.app.add_option("scene", files, "The scene file (TOML), e.g. scenes/cantilever.toml; several with --compare")
+        ->required();
+    cli.app.add_option("--set", settings,
+                       "Override a field: key=value in TOML syntax, e.g. body.material.model=auto, time.step=1/120, "
+                       "body.0.material.youngs_modulus=2e5 (no index: every body)")
+        ->allow_extra_args(false)  // one key=value per --set (a scene file after it stays the scene)
+        ->take_all();              // and every --set kept
+    cli.app.add_flag("--compare", compare,
+                     "Run every model and auto against the stable neo-Hookean reference and print the table (models_<scene>.csv)");
+    cli.app.add_flag("--no-progress", no_progress, "No progress bar on stderr (it shows only on a terminal anyway)");
+    bool view = false;
+    int screenshot = -1;
+    cli.app.add_flag("--view", view,
+                     "Play the run live in a window (space: pause, right arrow: step, r: restart, c: colour field, "
+                     "q: stop); without a display the run goes on headless");
+    cli.app.add_option("--screenshot", screenshot, "With --view: save the window at this step as view_<step>.png in --out")
+        ->check(check::at_least<int>(0));
+    std::vector<SceneSpec> scenes;
+    // Every scene is read and checked before the output folder is touched.
+    cli.check_options([&] {
+        bool quick = false;
+        for (int i = 1; i < argc; ++i)
+            quick = quick || std::string(argv[i]) == "--quick";
+        if (files.size() > 1 && !compare)
+            throw Error(str("scene: give one scene file, or several with --compare (got ", files.size(), ")"));
+        if (screenshot >= 0 && !view)
+            throw Error("--screenshot: needs --view");
+        if (view && compare)
+            throw Error("--view: plays one run; --compare runs many without frames");
+        for (const std::string& file : files) {
+            scenes.push_back(read_scene(file, settings, quick));
+            if (scenes.back().skin)
+                make_skin_observer(*scenes.back().skin, scenes.back().bodies.front().mesh);
+        }
+    });
+    bool stopped = false;
+    const int code = cli.run(argc, argv, [&](const RunContext& run) {
+        cg::set_blas_threads(1);
+        for (const SceneSpec& scene : scenes) {
+            std::cout << scene.title << " (" << scene.file.filename().string() << "): " << scene.bodies.size()
+                      << " bodies, dt = " << scene.time_step << " s, " << scene.duration << " s, solver " << scene.solver
+                      << "\n";
+            for (const BodySpec& body : scene.bodies)
+                std::cout << "  " << body.name << ": " << body.mesh.V.rows() << " vertices, " << body.mesh.T.rows()
+                          << " tets, " << body.pinned.size() << " pinned, model " << body.model << '\n';
+            if (compare)
+                compare_models(scene, run);
+        }
+        if (compare)
+            return;
+        catch_interrupt();
+        RunOptions options;
+        options.run = &run;
+        options.progress = !no_progress;
+        std::unique_ptr<LiveView> live;
+        if (view && fig::display_available()) {
+            live = std::make_unique<LiveView>(scenes.front(), run.file(str("view_", screenshot, ".png")), screenshot);
+            options.on_frame = [&](const io::MeshData& frame, int step, double time) { live->frame(frame, step, time); };
+        } else if (view) {
+            std::cout << "note: no display for --view (set DISPLAY); the run goes on headless\n";
+        }
+        RunResult result;
+        for (;;) {
+            try {
+                result = run_scene(scenes.front(), options);
+                break;
+            } catch (const LiveView::Restart&) {  // the live view's r: the run starts over
+                std::cout << "restarted\n";
+                std::filesystem::remove_all(run.file(scenes.front().file.stem().string()));
+            }
+        }
+        std::cout << result.steps << " steps in " << result.seconds << " s ("
+                  << (result.steps > 0 ? 1e3 * result.seconds / result.steps : 0.0) << " ms per step), "
+                  << result.frame_count << " frames, " << result.newton_iterations << " Newton iterations\n";
+        stopped = result.interrupted;
+    });
+    // Interrupted: the files so far were published (a valid .pvd); the exit code says it stopped.
+    return code == 0 && stopped ? 130 : code;
+}

@@ -1,0 +1,187 @@
+#pragma once
+// The scenes capstone: a scene file (TOML) and what it describes. docs/scenes.md#the-scene-file
+//
+// A scene is plain data, read and checked once, before anything is computed or written: one or
+// more bodies (each a mesh, a material and force model, pinned vertices with their prescribed
+// motion, loads, damping, an initial velocity), the gravity they share, the time step and duration,
+// the thresholds of model "auto", the outputs, and an optional skin (chapter 13). The runner
+// (runner.hpp) builds chapter 10's Scene and Body for each body from it.
+//
+// Every field is checked where it is read: the message names the file, line and column, the field
+// (e.g. body[0].material.poisson_ratio) and what is allowed; a field the format does not know is an
+// error, never ignored. --set key=value and the scene's own [quick] table edit the file's tree
+// before it is read, so an override is checked like the file itself.
+
+#include "10_linear_dynamics/body.hpp"
+
+#include "common/mesh.hpp"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <utility>
+
+#include <filesystem>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace fem::scenes {
+
+/// A set of vertices of a body's rest mesh. docs/scenes.md#selecting-vertices
+struct Selector {
+    enum class Kind { box, plane, vertices };
+    Kind kind = Kind::box;
+    Eigen::Vector3d low = Eigen::Vector3d::Zero(), high = Eigen::Vector3d::Zero();  ///< box corners [m]
+    Eigen::Vector3d point = Eigen::Vector3d::Zero();   ///< plane: a point on it [m]
+    Eigen::Vector3d normal = Eigen::Vector3d::UnitX(); ///< plane: its normal (unit)
+    bool below = false;            ///< plane: every vertex on or behind it (n·(x − p) ≤ tol), not only on it
+    std::vector<int> vertices;     ///< an explicit list
+    std::string where;             ///< "scenes/x.toml:12:1: body[0].pin[1]", for "selects nothing"
+};
+
+/// How pinned vertices move: held (fixed), turned about an axis, or moved by a displacement, with
+/// the smooth ramp s(t) = 3τ² − 2τ³, τ = (t − start)/(end − start) clamped to [0, 1] (zero velocity
+/// at both ends). docs/scenes.md#pinned-vertices-and-prescribed-motion
+struct Motion {
+    enum class Kind { fixed, rotate, translate };
+    Kind kind = Kind::fixed;
+    Eigen::Vector3d axis = Eigen::Vector3d::UnitX();   ///< rotate: the axis direction (unit)
+    Eigen::Vector3d center = Eigen::Vector3d::Zero();  ///< rotate: a point on the axis [m]
+    double angle = 0.0;                                ///< rotate: the total angle [rad]
+    Eigen::Vector3d displacement = Eigen::Vector3d::Zero();  ///< translate: the total displacement [m]
+    double start = 0.0, end = 0.0;                     ///< the ramp's time window [s], start < end
+};
+
+/// One group of pinned vertices and its motion.
+struct Pin {
+    Selector select;
+    Motion motion;
+};
+
+/// An applied force beyond gravity: a point load (total force spread equally over the selected
+/// vertices) or a surface traction (force per area on the boundary triangles whose three corners are
+/// selected, lumped a third of each triangle's force to each corner). Scaled by min(1, t/ramp)
+/// (ramp > 0) and zero after `until`. docs/scenes.md#loads
+struct Load {
+    enum class Kind { point, surface };
+    Kind kind = Kind::point;
+    Selector select;
+    Eigen::Vector3d value = Eigen::Vector3d::Zero();  ///< point: total force [N]; surface: traction [Pa]
+    double ramp = 0.0;                                ///< [s], 0: applied at once
+    double until = std::numeric_limits<double>::infinity();  ///< [s], released after this time
+};
+
+/// Where a body's tets come from.
+struct MeshSpec {
+    std::filesystem::path file;         ///< .obj/.stl/.ply (tetrahedralised with TetGen), .node/.ele/.vtu
+    std::string generator;              ///< "box" (box_mesh) when no file
+    Eigen::Vector3d size = Eigen::Vector3d::Ones();   ///< box: edge lengths [m]
+    Eigen::Vector3i cells = Eigen::Vector3i::Ones();  ///< box: cubes along x, y, z (6 tets each)
+    double scale = 1.0;                 ///< applied to a file's positions first
+    Eigen::Vector3d translate = Eigen::Vector3d::Zero();  ///< then this shift [m]
+    std::string tetgen = "pq1.5aY";     ///< TetGen's switches for a surface (a max volume may follow a)
+};
+
+/// The force models a body can use. "auto" starts linear and moves up per step (runner.hpp).
+const std::vector<std::string>& model_names();
+
+/// One body of a scene.
+struct BodySpec {
+    std::string name;                   ///< names its files and table rows (default body0, body1, …)
+    MeshSpec mesh_spec;
+    TetMesh mesh;                       ///< the rest mesh, built when the scene is read
+    std::string model = "linear";       ///< one of model_names()
+    dynamics::Material material;
+    dynamics::MassModel mass = dynamics::MassModel::lumped;
+    dynamics::Damping damping;
+    std::vector<Pin> pins;
+    std::vector<Load> loads;
+    Eigen::Vector3d initial_velocity = Eigen::Vector3d::Zero();  ///< of every free vertex [m/s]
+    std::vector<int> pinned;            ///< the union of the pins' vertices, ascending
+};
+
+/// When model "auto" moves up from linear to corotational to hyperelastic (and back down), measured
+/// per step on every tet's deformation gradient F. docs/scenes.md#model-auto
+struct AutoThresholds {
+    double rotation = 0.1745329251994330;  ///< largest element rotation [rad] linear allows (10°)
+    double strain = 0.05;                  ///< largest principal Green strain corotational allows
+    double volume_ratio = 0.5;             ///< smallest det F corotational allows (near inversion)
+    double hysteresis = 0.5;               ///< move down only below this fraction of a threshold
+    std::string hyperelastic = "stable-neo-hookean";  ///< the model above corotational
+};
+
+/// What a run writes. docs/scenes.md#outputs
+struct OutputSpec {
+    double frame_rate = 30.0;           ///< frames per simulated second (each a .vtu, a PNG, a CSV row)
+    bool pvd = true;                    ///< the .pvd time series of .vtu frames
+    bool png = true;                    ///< PNG frames (needs a display)
+    std::string video = "mp4";          ///< "mp4", "gif" or "none" (ffmpeg, from the PNG frames)
+    bool csv = true;                    ///< steps.csv: energies, Newton iterations and time per step
+    bool charts = true;                 ///< the charts of steps.csv (PNG + CSV: energies, step_time, newton_iterations)
+    std::vector<std::string> fields{"displacement", "velocity", "von Mises stress"};  ///< in the frames
+    std::string colour = "von Mises stress";  ///< the field the PNGs are coloured by
+    Eigen::Vector3d view_direction{0.3, 1.0, -0.3};   ///< the camera looks along this
+    Eigen::Vector3d view_up{0.0, 0.0, 1.0};
+    double warp = 1.0;                  ///< displacement scale of the PNGs
+    /// The box the camera frames [m] (xmin, xmax, ymin, ymax, zmin, zmax); default: the union of
+    /// the frames' bounds, known only at the end, so a live view (--view) frames the rest shape.
+    /// Set it (and colour_range) for a live view with exactly the PNGs' camera and colours.
+    std::optional<std::array<double, 6>> frame_box;
+    std::optional<std::pair<double, double>> colour_range;  ///< default: the run's range
+    int width = 900, height = 700;      ///< PNG size [pixels]
+};
+
+/// An optional fine surface carried by the tets (chapter 13). docs/scenes.md#skin
+struct SkinSpec {
+    std::filesystem::path file;         ///< .obj/.stl/.ply surface
+    std::string body;                   ///< the body that carries it
+};
+
+/// A whole scene, as read from its file.
+struct SceneSpec {
+    std::filesystem::path file;
+    std::string title;
+    std::vector<BodySpec> bodies;
+    Eigen::Vector3d gravity{0.0, 0.0, -9.81};
+    double time_step = 1.0 / 60.0;      ///< Δt [s] ("1/60" allowed in the file)
+    double duration = 1.0;              ///< [s], a whole number of steps
+    std::string integrator = "backward-euler";
+    std::string solver = "default";     ///< chapter 09's solver name
+    double newton_tolerance = 1e-6;     ///< chapter 12's relative tolerance
+    AutoThresholds thresholds;
+    OutputSpec output;
+    std::optional<SkinSpec> skin;
+};
+
+/// Reads and checks a scene file: first the [quick] table's overrides when quick is set, then
+/// each "key=value" of overrides (the --set options; value in TOML syntax, or else a string),
+/// then every field. Builds every body's mesh (TetGen for a surface file) and selects its pinned
+/// vertices. fem::Error naming the file, line and column, the field and what is allowed, for a
+/// missing or unreadable file, a syntax error, an unknown field, a wrong type or value, a mesh
+/// without tets, a selection that selects nothing, or a surface TetGen cannot tetrahedralise.
+/// docs/scenes.md#the-scene-file
+SceneSpec read_scene(const std::filesystem::path& path, const std::vector<std::string>& overrides = {},
+                     bool quick = false);
+
+/// Chapter 10's Scene of one body of a scene: its mesh, material, pinned vertices, damping and mass,
+/// the scene's gravity, Δt and duration.
+dynamics::Scene dynamics_scene(const SceneSpec& scene, const BodySpec& body);
+
+/// The vertices of mesh a selector selects, ascending. fem::Error (naming selector.where) if none.
+std::vector<int> select_vertices(const TetMesh& mesh, const Selector& selector);
+
+/// The prescribed displacement g(X, t) of a rest position X under a motion at time t [m].
+Eigen::Vector3d prescribed_displacement(const Motion& motion, const Eigen::Vector3d& X, double t);
+
+/// The triangles on the boundary of a tet mesh (faces of one tet only), outward by the tet's
+/// orientation (#F×3).
+MatrixX3i boundary_faces(const TetMesh& mesh);
+
+/// Tetrahedralises a closed triangle surface with Debian's tetgen program and the given switches
+/// ("pq1.5aY": a piecewise linear complex, quality 1.5, the surface kept). fem::Error with TetGen's
+/// reason when it fails (an open or self-intersecting surface) or is not installed.
+TetMesh tetrahedralize(const TriMesh& surface, const std::string& switches, const std::string& what);
+
+}  // namespace fem::scenes

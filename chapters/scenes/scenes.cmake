@@ -1,0 +1,49 @@
+# The scenes capstone (docs/scenes.md): the scene file and runner library fem_scenes (headers in
+# chapters/scenes, sources in solutions/scenes; no exercises), the executable bin/fem_scene, its
+# tests test_scenes (ctest label scenes), and a --quick run of every gallery scene in scenes/
+# against its stored numbers (tests/scenes/expected/<scene>).
+find_package(tomlplusplus 3 REQUIRED)  # Debian's libtomlplusplus-dev (tools/setup.sh)
+
+add_library(fem_scenes STATIC ${FEM_ROOT}/solutions/scenes/scene_file.cpp ${FEM_ROOT}/solutions/scenes/runner.cpp)
+target_include_directories(fem_scenes PUBLIC ${FEM_ROOT}/chapters)
+target_link_libraries(fem_scenes PUBLIC fem_ch12_reference fem_ch11_reference fem_ch10_reference
+                      PRIVATE tomlplusplus::tomlplusplus fem_flags)
+
+add_executable(fem_scene ${FEM_ROOT}/chapters/scenes/main.cpp)
+target_link_libraries(fem_scene PRIVATE fem_scenes fem_flags)
+
+if(FEM_BUILD_TESTS)
+  file(GLOB scene_test_sources CONFIGURE_DEPENDS ${FEM_ROOT}/tests/scenes/*.cpp)
+  add_executable(test_scenes ${scene_test_sources})
+  target_link_libraries(test_scenes PRIVATE fem_scenes fem_test_main fem_flags)
+  target_compile_definitions(test_scenes PRIVATE FEM_TEST_OUTPUT_DIR="${CMAKE_BINARY_DIR}/test_output/scenes"
+                             FEM_SCENES_DIR="${FEM_ROOT}/scenes" FEM_SCENE_EXE="$<TARGET_FILE:fem_scene>"
+                             FEM_SCENE_BAD_DIR="${FEM_ROOT}/tests/scenes/bad_scenes")
+  add_dependencies(test_scenes fem_scene)
+  fem_discover_tests(test_scenes "scenes")
+  add_dependencies(fem_tests test_scenes)
+
+  # Every gallery scene in --quick mode against its stored numbers (tools/check_run.py).
+  file(GLOB gallery CONFIGURE_DEPENDS ${FEM_ROOT}/scenes/*.toml)
+  foreach(scene_file IN LISTS gallery)
+    get_filename_component(scene ${scene_file} NAME_WE)
+    add_test(NAME scenes_quick_run_${scene}
+             COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/check_run.py
+                     --exe $<TARGET_FILE:fem_scene> --expected ${FEM_ROOT}/tests/scenes/expected/${scene}
+                     --out ${CMAKE_BINARY_DIR}/check_runs/scenes/${scene} -- ${scene_file} --no-progress)
+    set_tests_properties(scenes_quick_run_${scene} PROPERTIES LABELS "scenes;run")
+  endforeach()
+endif()
+
+if(FEM_BUILD_TESTS)
+  # docs/scenes.md names only what exists and quotes the tables fem_scene --compare prints.
+  add_test(NAME scenes_docs
+           COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/check_docs.py --root ${FEM_ROOT}
+                   --chapter scenes --bin ${CMAKE_BINARY_DIR}/bin --out ${CMAKE_BINARY_DIR}/check_docs/scenes)
+  set_tests_properties(scenes_docs PROPERTIES LABELS "scenes;docs")
+  # Bad command lines: refused before anything is computed or written.
+  add_test(NAME scenes_bad_options
+           COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/check_bad_options.py
+                   --exe $<TARGET_FILE:fem_scene> --table ${FEM_ROOT}/tests/scenes/bad_options.txt)
+  set_tests_properties(scenes_bad_options PROPERTIES LABELS "scenes;run")
+endif()

@@ -1,0 +1,927 @@
+// The scene file: TOML read with toml++, every field checked where it is read.
+// docs/scenes.md#the-scene-file
+#include "scenes/scene_file.hpp"
+
+#include "10_linear_dynamics/time_integration.hpp"
+
+#include "common/error.hpp"
+#include "common/files.hpp"
+#include "common/mesh_io.hpp"
+
+#include <toml++/toml.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <unistd.h>
+
+namespace fem::scenes {
+
+const std::vector<std::string>& model_names()
+{
+    static const std::vector<std::string> names{"linear", "corotational", "stvk", "neo-hookean", "stable-neo-hookean",
+                                                "auto"};
+    return names;
+}
+
+namespace {
+
+std::string joined(const std::vector<std::string>& names)
+{
+    std::string out;
+    for (const std::string& name : names)
+        out += (out.empty() ? "" : ", ") + name;
+    return out;
+}
+
+/// Where the fields being read come from: the scene file, and the overrides that replaced some of
+/// them (the field path as given, e.g. "body.material.model", and the option that set it).
+struct Source {
+    std::string file;
+    std::vector<std::pair<std::string, std::string>> overrides;
+
+    /// The option that set a field (e.g. "--set body.0.material.poisson_ratio=0.5"), matched on the
+    /// path without array indices; empty when none did.
+    std::string override_of(const std::string& field) const
+    {
+        const auto plain = [](std::string path) {
+            std::string out;
+            std::string part;
+            std::replace(path.begin(), path.end(), '[', '.');
+            path.erase(std::remove(path.begin(), path.end(), ']'), path.end());
+            std::istringstream in(path);
+            while (std::getline(in, part, '.'))
+                if (!part.empty() && !std::all_of(part.begin(), part.end(), ::isdigit))
+                    out += (out.empty() ? "" : ".") + part;
+            return out;
+        };
+        std::string found;
+        for (const auto& [key, option] : overrides)
+            if (plain(key) == plain(field))
+                found = option;  // the last one set it
+        return found;
+    }
+};
+
+/// One table of the scene file being read: its dotted name (body[0].material), the file it came
+/// from, and the check that it holds only the allowed fields (no check when none are given).
+class Fields {
+public:
+    Fields(const toml::table& table, std::string name, const Source& source, std::vector<std::string> allowed)
+        : table_(table), name_(std::move(name)), source_(source), file_(source.file)
+    {
+        for (auto&& [key, node] : table_) {
+            if (!allowed.empty() && std::find(allowed.begin(), allowed.end(), key.str()) == allowed.end())
+                fail(node, std::string(key.str()), str("unknown field; allowed here: ", joined(allowed)));
+        }
+    }
+
+    /// "file:line:column" of a node; for a node an override put there, "file: <the option>".
+    std::string where(const toml::node& node, const std::string& key = "") const
+    {
+        const toml::source_region& source = node.source();
+        if (source.begin.line == 0) {
+            const std::string option = source_.override_of(field(key));
+            return option.empty() ? file_ : str(file_, ": ", option);
+        }
+        return str(file_, ":", source.begin.line, ":", source.begin.column);
+    }
+    std::string field(const std::string& key) const { return name_.empty() ? key : name_ + "." + key; }
+
+    [[noreturn]] void fail(const toml::node& node, const std::string& key, const std::string& message) const
+    {
+        throw Error(str(where(node, key), ": ", field(key), ": ", message));
+    }
+    [[noreturn]] void missing(const std::string& key, const std::string& message) const
+    {
+        throw Error(str(where(table_), ": ", field(key), ": missing; ", message));
+    }
+
+    const toml::node* get(const std::string& key) const { return table_.get(key); }
+    bool has(const std::string& key) const { return get(key) != nullptr; }
+    const toml::table& table() const { return table_; }
+    const std::string& name() const { return name_; }
+    const Source& source() const { return source_; }
+
+    /// A number (an integer is taken as a real) that must satisfy ok, whose failure says allowed.
+    template <typename Check>
+    double number(const std::string& key, double fallback, Check ok, const std::string& allowed) const
+    {
+        const toml::node* node = get(key);
+        if (node == nullptr)
+            return fallback;
+        return number_of(*node, key, ok, allowed);
+    }
+    template <typename Check>
+    double number_of(const toml::node& node, const std::string& key, Check ok, const std::string& allowed) const
+    {
+        if (!node.is_number())
+            fail(node, key, str("must be ", allowed, ", got ", type_name(node)));
+        const double value = *node.value<double>();
+        if (!std::isfinite(value) || !ok(value))
+            fail(node, key, str("must be ", allowed, ", got ", value));
+        return value;
+    }
+    double positive(const std::string& key, double fallback) const
+    {
+        return number(key, fallback, [](double x) { return x > 0.0; }, "a number > 0");
+    }
+    double non_negative(const std::string& key, double fallback) const
+    {
+        return number(key, fallback, [](double x) { return x >= 0.0; }, "a number >= 0");
+    }
+    double finite(const std::string& key, double fallback) const
+    {
+        return number(key, fallback, [](double) { return true; }, "a finite number");
+    }
+    int integer(const std::string& key, int fallback, int low, int high) const
+    {
+        const toml::node* node = get(key);
+        if (node == nullptr)
+            return fallback;
+        return integer_of(*node, key, low, high);
+    }
+    int integer_of(const toml::node& node, const std::string& key, int low, int high) const
+    {
+        const std::string allowed = str("an integer in [", low, ", ", high, "]");
+        if (!node.is_integer())
+            fail(node, key, str("must be ", allowed, ", got ", type_name(node)));
+        const std::int64_t value = *node.value<std::int64_t>();
+        if (value < low || value > high)
+            fail(node, key, str("must be ", allowed, ", got ", value));
+        return static_cast<int>(value);
+    }
+    bool flag(const std::string& key, bool fallback) const
+    {
+        const toml::node* node = get(key);
+        if (node == nullptr)
+            return fallback;
+        if (!node->is_boolean())
+            fail(*node, key, str("must be true or false, got ", type_name(*node)));
+        return *node->value<bool>();
+    }
+    std::string text(const std::string& key, const std::string& fallback, const std::vector<std::string>& allowed = {}) const
+    {
+        const toml::node* node = get(key);
+        if (node == nullptr)
+            return fallback;
+        const std::string what = allowed.empty() ? "a string" : str("one of ", joined(allowed));
+        if (!node->is_string())
+            fail(*node, key, str("must be ", what, ", got ", type_name(*node)));
+        std::string value = *node->value<std::string>();
+        if (!allowed.empty() && std::find(allowed.begin(), allowed.end(), value) == allowed.end())
+            fail(*node, key, str("must be ", what, ", got '", value, "'"));
+        return value;
+    }
+    const toml::array& array(const std::string& key, std::size_t size, const std::string& allowed) const
+    {
+        const toml::node* node = get(key);
+        if (!node->is_array() || (size != 0 && node->as_array()->size() != size))
+            fail(*node, key, str("must be ", allowed, ", got ", describe(*node)));
+        return *node->as_array();
+    }
+    Eigen::Vector3d vector(const std::string& key, const Eigen::Vector3d& fallback, bool nonzero = false) const
+    {
+        if (!has(key))
+            return fallback;
+        const std::string allowed = nonzero ? "an array of 3 finite numbers, not all 0" : "an array of 3 finite numbers";
+        const toml::array& values = array(key, 3, allowed);
+        Eigen::Vector3d v;
+        for (int i = 0; i < 3; ++i) {
+            const toml::node& x = *values.get(static_cast<std::size_t>(i));
+            if (!x.is_number() || !std::isfinite(*x.value<double>()))
+                fail(x, str(key, "[", i, "]"), str("must be a finite number, got ", describe(x)));
+            v[i] = *x.value<double>();
+        }
+        if (nonzero && v.norm() == 0.0)
+            fail(*get(key), key, str("must be ", allowed));
+        return v;
+    }
+    std::vector<int> integers(const std::string& key) const
+    {
+        const toml::array& values = array(key, 0, "an array of vertex indices");
+        std::vector<int> out;
+        for (std::size_t i = 0; i < values.size(); ++i)
+            out.push_back(integer_of(*values.get(i), str(key, "[", i, "]"), 0, std::numeric_limits<int>::max()));
+        return out;
+    }
+    std::vector<std::string> texts(const std::string& key, const std::vector<std::string>& fallback,
+                                   const std::vector<std::string>& allowed) const
+    {
+        if (!has(key))
+            return fallback;
+        const toml::array& values = array(key, 0, str("an array of strings from: ", joined(allowed)));
+        std::vector<std::string> out;
+        for (std::size_t i = 0; i < values.size(); ++i) {
+            const toml::node& x = *values.get(i);
+            const std::string item = str(key, "[", i, "]");
+            if (!x.is_string() || std::find(allowed.begin(), allowed.end(), *x.value<std::string>()) == allowed.end())
+                fail(x, item, str("must be one of ", joined(allowed), ", got ", describe(x)));
+            out.push_back(*x.value<std::string>());
+        }
+        return out;
+    }
+    /// A sub-table (empty Fields if absent).
+    const toml::table* subtable(const std::string& key) const
+    {
+        const toml::node* node = get(key);
+        if (node == nullptr)
+            return nullptr;
+        if (!node->is_table())
+            fail(*node, key, str("must be a table, got ", type_name(*node)));
+        return node->as_table();
+    }
+
+    static std::string type_name(const toml::node& node)
+    {
+        std::ostringstream out;
+        out << node.type();
+        return out.str();
+    }
+    static std::string describe(const toml::node& node)
+    {
+        std::ostringstream out;
+        if (node.is_string())
+            out << "'" << *node.value<std::string>() << "'";
+        else if (node.is_boolean())
+            out << (*node.value<bool>() ? "true" : "false");
+        else if (node.is_number())
+            out << *node.value<double>();
+        else
+            out << "a " << node.type();
+        return out.str();
+    }
+
+private:
+    const toml::table& table_;
+    std::string name_;
+    const Source& source_;
+    const std::string& file_;
+};
+
+/// Δt: a number > 0 or a fraction "1/60".
+double time_step_field(const Fields& fields, const std::string& key, double fallback)
+{
+    const toml::node* node = fields.get(key);
+    if (node == nullptr)
+        return fallback;
+    const std::string allowed = "a number > 0 or a fraction like \"1/60\"";
+    double value = 0.0;
+    if (node->is_string()) {
+        const std::string text = *node->value<std::string>();
+        double a = 0.0, b = 0.0;
+        char slash = 0, rest = 0;
+        std::istringstream in(text);
+        if (!(in >> a >> slash >> b) || slash != '/' || (in >> rest) || b == 0.0)
+            fields.fail(*node, key, str("must be ", allowed, ", got '", text, "'"));
+        value = a / b;
+    } else {
+        if (!node->is_number())
+            fields.fail(*node, key, str("must be ", allowed, ", got ", Fields::type_name(*node)));
+        value = *node->value<double>();
+    }
+    if (!std::isfinite(value) || value <= 0.0)
+        fields.fail(*node, key, str("must be ", allowed, ", got ", value));
+    return value;
+}
+
+/// The table of an array of tables, checked to be one.
+const toml::table& table_in_array(const Fields& parent, const toml::node& node, const std::string& item)
+{
+    if (!node.is_table())
+        parent.fail(node, item, str("must be a table, got ", Fields::type_name(node)));
+    return *node.as_table();
+}
+
+Selector read_selector(const Fields& fields)
+{
+    Selector s;
+    s.where = str(fields.where(fields.table()), ": ", fields.name());
+    const int given = int(fields.has("box")) + int(fields.has("plane")) + int(fields.has("vertices"));
+    if (given != 1)
+        throw Error(str(s.where, ": give exactly one of box = [[x0, y0, z0], [x1, y1, z1]], ",
+                        "plane = { point = [...], normal = [...] } or vertices = [...]"));
+    if (fields.has("box")) {
+        s.kind = Selector::Kind::box;
+        const toml::array& corners = fields.array("box", 2, "two corners [[x0, y0, z0], [x1, y1, z1]]");
+        const toml::table corner_table{{"low", *corners.get(0)}, {"high", *corners.get(1)}};
+        const Fields corner(corner_table, fields.field("box"), fields.source(), {"low", "high"});
+        s.low = corner.vector("low", Eigen::Vector3d::Zero());
+        s.high = corner.vector("high", Eigen::Vector3d::Zero());
+        if ((s.low.array() > s.high.array()).any())
+            fields.fail(*fields.get("box"), "box", "the first corner must be below the second in x, y and z");
+    } else if (fields.has("plane")) {
+        s.kind = Selector::Kind::plane;
+        const Fields plane(*fields.subtable("plane"), fields.field("plane"), fields.source(), {"point", "normal", "side"});
+        s.point = plane.vector("point", Eigen::Vector3d::Zero());
+        s.normal = plane.vector("normal", Eigen::Vector3d::UnitX(), true).normalized();
+        s.below = plane.text("side", "on", {"on", "below"}) == "below";
+    } else {
+        s.kind = Selector::Kind::vertices;
+        s.vertices = fields.integers("vertices");
+    }
+    return s;
+}
+
+Motion read_motion(const Fields& fields, double duration)
+{
+    Motion m;
+    const std::string kind = fields.text("motion", "fixed", {"fixed", "rotate", "translate"});
+    m.start = fields.non_negative("start", 0.0);
+    m.end = fields.positive("end", std::max(duration, m.start + 1e-9));
+    if (m.end <= m.start)
+        fields.fail(*fields.get("end"), "end", str("must be after start = ", m.start, " s"));
+    const bool rotate = kind == "rotate", translate = kind == "translate";
+    for (const std::string key : {"axis", "center", "angle"})
+        if (!rotate && fields.has(key))
+            fields.fail(*fields.get(key), key, "belongs to motion = \"rotate\"");
+    if (!translate && fields.has("displacement"))
+        fields.fail(*fields.get("displacement"), "displacement", "belongs to motion = \"translate\"");
+    if (kind == "fixed") {
+        for (const std::string key : {"start", "end"})
+            if (fields.has(key))
+                fields.fail(*fields.get(key), key, "belongs to a moving pin (motion = \"rotate\" or \"translate\")");
+        return m;
+    }
+    if (rotate) {
+        m.kind = Motion::Kind::rotate;
+        m.axis = fields.vector("axis", Eigen::Vector3d::UnitX(), true).normalized();
+        m.center = fields.vector("center", Eigen::Vector3d::Zero());
+        m.angle = fields.finite("angle", 0.0) * std::acos(-1.0) / 180.0;
+    } else {
+        m.kind = Motion::Kind::translate;
+        m.displacement = fields.vector("displacement", Eigen::Vector3d::Zero());
+    }
+    return m;
+}
+
+const std::vector<std::string> selector_keys{"box", "plane", "vertices"};
+
+std::vector<std::string> with(std::vector<std::string> keys, const std::vector<std::string>& more)
+{
+    keys.insert(keys.end(), more.begin(), more.end());
+    return keys;
+}
+
+std::filesystem::path resolve(const std::filesystem::path& scene_file, const std::string& name)
+{
+    const std::filesystem::path given(name);
+    if (given.is_absolute())
+        return given;
+    const std::filesystem::path beside = scene_file.parent_path() / given;
+    if (std::filesystem::exists(beside))
+        return beside;
+    const std::filesystem::path data = data_path(name);
+    return std::filesystem::exists(data) ? data : beside;
+}
+
+TetMesh build_mesh(const Fields& fields, const std::filesystem::path& scene_file, MeshSpec& spec)
+{
+    const bool file = fields.has("file"), generator = fields.has("generator");
+    if (file == generator)
+        throw Error(str(fields.where(fields.table()), ": ", fields.name(),
+                        ": give exactly one of file = \"...\" (.obj, .stl, .ply, .node, .ele, .vtu) or generator = \"box\""));
+    spec.scale = fields.positive("scale", 1.0);
+    spec.translate = fields.vector("translate", Eigen::Vector3d::Zero());
+    TetMesh mesh;
+    if (generator) {
+        spec.generator = fields.text("generator", "box", {"box"});
+        spec.size = fields.vector("size", Eigen::Vector3d::Ones());
+        if ((spec.size.array() <= 0.0).any())
+            fields.fail(*fields.get("size"), "size", "every edge length must be > 0");
+        if (fields.has("cells")) {
+            const toml::array& cells = fields.array("cells", 3, "an array of 3 integers in [1, 200]");
+            for (int i = 0; i < 3; ++i)
+                spec.cells[i] = fields.integer_of(*cells.get(static_cast<std::size_t>(i)), str("cells[", i, "]"), 1, 200);
+        }
+        for (const std::string key : {"tetgen"})
+            if (fields.has(key))
+                fields.fail(*fields.get(key), key, "belongs to a surface file");
+        mesh = box_mesh(spec.cells.x(), spec.cells.y(), spec.cells.z(), spec.size);
+    } else {
+        for (const std::string key : {"size", "cells"})
+            if (fields.has(key))
+                fields.fail(*fields.get(key), key, "belongs to generator = \"box\"");
+        const std::string name = fields.text("file", "");
+        spec.file = resolve(scene_file, name);
+        const toml::node& node = *fields.get("file");
+        if (!std::filesystem::exists(spec.file))
+            fields.fail(node, "file", str("no such file: ", spec.file.string()));
+        const std::string extension = spec.file.extension().string();
+        try {
+            if (extension == ".obj" || extension == ".stl" || extension == ".ply") {
+                spec.tetgen = fields.text("tetgen", spec.tetgen);
+                mesh = tetrahedralize(io::read_tri_mesh(spec.file), spec.tetgen, spec.file.string());
+            } else if (extension == ".node" || extension == ".ele" || extension == ".vtu") {
+                if (fields.has("tetgen"))
+                    fields.fail(*fields.get("tetgen"), "tetgen", "belongs to a surface file (.obj, .stl, .ply)");
+                mesh = io::read_tet_mesh(spec.file);
+            } else {
+                fields.fail(node, "file", str("has the extension '", extension,
+                                              "'; allowed: .obj, .stl, .ply (surfaces, TetGen makes the tets), .node, .ele, .vtu"));
+            }
+        } catch (const Error& e) {
+            const std::string text = e.what();
+            if (text.rfind(fields.where(node), 0) == 0)
+                throw;
+            fields.fail(node, "file", text);
+        }
+        mesh.V *= spec.scale;
+    }
+    if (mesh.T.rows() == 0)
+        fields.fail(*fields.get(file ? "file" : "generator"), file ? "file" : "generator", "the mesh has no tets");
+    mesh.V.rowwise() += spec.translate.transpose();
+    return mesh;
+}
+
+BodySpec read_body(const toml::table& table, const std::string& name, const Source& file,
+                   const std::filesystem::path& scene_file, double duration, int index)
+{
+    const Fields fields(table, name, file,
+                        {"name", "mesh", "material", "mass", "damping", "pin", "load", "initial_velocity"});
+    BodySpec body;
+    body.name = fields.text("name", str("body", index));
+    if (body.name.empty() || body.name.find_first_of("/\\ \t") != std::string::npos)
+        fields.fail(*fields.get("name"), "name", "must be a non-empty name without spaces or slashes");
+
+    const toml::table* mesh_table = fields.subtable("mesh");
+    if (mesh_table == nullptr)
+        fields.missing("mesh", "give [body.mesh] with file = \"...\" or generator = \"box\"");
+    const Fields mesh(*mesh_table, fields.field("mesh"), file,
+                      {"file", "generator", "size", "cells", "scale", "translate", "tetgen"});
+    body.mesh = build_mesh(mesh, scene_file, body.mesh_spec);
+
+    const toml::table* material_table = fields.subtable("material");
+    if (material_table == nullptr)
+        fields.missing("material", "give [body.material] with model, youngs_modulus, poisson_ratio, density");
+    const Fields material(*material_table, fields.field("material"), file,
+                          {"model", "youngs_modulus", "poisson_ratio", "density"});
+    body.model = material.text("model", "linear", model_names());
+    body.material.youngs_modulus = material.positive("youngs_modulus", body.material.youngs_modulus);
+    body.material.poisson_ratio = material.number(
+        "poisson_ratio", body.material.poisson_ratio, [](double nu) { return nu > -1.0 && nu < 0.5; },
+        "a number in (-1, 0.5) (0.5 is incompressible, which a displacement model cannot represent)");
+    body.material.density = material.positive("density", body.material.density);
+    body.mass = fields.text("mass", "lumped", {"lumped", "consistent"}) == "lumped" ? dynamics::MassModel::lumped
+                                                                                   : dynamics::MassModel::consistent;
+    if (const toml::table* damping_table = fields.subtable("damping")) {
+        const Fields damping(*damping_table, fields.field("damping"), file, {"alpha", "beta"});
+        const auto in_range = [](double x) { return x >= 0.0 && x <= 0.02; };
+        body.damping.alpha = damping.number("alpha", 0.0, in_range, "a number in [0, 0.02] (1/s)");
+        body.damping.beta = damping.number("beta", 0.0, in_range, "a number in [0, 0.02] (s)");
+    }
+    body.initial_velocity = fields.vector("initial_velocity", Eigen::Vector3d::Zero());
+
+    const auto each = [&](const std::string& key, const auto& read) {
+        const toml::node* node = fields.get(key);
+        if (node == nullptr)
+            return;
+        if (!node->is_array_of_tables())
+            fields.fail(*node, key, str("must be an array of tables ([[", name.substr(0, name.find('[')), ".", key,
+                                        "]]), got ", Fields::type_name(*node)));
+        const toml::array& items = *node->as_array();
+        for (std::size_t i = 0; i < items.size(); ++i)
+            read(Fields(table_in_array(fields, *items.get(i), key), str(fields.field(key), "[", i, "]"), file,
+                        with(selector_keys, key == "pin" ? std::vector<std::string>{"motion", "axis", "center", "angle",
+                                                                                   "displacement", "start", "end"}
+                                                         : std::vector<std::string>{"type", "force", "traction",
+                                                                                    "ramp", "until"})));
+    };
+    std::set<int> pinned;
+    each("pin", [&](const Fields& pin) {
+        Pin p{read_selector(pin), read_motion(pin, duration)};
+        const std::vector<int> selected = select_vertices(body.mesh, p.select);
+        p.select.vertices = selected;  // resolved once: the runner moves exactly these
+        p.select.kind = Selector::Kind::vertices;
+        for (int v : selected)
+            if (!pinned.insert(v).second)
+                throw Error(str(p.select.where, ": vertex ", v, " is pinned by an earlier pin too; pins must not overlap"));
+        body.pins.push_back(std::move(p));
+    });
+    body.pinned.assign(pinned.begin(), pinned.end());
+    each("load", [&](const Fields& load) {
+        Load l;
+        const std::string type = load.text("type", "point", {"point", "surface"});
+        l.kind = type == "point" ? Load::Kind::point : Load::Kind::surface;
+        const std::string value_key = type == "point" ? "force" : "traction";
+        const std::string other_key = type == "point" ? "traction" : "force";
+        if (load.has(other_key))
+            load.fail(*load.get(other_key), other_key, str("belongs to the other load type; a ", type, " load has ", value_key));
+        if (!load.has(value_key))
+            load.missing(value_key, str("a ", type, " load needs ", value_key, " = [x, y, z] (",
+                                        type == "point" ? "total force, N" : "force per area, Pa", ")"));
+        l.value = load.vector(value_key, Eigen::Vector3d::Zero());
+        l.ramp = load.non_negative("ramp", 0.0);
+        l.until = load.positive("until", l.until);
+        l.select = read_selector(load);
+        l.select.vertices = select_vertices(body.mesh, l.select);
+        l.select.kind = Selector::Kind::vertices;
+        body.loads.push_back(std::move(l));
+    });
+    return body;
+}
+
+/// Splits "a.b.c" into its parts.
+std::vector<std::string> split_path(const std::string& path)
+{
+    std::vector<std::string> parts;
+    std::string part;
+    std::istringstream in(path);
+    while (std::getline(in, part, '.'))
+        parts.push_back(part);
+    return parts;
+}
+
+bool all_digits(const std::string& s)
+{
+    return !s.empty() && std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
+}
+
+/// Sets the field at parts[at..] below node to value; an array of tables without an index takes
+/// the value in every element.
+void assign(toml::table& table, const std::vector<std::string>& parts, std::size_t at, const toml::node& value,
+            const std::string& option)
+{
+    const std::string& key = parts[at];
+    if (at + 1 == parts.size()) {
+        value.visit([&](auto&& v) { table.insert_or_assign(key, v); });
+        return;
+    }
+    toml::node* child = table.get(key);
+    if (child == nullptr) {
+        table.insert_or_assign(key, toml::table{});
+        child = table.get(key);
+    }
+    if (child->is_table()) {
+        assign(*child->as_table(), parts, at + 1, value, option);
+    } else if (child->is_array_of_tables()) {
+        toml::array& items = *child->as_array();
+        if (all_digits(parts[at + 1])) {
+            const std::size_t index = std::stoul(parts[at + 1]);
+            if (index >= items.size())
+                throw Error(str(option, ": ", key, " has ", items.size(), " entries, no ", index));
+            if (at + 2 == parts.size())
+                throw Error(str(option, ": name a field of ", key, "[", index, "]"));
+            assign(*items.get(index)->as_table(), parts, at + 2, value, option);
+        } else {
+            for (std::size_t i = 0; i < items.size(); ++i)
+                assign(*items.get(i)->as_table(), parts, at + 1, value, option);
+        }
+    } else {
+        throw Error(str(option, ": ", key, " is not a table, so it has no field ", parts[at + 1]));
+    }
+}
+
+/// Applies one "key=value" override to the tree.
+void apply_override(toml::table& root, const std::string& setting, const std::string& option)
+{
+    const std::size_t equals = setting.find('=');
+    if (equals == std::string::npos || equals == 0)
+        throw Error(str(option, ": expected key=value (e.g. body.material.model=auto or time.step=1/120)"));
+    const std::string key = setting.substr(0, equals), text = setting.substr(equals + 1);
+    const std::vector<std::string> parts = split_path(key);
+    for (const std::string& part : parts)
+        if (part.empty())
+            throw Error(str(option, ": the key '", key, "' has an empty part"));
+    // The value in TOML syntax (a number, true, [1, 2, 3], "text"); anything else is a string.
+    toml::table parsed;
+    try {
+        parsed = toml::parse("value = " + text, option);
+    } catch (const toml::parse_error&) {
+        std::string quoted = "\"";
+        for (char c : text) {
+            if (c == '"' || c == '\\')
+                quoted += '\\';
+            quoted += c;
+        }
+        try {
+            parsed = toml::parse("value = " + quoted + "\"", option);
+        } catch (const toml::parse_error& e) {
+            throw Error(str(option, ": the value is neither TOML nor a plain string: ", e.description()));
+        }
+    }
+    assign(root, parts, 0, *parsed.get("value"), option);
+}
+
+/// Adds the leaves of a [quick] table as "a.b.c" paths.
+void flatten(const toml::table& table, const std::string& prefix, std::vector<std::pair<std::string, const toml::node*>>& out)
+{
+    for (auto&& [key, node] : table) {
+        const std::string path = prefix.empty() ? std::string(key.str()) : prefix + "." + std::string(key.str());
+        if (node.is_table())
+            flatten(*node.as_table(), path, out);
+        else
+            out.emplace_back(path, &node);
+    }
+}
+
+}  // namespace
+
+SceneSpec read_scene(const std::filesystem::path& path, const std::vector<std::string>& overrides, bool quick)
+{
+    const std::string file = path.string();
+    if (!std::filesystem::is_regular_file(path))
+        throw Error(str("scene file '", file, "': ", std::filesystem::exists(path) ? "not a regular file" : "no such file"));
+    toml::table root;
+    try {
+        root = toml::parse_file(file);
+    } catch (const toml::parse_error& e) {
+        throw Error(str(file, ":", e.source().begin.line, ":", e.source().begin.column, ": TOML syntax error: ",
+                        e.description()));
+    }
+    Source source{file, {}};
+    if (quick) {
+        if (const toml::node* node = root.get("quick")) {
+            if (!node->is_table())
+                Fields(root, "", source, {}).fail(*node, "quick", "must be a table of overrides (field = value)");
+            std::vector<std::pair<std::string, const toml::node*>> leaves;
+            flatten(*node->as_table(), "", leaves);
+            toml::table copy = root;
+            for (const auto& [key, value] : leaves) {
+                const std::string option = str("[quick] ", key, " (line ", value->source().begin.line, ")");
+                assign(copy, split_path(key), 0, *value, str(file, ": ", option));
+                source.overrides.emplace_back(key, option);
+            }
+            root = std::move(copy);
+        }
+    }
+    for (const std::string& setting : overrides) {
+        apply_override(root, setting, "--set " + setting);
+        source.overrides.emplace_back(setting.substr(0, setting.find('=')), "--set " + setting);
+    }
+
+    const Fields top(root, "", source, {"title", "gravity", "body", "time", "solver", "auto", "output", "skin", "quick"});
+    SceneSpec scene;
+    scene.file = path;
+    scene.title = top.text("title", path.stem().string());
+    scene.gravity = top.vector("gravity", scene.gravity);
+
+    if (const toml::table* time_table = top.subtable("time")) {
+        const Fields time(*time_table, "time", source, {"step", "duration", "integrator"});
+        scene.time_step = time_step_field(time, "step", scene.time_step);
+        scene.duration = time.number("duration", scene.duration, [](double d) { return d > 0.0 && d <= 3600.0; },
+                                     "a number in (0, 3600] (seconds)");
+        scene.integrator = time.text("integrator", scene.integrator, dynamics::integrator_names());
+        try {
+            dynamics::step_count(scene.duration, scene.time_step);
+        } catch (const Error& e) {
+            time.fail(time.has("duration") ? *time.get("duration") : *time_table, "duration", e.what());
+        }
+    }
+    if (const toml::table* solver_table = top.subtable("solver")) {
+        const Fields solver(*solver_table, "solver", source, {"name", "newton_tolerance"});
+        scene.solver = solver.text("name", scene.solver);
+        scene.newton_tolerance = solver.number("newton_tolerance", scene.newton_tolerance,
+                                               [](double t) { return t > 0.0 && t < 1.0; }, "a number in (0, 1)");
+    }
+    if (const toml::table* auto_table = top.subtable("auto")) {
+        const Fields a(*auto_table, "auto", source, {"rotation", "strain", "volume_ratio", "hysteresis", "hyperelastic"});
+        const double degrees = std::acos(-1.0) / 180.0;
+        scene.thresholds.rotation =
+            a.number("rotation", scene.thresholds.rotation / degrees, [](double x) { return x > 0.0 && x < 90.0; },
+                     "a number in (0, 90) (degrees)") * degrees;
+        scene.thresholds.strain = a.number("strain", scene.thresholds.strain, [](double x) { return x > 0.0 && x < 1.0; },
+                                           "a number in (0, 1)");
+        scene.thresholds.volume_ratio = a.number("volume_ratio", scene.thresholds.volume_ratio,
+                                                 [](double x) { return x > 0.0 && x < 1.0; }, "a number in (0, 1)");
+        scene.thresholds.hysteresis = a.number("hysteresis", scene.thresholds.hysteresis,
+                                               [](double x) { return x > 0.0 && x <= 1.0; }, "a number in (0, 1]");
+        scene.thresholds.hyperelastic =
+            a.text("hyperelastic", scene.thresholds.hyperelastic, {"stvk", "neo-hookean", "stable-neo-hookean"});
+    }
+    if (const toml::table* output_table = top.subtable("output")) {
+        const Fields o(*output_table, "output", source,
+                       {"frame_rate", "pvd", "png", "video", "csv", "charts", "frame_box", "colour_range", "fields", "colour", "view_direction", "view_up",
+                        "warp", "width", "height"});
+        OutputSpec& out = scene.output;
+        out.frame_rate = o.number("frame_rate", out.frame_rate, [](double f) { return f > 0.0 && f <= 1000.0; },
+                                  "a number in (0, 1000] (frames per simulated second)");
+        out.pvd = o.flag("pvd", out.pvd);
+        out.png = o.flag("png", out.png);
+        out.video = o.text("video", out.video, {"mp4", "gif", "none"});
+        out.csv = o.flag("csv", out.csv);
+        out.charts = o.flag("charts", out.charts);
+        if (out.charts && !out.csv)
+            o.fail(*o.get(o.has("charts") ? "charts" : "csv"), "charts", "are drawn from steps.csv: set csv = true or charts = false");
+        if (out.png && !out.pvd)
+            o.fail(*o.get(o.has("png") ? "png" : "pvd"), "png", "frames are rendered from the .pvd frames: set pvd = true or png = false");
+        const std::vector<std::string> fields{"displacement", "velocity", "von Mises stress", "model"};
+        out.fields = o.texts("fields", out.fields, fields);
+        out.colour = o.text("colour", out.colour, fields);
+        out.view_direction = o.vector("view_direction", out.view_direction, true);
+        out.view_up = o.vector("view_up", out.view_up, true);
+        out.warp = o.positive("warp", out.warp);
+        if (o.has("frame_box")) {
+            const toml::array& corners = o.array("frame_box", 2, "two corners [[x0, y0, z0], [x1, y1, z1]]");
+            const toml::table corner_table{{"low", *corners.get(0)}, {"high", *corners.get(1)}};
+            const Fields corner(corner_table, o.field("frame_box"), o.source(), {"low", "high"});
+            const Eigen::Vector3d low = corner.vector("low", Eigen::Vector3d::Zero());
+            const Eigen::Vector3d high = corner.vector("high", Eigen::Vector3d::Zero());
+            if ((low.array() >= high.array()).any())
+                o.fail(*o.get("frame_box"), "frame_box", "the first corner must be below the second in x, y and z");
+            out.frame_box = std::array<double, 6>{low.x(), high.x(), low.y(), high.y(), low.z(), high.z()};
+        }
+        if (o.has("colour_range")) {
+            const toml::array& range = o.array("colour_range", 2, "[low, high] with low < high");
+            const double low = o.number_of(*range.get(0), "colour_range[0]", [](double) { return true; }, "a finite number");
+            const double high = o.number_of(*range.get(1), "colour_range[1]", [low](double h) { return h > low; },
+                                            "a finite number above colour_range[0]");
+            out.colour_range = std::make_pair(low, high);
+        }
+        out.width = o.integer("width", out.width, 64, 4096);
+        out.height = o.integer("height", out.height, 64, 4096);
+        if (out.colour != "displacement" && std::find(out.fields.begin(), out.fields.end(), out.colour) == out.fields.end())
+            o.fail(*output_table, "colour", str("'", out.colour, "' must be one of the fields written (output.fields)"));
+        if (out.video != "none" && !out.png)
+            o.fail(*o.get("video"), "video", "is made from the PNG frames: set png = true or video = \"none\"");
+    }
+
+    const toml::node* bodies = top.get("body");
+    if (bodies == nullptr)
+        top.missing("body", "give at least one [[body]] with its mesh and material");
+    if (!bodies->is_array_of_tables())
+        top.fail(*bodies, "body", str("must be an array of tables ([[body]]), got ", Fields::type_name(*bodies)));
+    const toml::array& items = *bodies->as_array();
+    std::set<std::string> names;
+    for (std::size_t i = 0; i < items.size(); ++i) {
+        const std::string name = str("body[", i, "]");
+        scene.bodies.push_back(
+            read_body(table_in_array(top, *items.get(i), "body"), name, source, path, scene.duration, static_cast<int>(i)));
+        if (!names.insert(scene.bodies.back().name).second)
+            top.fail(*items.get(i), name + ".name", str("'", scene.bodies.back().name, "' is the name of an earlier body"));
+    }
+
+    if (const toml::table* skin_table = top.subtable("skin")) {
+        const Fields s(*skin_table, "skin", source, {"file", "body"});
+        SkinSpec skin;
+        if (!s.has("file"))
+            s.missing("file", "the fine surface (.obj, .stl, .ply) the tets carry");
+        skin.file = resolve(path, s.text("file", ""));
+        if (!std::filesystem::exists(skin.file))
+            s.fail(*s.get("file"), "file", str("no such file: ", skin.file.string()));
+        skin.body = s.text("body", scene.bodies.front().name);
+        if (!names.count(skin.body))
+            s.fail(*s.get("body"), "body", str("no body is called '", skin.body, "'"));
+        scene.skin = skin;
+    }
+    for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
+        const BodySpec& body = scene.bodies[i];
+        const bool hyper = body.model != "linear" && body.model != "corotational";
+        if (hyper && (body.damping.alpha != 0.0 || body.damping.beta != 0.0))
+            throw Error(str(file, ": body[", i, "].damping: not with body[", i, "].material.model = '", body.model,
+                            "', which steps with chapter 12's Newton backward Euler, which has no Rayleigh damping: set "
+                            "damping to 0 or the model to linear or corotational"));
+        if (hyper && scene.integrator != "backward-euler")
+            throw Error(str(file, ": time.integrator: '", scene.integrator, "' is not for body[", i, "].material.model = '",
+                            body.model, "', which steps with Newton backward Euler only: use backward-euler"));
+        try {
+            dynamics::validate(dynamics_scene(scene, body));
+        } catch (const Error& e) {
+            throw Error(str(file, ": ", body.name, ": ", e.what()));
+        }
+    }
+    return scene;
+}
+
+dynamics::Scene dynamics_scene(const SceneSpec& scene, const BodySpec& body)
+{
+    return dynamics::Scene{.mesh = body.mesh, .material = body.material, .pinned = body.pinned,
+                           .gravity = scene.gravity, .damping = body.damping, .mass = body.mass,
+                           .time_step = scene.time_step, .duration = scene.duration};
+}
+
+std::vector<int> select_vertices(const TetMesh& mesh, const Selector& selector)
+{
+    std::vector<int> out;
+    const Eigen::Index n = mesh.V.rows();
+    const double diagonal = (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).norm();
+    const double tolerance = 1e-6 * diagonal;
+    if (selector.kind == Selector::Kind::vertices) {
+        std::set<int> unique;
+        for (int v : selector.vertices) {
+            if (v < 0 || v >= n)
+                throw Error(str(selector.where, ": vertex ", v, " does not exist (the mesh has ", n, " vertices)"));
+            unique.insert(v);
+        }
+        out.assign(unique.begin(), unique.end());
+    }
+    for (Eigen::Index v = 0; v < n && selector.kind != Selector::Kind::vertices; ++v) {
+        const Eigen::Vector3d x = mesh.V.row(v).transpose();
+        bool in = false;
+        if (selector.kind == Selector::Kind::box) {
+            in = ((x.array() >= selector.low.array() - tolerance) && (x.array() <= selector.high.array() + tolerance)).all();
+        } else {
+            const double distance = selector.normal.dot(x - selector.point);
+            in = selector.below ? distance <= tolerance : std::abs(distance) <= tolerance;
+        }
+        if (in)
+            out.push_back(static_cast<int>(v));
+    }
+    if (out.empty()) {
+        const Eigen::RowVector3d low = mesh.V.colwise().minCoeff(), high = mesh.V.colwise().maxCoeff();
+        throw Error(str(selector.where, ": selects no vertex of the mesh, which spans [", low.x(), ", ", high.x(),
+                        "] x [", low.y(), ", ", high.y(), "] x [", low.z(), ", ", high.z(), "] m"));
+    }
+    return out;
+}
+
+Eigen::Vector3d prescribed_displacement(const Motion& motion, const Eigen::Vector3d& X, double t)
+{
+    if (motion.kind == Motion::Kind::fixed)
+        return Eigen::Vector3d::Zero();
+    const double tau = std::clamp((t - motion.start) / (motion.end - motion.start), 0.0, 1.0);
+    const double s = tau * tau * (3.0 - 2.0 * tau);
+    if (motion.kind == Motion::Kind::translate)
+        return s * motion.displacement;
+    const Eigen::Matrix3d R = Eigen::AngleAxisd(s * motion.angle, motion.axis).toRotationMatrix();
+    return R * (X - motion.center) + motion.center - X;
+}
+
+MatrixX3i boundary_faces(const TetMesh& mesh)
+{
+    // Each tet (a, b, c, d) of positive volume has the outward faces below; a face shared by two
+    // tets appears in both with opposite orientation, so only faces counted once are on the boundary.
+    static constexpr int faces[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+    std::map<std::array<int, 3>, std::pair<int, std::array<int, 3>>> count;
+    for (Eigen::Index t = 0; t < mesh.T.rows(); ++t) {
+        for (const auto& f : faces) {
+            const std::array<int, 3> oriented{mesh.T(t, f[0]), mesh.T(t, f[1]), mesh.T(t, f[2])};
+            std::array<int, 3> key = oriented;
+            std::sort(key.begin(), key.end());
+            auto& entry = count[key];
+            entry.first += 1;
+            entry.second = oriented;
+        }
+    }
+    std::vector<std::array<int, 3>> kept;
+    for (const auto& [key, entry] : count)
+        if (entry.first == 1)
+            kept.push_back(entry.second);
+    MatrixX3i F(static_cast<Eigen::Index>(kept.size()), 3);
+    for (std::size_t i = 0; i < kept.size(); ++i)
+        F.row(static_cast<Eigen::Index>(i)) << kept[i][0], kept[i][1], kept[i][2];
+    return F;
+}
+
+TetMesh tetrahedralize(const TriMesh& surface, const std::string& switches, const std::string& what)
+{
+    if (switches.find_first_not_of("pqaYAVQzcCfMnTo0123456789.e") != std::string::npos || switches.find('p') == std::string::npos)
+        throw Error(str(what, ": TetGen switches '", switches, "' must include p (tetrahedralise a surface) and be plain "
+                                                          "switches such as pq1.5aY"));
+    const std::filesystem::path folder =
+        std::filesystem::temp_directory_path() / str("fem-scene-tetgen-", ::getpid(), "-", std::rand());
+    std::filesystem::create_directories(folder);
+    struct Cleanup {
+        std::filesystem::path folder;
+        ~Cleanup() { std::error_code ignored; std::filesystem::remove_all(folder, ignored); }
+    } cleanup{folder};
+    // TetGen reads an .off surface (it has no .obj reader).
+    std::ostringstream off;
+    off.precision(17);
+    off << "OFF\n" << surface.V.rows() << ' ' << surface.F.rows() << " 0\n";
+    for (Eigen::Index v = 0; v < surface.V.rows(); ++v)
+        off << surface.V(v, 0) << ' ' << surface.V(v, 1) << ' ' << surface.V(v, 2) << '\n';
+    for (Eigen::Index f = 0; f < surface.F.rows(); ++f)
+        off << "3 " << surface.F(f, 0) << ' ' << surface.F(f, 1) << ' ' << surface.F(f, 2) << '\n';
+    write_file(folder / "surface.off", off.str());
+    const std::string command = str("tetgen -", switches, "Q '", (folder / "surface.off").string(), "' 2>&1");
+    std::string output;
+    FILE* pipe = ::popen(command.c_str(), "r");
+    if (pipe == nullptr)
+        throw Error(str(what, ": could not start TetGen (tools/setup.sh installs Debian's tetgen)"));
+    std::array<char, 512> buffer;
+    while (std::fgets(buffer.data(), buffer.size(), pipe) != nullptr)
+        output += buffer.data();
+    const int status = ::pclose(pipe);
+    const std::filesystem::path node = folder / "surface.1.node";
+    if (status != 0 || !std::filesystem::exists(node)) {
+        // TetGen's own words: its error or failed assertion if it printed one, else its last line.
+        std::string reason, last;
+        std::istringstream lines(output);
+        for (std::string line; std::getline(lines, line);) {
+            if (!line.empty())
+                last = line;
+            const std::size_t assertion = line.find("Assertion");
+            if (reason.empty() && assertion != std::string::npos)
+                reason = line.substr(assertion);
+            else if (reason.empty() && line.find("rror") != std::string::npos)
+                reason = line;
+        }
+        if (reason.empty())
+            reason = last;
+        if (WIFEXITED(status) && WEXITSTATUS(status) == 127)
+            reason = "the tetgen program is not installed (tools/setup.sh installs it)";
+        throw Error(str(what, ": TetGen could not tetrahedralise the surface (does it enclose a volume, closed and ",
+                        "free of self-intersections?): ", reason.empty() ? "no output" : reason));
+    }
+    return io::read_tet_mesh(node);
+}
+
+}  // namespace fem::scenes

@@ -1,0 +1,409 @@
+// The runner: loads and prescribed motion against closed forms, determinism, an interrupted run,
+// and bad scene files refused by fem_scene before it writes anything. docs/scenes.md#the-runner
+#include "scenes/runner.hpp"
+
+#include "06_assembly/assembly.hpp"
+
+#include "common/error.hpp"
+#include "common/vtk_io.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <X11/Xlib.h>
+#include <X11/keysym.h>
+
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+#include <sys/wait.h>
+#include <unistd.h>
+
+using namespace fem;
+using namespace fem::scenes;
+
+namespace {
+
+const std::filesystem::path gallery = FEM_SCENES_DIR;
+const std::filesystem::path output = FEM_TEST_OUTPUT_DIR;
+
+/// A scene from its text, written into the tests' output folder first.
+SceneSpec scene_from(const std::string& name, const std::string& text)
+{
+    std::filesystem::create_directories(output);
+    const std::filesystem::path file = output / (name + ".toml");
+    std::ofstream(file) << text;
+    return read_scene(file);
+}
+
+RunResult positions_of(const SceneSpec& scene, const std::string& model = "")
+{
+    RunOptions options;
+    options.model = model;
+    options.keep_positions = true;
+    options.print_models = false;
+    return run_scene(scene, options);
+}
+
+/// A free 0.1 m cube (no pin, no gravity) pushed by one load for 0.2 s at Δt = 0.02 s.
+std::string pushed_cube(const std::string& model, const std::string& load)
+{
+    return "gravity = [0.0, 0.0, 0.0]\n[[body]]\n"
+           "mesh = { generator = \"box\", size = [0.1, 0.1, 0.1], cells = [2, 2, 2] }\n"
+           "material = { model = \"" + model + "\", youngs_modulus = 1e5, poisson_ratio = 0.3, density = 500.0 }\n"
+           "[[body.load]]\n" + load + "\n"
+           "[time]\nstep = 0.02\nduration = 0.2\n";
+}
+
+/// Starts fem_scene with these arguments in a child process (its output discarded); returns its id.
+pid_t start_scene(const std::vector<std::string>& arguments)
+{
+    const pid_t child = ::fork();
+    if (child == 0) {
+        std::freopen("/dev/null", "w", stdout);
+        std::freopen("/dev/null", "w", stderr);
+        std::vector<char*> argv{const_cast<char*>(FEM_SCENE_EXE)};
+        for (const std::string& argument : arguments)
+            argv.push_back(const_cast<char*>(argument.c_str()));
+        argv.push_back(nullptr);
+        ::execv(FEM_SCENE_EXE, argv.data());
+        std::_Exit(127);
+    }
+    return child;
+}
+
+std::string read_text(const std::filesystem::path& path)
+{
+    std::ifstream file(path, std::ios::binary);
+    std::ostringstream text;
+    text << file.rdbuf();
+    return text.str();
+}
+
+}  // namespace
+
+TEST_CASE("a point or surface load moves the centre of mass as F t^2 / 2m does under backward Euler", "[scenes]")
+{
+    // Internal forces sum to zero, so backward Euler gives the total momentum Σ m v = F t_k exactly
+    // and the centre of mass Σ m u / m = Δt² F/m · n(n+1)/2 after n steps.
+    struct Case {
+        std::string model, load;
+        Eigen::Vector3d total;  // the load's total force [N]
+    };
+    const std::vector<Case> cases{
+        {"linear", "type = \"point\"\nvertices = [0]\nforce = [0.0, 0.0, 3.0]", {0.0, 0.0, 3.0}},
+        {"corotational", "type = \"point\"\nvertices = [0, 26]\nforce = [1.0, -2.0, 0.5]", {1.0, -2.0, 0.5}},
+        // 100 Pa on the 0.1 × 0.1 face x = 0.1: 1 N along x.
+        {"linear", "type = \"surface\"\nplane = { point = [0.1, 0.0, 0.0], normal = [1.0, 0.0, 0.0] }\n"
+                   "traction = [100.0, 0.0, 0.0]", {1.0, 0.0, 0.0}},
+    };
+    for (const Case& c : cases) {
+        INFO(c.model << " " << c.load);
+        const SceneSpec scene = scene_from("pushed_cube", pushed_cube(c.model, c.load));
+        const RunResult run = positions_of(scene);
+        const TetMesh& mesh = scene.bodies[0].mesh;
+        const Eigen::VectorXd m = assembly::vertex_masses(mesh, scene.bodies[0].material.density);
+        const MatrixX3d u = run.frames[0].back() - mesh.V;
+        const Eigen::Vector3d weighted = (u.array().colwise() * m.array()).colwise().sum().transpose();
+        const int n = run.steps;
+        REQUIRE(n == 10);
+        const Eigen::Vector3d expected = 0.02 * 0.02 * c.total * (n * (n + 1) / 2.0);
+        CHECK((weighted - expected).norm() < 1e-12 * expected.norm());
+    }
+}
+
+TEST_CASE("the twisted bar's moving end is where a half turn puts it, and the bar follows", "[scenes]")
+{
+    const SceneSpec scene = read_scene(gallery / "twisted_bar.toml", {"body.material.model=corotational"}, true);
+    const BodySpec& bar = scene.bodies[0];
+    const RunResult run = positions_of(scene);
+    // [quick] ends the turn at 0.25 s = the last frame: a half turn about the axis y = z = 0.
+    const MatrixX3d& x = run.frames[0].back();
+    int moved = 0;
+    for (Eigen::Index v = 0; v < bar.mesh.V.rows(); ++v) {
+        if (std::abs(bar.mesh.V(v, 0) - 0.2) > 1e-12)
+            continue;
+        ++moved;
+        const Eigen::RowVector3d turned(bar.mesh.V(v, 0), -bar.mesh.V(v, 1), -bar.mesh.V(v, 2));
+        CHECK((x.row(v) - turned).norm() < 1e-15);
+    }
+    CHECK(moved == 9);
+    // The free middle of the bar turned by about a quarter turn with it (the bar twists evenly).
+    const Eigen::Index middle = [&] {
+        for (Eigen::Index v = 0; v < bar.mesh.V.rows(); ++v)
+            if (std::abs(bar.mesh.V(v, 0) - 0.1) < 1e-12 && std::abs(bar.mesh.V(v, 1) - 0.02) < 1e-12 &&
+                std::abs(bar.mesh.V(v, 2) - 0.02) < 1e-12)
+                return v;
+        return Eigen::Index(-1);
+    }();
+    REQUIRE(middle >= 0);
+    const double angle = std::atan2(x(middle, 2), x(middle, 1)) - std::atan2(0.02, 0.02);
+    CHECK(angle > 0.3 * std::acos(-1.0));
+    CHECK(angle < 0.7 * std::acos(-1.0));
+}
+
+TEST_CASE("determinism: the same scene twice gives the same numbers to the last bit", "[scenes]")
+{
+    const SceneSpec scene = read_scene(gallery / "stiff_soft_pair.toml", {}, true);
+    const RunResult first = positions_of(scene), second = positions_of(scene);
+    REQUIRE(first.frames.size() == 2);
+    for (std::size_t b = 0; b < 2; ++b)
+        for (std::size_t f = 0; f < first.frames[b].size(); ++f)
+            CHECK((first.frames[b][f].array() == second.frames[b][f].array()).all());
+}
+
+TEST_CASE("determinism: fem_scene with 1 and 2 threads writes identical frames and energies", "[scenes]")
+{
+    const std::filesystem::path base = output / "threads";
+    std::filesystem::remove_all(base);
+    for (int threads : {1, 2}) {
+        const std::string command = "OMP_NUM_THREADS=" + std::to_string(threads) + " '" FEM_SCENE_EXE "' '" +
+                                    (gallery / "stiff_soft_pair.toml").string() + "' --quick --no-figures --out '" +
+                                    (base / std::to_string(threads)).string() + "' >/dev/null 2>&1";
+        REQUIRE(std::system(command.c_str()) == 0);
+    }
+    int frames = 0;
+    for (const auto& entry : std::filesystem::recursive_directory_iterator(base / "1")) {
+        if (entry.path().extension() != ".vtu" && entry.path().extension() != ".pvd")
+            continue;
+        ++frames;
+        const std::filesystem::path twin = base / "2" / std::filesystem::relative(entry.path(), base / "1");
+        CHECK(read_text(entry.path()) == read_text(twin));
+    }
+    CHECK(frames > 2);
+    // steps.csv: every column but the measured step time.
+    const auto without_time = [](const std::filesystem::path& path) {
+        std::istringstream lines(read_text(path));
+        std::string kept;
+        for (std::string line; std::getline(lines, line);)
+            kept += line.substr(0, line.rfind(',')) + '\n';
+        return kept;
+    };
+    CHECK(without_time(base / "1" / "steps.csv") == without_time(base / "2" / "steps.csv"));
+}
+
+TEST_CASE("an interrupted run (SIGINT) leaves a valid .pvd of the frames written so far", "[scenes]")
+{
+    const std::filesystem::path out = output / "interrupted";
+    std::filesystem::remove_all(out);
+    const std::string scene = (gallery / "cantilever.toml").string();
+    const pid_t child = start_scene({scene, "--no-figures", "--set", "time.duration=600", "--set",
+                                     "body.material.model=stable-neo-hookean", "--out", out.string()});
+    REQUIRE(child > 0);
+    // Wait until the run is stepping: its first frames are in the staging folder.
+    bool stepping = false;
+    for (int poll = 0; poll < 600 && !stepping; ++poll) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        std::error_code ignored;
+        for (const auto& entry : std::filesystem::directory_iterator(out, ignored))
+            stepping = stepping || std::filesystem::exists(entry.path() / "cantilever" / "cantilever_0002.vtu");
+    }
+    REQUIRE(stepping);
+    ::kill(child, SIGINT);
+    int status = 0;
+    ::waitpid(child, &status, 0);
+    REQUIRE(WIFEXITED(status));
+    CHECK(WEXITSTATUS(status) == 130);
+    const auto frames = io::read_pvd(out / "cantilever.pvd");
+    CHECK(frames.size() >= 3);
+    CHECK(frames.size() < 600 * 30);
+    for (const auto& [time, file] : frames)
+        CHECK(io::read_vtu(out / file).points.rows() > 0);
+    CHECK(std::filesystem::exists(out / "steps.csv"));
+}
+
+TEST_CASE("fem_scene refuses bad scene files with one error line and writes nothing", "[scenes]")
+{
+    const std::filesystem::path bad = FEM_SCENE_BAD_DIR;
+    for (const std::string file : {"missing.toml", "syntax.toml", "unknown_field.toml", "wrong_type.toml", "nu_half.toml",
+                                   "dt_zero.toml", "no_tets.toml", "pins_nothing.toml", "tetgen_fails.toml", "skin.toml"}) {
+        INFO(file);
+        const std::filesystem::path out = output / "refused";
+        std::filesystem::remove_all(out);
+        const std::filesystem::path log = output / "refused.log";
+        const std::string command = "'" FEM_SCENE_EXE "' '" + (bad / file).string() + "' --out '" + out.string() +
+                                    "' >'" + log.string() + "' 2>&1";
+        const int status = std::system(command.c_str());
+        CHECK(WEXITSTATUS(status) == 1);
+        CHECK(!std::filesystem::exists(out));
+        const std::string printed = read_text(log);
+        CHECK(printed.rfind("error: ", 0) == 0);
+        if (file == "skin.toml")
+            CHECK(printed.find("skin needs chapter 13") != std::string::npos);
+    }
+}
+
+TEST_CASE("the live view shows the PNG frame of the same step, pixel for pixel", "[scenes]")
+{
+    if (std::getenv("DISPLAY") == nullptr) {
+        WARN("no X display: run the tests under xvfb-run -a to check the live view");
+        return;
+    }
+    const std::filesystem::path base = output / "view";
+    std::filesystem::remove_all(base);
+    const std::string scene = (gallery / "cantilever.toml").string();
+    const std::string files = "'" FEM_SCENE_EXE "' '" + scene + "' --quick --no-progress --out '" + (base / "files").string() +
+                              "' >/dev/null 2>&1";
+    const std::string view = "'" FEM_SCENE_EXE "' '" + scene + "' --quick --no-progress --view --screenshot 5 --out '" +
+                             (base / "view").string() + "' >/dev/null 2>&1";
+    REQUIRE(std::system(files.c_str()) == 0);
+    REQUIRE(std::system(view.c_str()) == 0);
+    // [quick]: 12 frames per second at dt = 1/60 s, a frame every 5 steps: step 5 is frame 1.
+    const std::string png = read_text(base / "files" / "cantilever_0001.png");
+    REQUIRE(png.size() > 1000);
+    CHECK(read_text(base / "view" / "view_5.png") == png);
+    CHECK(read_text(base / "view" / "cantilever_0002.png") != png);  // another step is another picture
+}
+
+TEST_CASE("the live view without a display: one line says so and the run goes on headless", "[scenes]")
+{
+    const std::filesystem::path out = output / "headless";
+    std::filesystem::remove_all(out);
+    const std::filesystem::path log = output / "headless.log";
+    const std::string command = "env -u DISPLAY '" FEM_SCENE_EXE "' '" + (gallery / "hanging_cube.toml").string() +
+                                "' --quick --view --no-progress --out '" + out.string() + "' >'" + log.string() + "' 2>&1";
+    CHECK(std::system(command.c_str()) == 0);
+    const std::string printed = read_text(log);
+    CHECK(printed.find("note: no display for --view (set DISPLAY); the run goes on headless") != std::string::npos);
+    CHECK(std::filesystem::exists(out / "hanging_cube.pvd"));
+}
+
+TEST_CASE("the video: ffmpeg makes it from the PNG frames, or one line says it is missing", "[scenes]")
+{
+    if (std::getenv("DISPLAY") == nullptr) {
+        WARN("no X display, so no PNG frames to make a video of: run the tests under xvfb-run -a");
+        return;
+    }
+    const std::string scene = (gallery / "cantilever.toml").string();
+    for (bool with_ffmpeg : {true, false}) {
+        if (with_ffmpeg && std::system("command -v ffmpeg >/dev/null 2>&1") != 0) {
+            WARN("ffmpeg is not installed (tools/setup.sh installs it)");
+            continue;
+        }
+        const std::filesystem::path out = output / (with_ffmpeg ? "video" : "no_video");
+        std::filesystem::remove_all(out);
+        const std::filesystem::path log = output / "video.log";
+        // Without ffmpeg: a PATH that holds none (the runner needs no other program here).
+        const std::string command = std::string(with_ffmpeg ? "" : "PATH=/nonexistent ") + "'" FEM_SCENE_EXE "' '" + scene +
+                                    "' --quick --no-progress --set output.video=mp4 --set output.charts=false --out '" +
+                                    out.string() + "' >'" + log.string() + "' 2>&1";
+        CHECK(std::system(command.c_str()) == 0);
+        const std::string printed = read_text(log);
+        if (with_ffmpeg) {
+            CHECK(printed.find("video: cantilever.mp4") != std::string::npos);
+            const std::string mp4 = read_text(out / "cantilever.mp4");
+            CHECK(mp4.size() > 1000);
+            CHECK(mp4.substr(4, 4) == "ftyp");  // an MP4 container
+        } else {
+            CHECK(printed.find("video: skipped, ffmpeg is not installed") != std::string::npos);
+            CHECK(!std::filesystem::exists(out / "cantilever.mp4"));
+            CHECK(std::filesystem::exists(out / "cantilever_0003.png"));
+        }
+    }
+}
+
+namespace {
+
+/// The top-level window whose name starts with prefix, searched from root (0: none).
+Window find_window(Display* display, Window root, const std::string& prefix)
+{
+    char* name = nullptr;
+    if (XFetchName(display, root, &name) && name != nullptr) {
+        const bool found = std::string(name).rfind(prefix, 0) == 0;
+        XFree(name);
+        if (found)
+            return root;
+    }
+    Window parent = 0, *children = nullptr;
+    unsigned int count = 0;
+    Window found = 0;
+    if (XQueryTree(display, root, &root, &parent, &children, &count)) {
+        for (unsigned int i = 0; i < count && found == 0; ++i)
+            found = find_window(display, children[i], prefix);
+        if (children != nullptr)
+            XFree(children);
+    }
+    return found;
+}
+
+/// Sends a key press (an X key symbol, e.g. XK_space) to a window, as a user would.
+void press(Display* display, Window window, KeySym key)
+{
+    XKeyEvent event{};
+    event.type = KeyPress;
+    event.display = display;
+    event.window = window;
+    event.root = DefaultRootWindow(display);
+    event.same_screen = True;
+    event.keycode = XKeysymToKeycode(display, key);
+    XSendEvent(display, window, True, KeyPressMask, reinterpret_cast<XEvent*>(&event));
+    event.type = KeyRelease;
+    XSendEvent(display, window, True, KeyReleaseMask, reinterpret_cast<XEvent*>(&event));
+    XFlush(display);
+}
+
+/// The .vtu frames a running fem_scene has written so far into its staging folder.
+int frames_so_far(const std::filesystem::path& out, const std::string& stem)
+{
+    int count = 0;
+    std::error_code ignored;
+    for (const auto& staging : std::filesystem::directory_iterator(out, ignored))
+        for (const auto& frame : std::filesystem::directory_iterator(staging.path() / stem, ignored))
+            count += frame.path().extension() == ".vtu";
+    return count;
+}
+
+}  // namespace
+
+TEST_CASE("the live view's keys: space pauses, the right arrow steps, space resumes, r restarts, q stops", "[scenes]")
+{
+    Display* display = std::getenv("DISPLAY") ? XOpenDisplay(nullptr) : nullptr;
+    if (display == nullptr) {
+        WARN("no X display: run the tests under xvfb-run -a to check the live view's keys");
+        return;
+    }
+    const std::filesystem::path out = output / "keys";
+    std::filesystem::remove_all(out);
+    const std::string scene = (gallery / "cantilever.toml").string();
+    const pid_t child = start_scene({scene, "--quick", "--view", "--no-figures", "--no-progress", "--set", "time.duration=600",
+                                     "--out", out.string()});
+    REQUIRE(child > 0);
+    Window window = 0;
+    for (int poll = 0; poll < 600 && (window == 0 || frames_so_far(out, "cantilever") < 3); ++poll) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        if (window == 0)
+            window = find_window(display, DefaultRootWindow(display), "fem_scene: ");
+    }
+    REQUIRE(window != 0);
+    press(display, window, XK_space);  // pause
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    const int paused = frames_so_far(out, "cantilever");
+    std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+    CHECK(frames_so_far(out, "cantilever") == paused);
+    press(display, window, XK_Right);  // one frame on, still paused
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    CHECK(frames_so_far(out, "cantilever") == paused + 1);
+    press(display, window, XK_c);  // another colour field: the run goes on drawing
+    press(display, window, XK_space);  // resume: 12 frames a second
+    std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+    CHECK(frames_so_far(out, "cantilever") > paused);
+    // r: the run starts over (its frames so far are dropped and written again from the start).
+    for (int poll = 0; poll < 600 && frames_so_far(out, "cantilever") < paused + 8; ++poll)
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    const int before_restart = frames_so_far(out, "cantilever");
+    press(display, window, XK_r);
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    CHECK(frames_so_far(out, "cantilever") < before_restart);
+    press(display, window, XK_q);  // stop, as Ctrl-C does
+    int status = 0;
+    ::waitpid(child, &status, 0);
+    XCloseDisplay(display);
+    REQUIRE(WIFEXITED(status));
+    CHECK(WEXITSTATUS(status) == 130);
+    const auto frames = io::read_pvd(out / "cantilever.pvd");
+    REQUIRE(!frames.empty());
+    CHECK(frames.front().first == 0.0);
+    CHECK(frames.size() < static_cast<std::size_t>(before_restart));  // the restarted run's frames only
+}

@@ -1,0 +1,172 @@
+// The scene file: every bad scene is a clear error naming file, line, column and field; overrides
+// are checked like the file; selectors and prescribed motions. docs/scenes.md#the-scene-file
+#include "scenes/scene_file.hpp"
+
+#include "common/error.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <Eigen/Geometry>
+
+#include <filesystem>
+#include <fstream>
+
+using namespace fem;
+using namespace fem::scenes;
+
+namespace {
+
+const std::filesystem::path bad = FEM_SCENE_BAD_DIR;
+const std::filesystem::path gallery = FEM_SCENES_DIR;
+
+/// The message of the fem::Error read_scene throws (fails the test when it throws none).
+std::string error_of(const std::filesystem::path& file, const std::vector<std::string>& overrides = {})
+{
+    try {
+        read_scene(file, overrides);
+    } catch (const Error& e) {
+        return e.what();
+    }
+    FAIL("no error for " << file);
+    return "";
+}
+
+}  // namespace
+
+TEST_CASE("bad scene files: each names file, line, column, field and what is allowed", "[scenes]")
+{
+    struct Case {
+        const char* file;
+        std::vector<std::string> expected;  // parts of the message
+    };
+    const std::vector<Case> cases{
+        {"missing.toml", {"missing.toml", "no such file"}},
+        {"syntax.toml", {"syntax.toml:4:46:", "TOML syntax error"}},
+        {"unknown_field.toml", {"unknown_field.toml:13:", "time.substeps", "unknown field", "step, duration, integrator"}},
+        {"wrong_type.toml", {"wrong_type.toml:5:", "body[0].material.youngs_modulus", "a number > 0", "got string"}},
+        {"nu_half.toml", {"nu_half.toml:5:", "body[0].material.poisson_ratio", "(-1, 0.5)", "got 0.5"}},
+        {"dt_zero.toml", {"dt_zero.toml:11:8:", "time.step", "> 0", "got 0"}},
+        {"no_tets.toml", {"no_tets.toml:4:", "body[0].mesh.file", "0 tetrahedra"}},
+        {"pins_nothing.toml", {"pins_nothing.toml:10:1:", "body[0].pin[1]", "selects no vertex", "[0, 0.1]"}},
+        {"tetgen_fails.toml", {"tetgen_fails.toml:4:", "body[0].mesh.file", "TetGen could not tetrahedralise"}},
+    };
+    for (const Case& c : cases) {
+        const std::string message = error_of(bad / c.file);
+        INFO(message);
+        for (const std::string& part : c.expected)
+            CHECK(message.find(part) != std::string::npos);
+    }
+}
+
+TEST_CASE("every gallery scene reads, with and without its quick overrides", "[scenes]")
+{
+    int count = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(gallery)) {
+        if (entry.path().extension() != ".toml")
+            continue;
+        ++count;
+        INFO(entry.path());
+        for (bool quick : {false, true}) {
+            const SceneSpec scene = read_scene(entry.path(), {}, quick);
+            CHECK(!scene.bodies.empty());
+            for (const BodySpec& body : scene.bodies) {
+                CHECK(body.mesh.T.rows() > 0);
+                CHECK(!body.pinned.empty());
+            }
+        }
+    }
+    CHECK(count >= 5);
+}
+
+TEST_CASE("overrides of --set are checked like the file and reach every body without an index", "[scenes]")
+{
+    const std::filesystem::path pair = gallery / "stiff_soft_pair.toml";
+    const SceneSpec all = read_scene(pair, {"body.material.model=corotational", "time.step=1/120"});
+    REQUIRE(all.bodies.size() == 2);
+    CHECK(all.bodies[0].model == "corotational");
+    CHECK(all.bodies[1].model == "corotational");
+    CHECK(all.time_step == 1.0 / 120.0);
+    const SceneSpec one = read_scene(pair, {"body.1.material.youngs_modulus=2e5"});
+    CHECK(one.bodies[0].material.youngs_modulus == 1e6);
+    CHECK(one.bodies[1].material.youngs_modulus == 2e5);
+
+    const std::string nu = error_of(pair, {"body.0.material.poisson_ratio=0.5"});
+    CHECK(nu.find("--set body.0.material.poisson_ratio=0.5") != std::string::npos);
+    CHECK(nu.find("body[0].material.poisson_ratio") != std::string::npos);
+    const std::string unknown = error_of(pair, {"time.substeps=3"});
+    CHECK(unknown.find("time.substeps: unknown field") != std::string::npos);
+    const std::string model = error_of(pair, {"body.material.model=plastic"});
+    CHECK(model.find("linear, corotational, stvk, neo-hookean, stable-neo-hookean, auto") != std::string::npos);
+    CHECK(error_of(pair, {"time.step"}).find("expected key=value") != std::string::npos);
+    CHECK(error_of(pair, {"body.5.name=x"}).find("no 5") != std::string::npos);
+}
+
+TEST_CASE("a skin section is refused until chapter 13 lands", "[scenes]")
+{
+    // The scene reads (the [skin] fields are checked); the runner's make_skin_observer refuses it.
+    const SceneSpec scene = read_scene(bad / "skin.toml");
+    REQUIRE(scene.skin.has_value());
+    CHECK(scene.skin->body == "body0");
+}
+
+TEST_CASE("selectors: box, plane, list, and the vertices of a box mesh they pick", "[scenes]")
+{
+    const TetMesh mesh = box_mesh(2, 2, 2, Eigen::Vector3d(1.0, 1.0, 1.0));  // 27 vertices on a 3x3x3 grid
+    Selector plane;
+    plane.kind = Selector::Kind::plane;
+    plane.point = Eigen::Vector3d(0.5, 0.0, 0.0);
+    plane.normal = Eigen::Vector3d::UnitX();
+    CHECK(select_vertices(mesh, plane).size() == 9);
+    plane.below = true;
+    CHECK(select_vertices(mesh, plane).size() == 18);
+    Selector box;
+    box.low = Eigen::Vector3d(0.9, 0.9, 0.9);
+    box.high = Eigen::Vector3d(1.0, 1.0, 1.0);
+    const std::vector<int> corner = select_vertices(mesh, box);
+    REQUIRE(corner.size() == 1);
+    CHECK(mesh.V.row(corner[0]).isApprox(Eigen::RowVector3d(1.0, 1.0, 1.0)));
+    Selector list;
+    list.kind = Selector::Kind::vertices;
+    list.vertices = {3, 1, 3};
+    CHECK(select_vertices(mesh, list) == std::vector<int>{1, 3});
+    list.vertices = {27};
+    CHECK_THROWS_AS(select_vertices(mesh, list), Error);
+}
+
+TEST_CASE("prescribed motion: the smooth ramp reaches the rotation and holds it", "[scenes]")
+{
+    Motion turn;
+    turn.kind = Motion::Kind::rotate;
+    turn.axis = Eigen::Vector3d::UnitX();
+    turn.center = Eigen::Vector3d(0.0, 0.5, 0.5);
+    turn.angle = std::acos(-1.0);
+    turn.start = 1.0;
+    turn.end = 3.0;
+    const Eigen::Vector3d X(0.2, 1.0, 0.5);
+    CHECK(prescribed_displacement(turn, X, 0.5).norm() == 0.0);  // before the start
+    // Half way, s = 1/2: a quarter turn about the axis through (0, 0.5, 0.5).
+    const Eigen::Vector3d half = X + prescribed_displacement(turn, X, 2.0);
+    CHECK((half - Eigen::Vector3d(0.2, 0.5, 1.0)).norm() < 1e-15);
+    const Eigen::Vector3d end = X + prescribed_displacement(turn, X, 10.0);
+    CHECK((end - Eigen::Vector3d(0.2, 0.0, 0.5)).norm() < 1e-15);
+    Motion shift;
+    shift.kind = Motion::Kind::translate;
+    shift.displacement = Eigen::Vector3d(0.0, 0.0, 0.3);
+    shift.start = 0.0;
+    shift.end = 1.0;
+    CHECK(prescribed_displacement(shift, X, 0.25).z() == Approx(0.3 * (3 * 0.0625 - 2 * 0.015625)));
+}
+
+TEST_CASE("boundary faces of a box mesh: 12 per face of cubes, outward, closing the volume", "[scenes]")
+{
+    const TetMesh mesh = box_mesh(2, 1, 1, Eigen::Vector3d(2.0, 1.0, 1.0));
+    const MatrixX3i F = boundary_faces(mesh);
+    CHECK(F.rows() == 2 * (2 * 1 + 2 * 1 + 1 * 1) * 2);
+    // Σ over outward faces of (x · n) area / 3 is the volume (the divergence theorem).
+    double volume = 0.0;
+    for (Eigen::Index f = 0; f < F.rows(); ++f) {
+        const Eigen::Vector3d a = mesh.V.row(F(f, 0)), b = mesh.V.row(F(f, 1)), c = mesh.V.row(F(f, 2));
+        volume += a.dot(b.cross(c)) / 6.0;
+    }
+    CHECK(volume == Approx(2.0).epsilon(1e-14));
+}
