@@ -1,5 +1,5 @@
 #pragma once
-// The scenes capstone: one runner over chapters 10–12 (13: the skin, see SkinObserver).
+// The scenes capstone: one runner over chapters 10–13 (13: the skin, see SkinObserver).
 // docs/scenes.md#the-runner
 //
 // For each body of a scene the runner builds chapter 10's Scene and Body, whose force model is a
@@ -101,16 +101,19 @@ private:
 /// tractions lumped a third of each boundary triangle's force (area × traction) to its corners.
 Eigen::VectorXd applied_loads(const BodySpec& body, const MatrixX3i& boundary, double t);
 
-/// The chapter 13 hook: an observer of a body's frames that carries a fine surface. Until chapter
-/// 13 lands, make_skin_observer throws "skin needs chapter 13". docs/scenes.md#skin
+/// The chapter 13 hook: an observer of a body's frames that carries a fine surface (its .vtp
+/// series is written beside the tets' frames). docs/scenes.md#skin
 class SkinObserver {
 public:
     virtual ~SkinObserver() = default;
     /// The skin's surface at the body's displacement u (3n), for the frame's .vtp.
     virtual io::MeshData frame(const Eigen::VectorXd& u) const = 0;
 };
-/// The skin of a scene (the one place chapter 13 plugs in). fem::Error until it exists.
-std::unique_ptr<SkinObserver> make_skin_observer(const SkinSpec& skin, const TetMesh& mesh);
+/// The skin of a scene, bound to the rest tets of its body by chapter 13's build_skin (the one place
+/// chapter 13 plugs in); the skin's file is read in its body's mesh coordinates (the body's scale
+/// and translate apply). fem::Error naming the skin's file and body for a surface chapter 13
+/// refuses (empty, degenerate, or a vertex farther outside the tets than its limit).
+std::unique_ptr<SkinObserver> make_skin_observer(const SkinSpec& skin, const BodySpec& body);
 
 /// A stretch of steps one body ran at one level.
 struct Segment {

@@ -82,6 +82,8 @@ struct MeshSpec {
     double scale = 1.0;                 ///< applied to a file's positions first
     Eigen::Vector3d translate = Eigen::Vector3d::Zero();  ///< then this shift [m]
     std::string tetgen = "pq1.5aY";     ///< TetGen's switches for a surface (a max volume may follow a)
+    int lattice = 0;                    ///< > 0: instead of TetGen, chapter 13's enclosing_lattice of the
+                                        ///< surface with this many cubes along its longest side
 };
 
 /// The force models a body can use. "auto" starts linear and moves up per step (runner.hpp).

@@ -6,7 +6,7 @@ find_package(tomlplusplus 3 REQUIRED)  # Debian's libtomlplusplus-dev (tools/set
 
 add_library(fem_scenes STATIC ${FEM_ROOT}/solutions/scenes/scene_file.cpp ${FEM_ROOT}/solutions/scenes/runner.cpp)
 target_include_directories(fem_scenes PUBLIC ${FEM_ROOT}/chapters)
-target_link_libraries(fem_scenes PUBLIC fem_ch12_reference fem_ch11_reference fem_ch10_reference
+target_link_libraries(fem_scenes PUBLIC fem_ch13_reference fem_ch12_reference fem_ch11_reference fem_ch10_reference
                       PRIVATE tomlplusplus::tomlplusplus fem_flags)
 
 add_executable(fem_scene ${FEM_ROOT}/chapters/scenes/main.cpp)

@@ -5,12 +5,14 @@
 #include "11_corotational/corotational.hpp"
 #include "12_hyperelastic_newton/hyperelastic.hpp"
 #include "12_hyperelastic_newton/newton.hpp"
+#include "13_skinning/skinning.hpp"
 
 #include "04_tet_jacobians/tet_jacobians.hpp"
 #include "05_strain_stress/strain_stress.hpp"
 
 #include "common/error.hpp"
 #include "common/figures.hpp"
+#include "common/mesh_io.hpp"
 #include "common/motion.hpp"
 #include "common/table.hpp"
 #include "common/timer.hpp"
@@ -165,12 +167,39 @@ Eigen::VectorXd applied_loads(const BodySpec& body, const MatrixX3i& boundary, d
     return f;
 }
 
-std::unique_ptr<SkinObserver> make_skin_observer(const SkinSpec& skin, const TetMesh&)
+namespace {
+
+/// Chapter 13's skin: W bound once to the body's rest tets (point location, barycentric weights,
+/// the outside rule), and each frame the surface at x = W (X + u) with its normals.
+class ChapterSkin final : public SkinObserver {
+public:
+    ChapterSkin(const SkinSpec& spec, const BodySpec& body) : rest_(body.mesh.V)
+    {
+        try {
+            // The skin's file is in the coordinates of its body's mesh file: the same scale and shift.
+            TriMesh surface = io::read_tri_mesh(spec.file);
+            surface.V *= body.mesh_spec.scale;
+            surface.V.rowwise() += body.mesh_spec.translate.transpose();
+            skin_ = skin::build_skin(body.mesh, surface);
+        } catch (const Error& e) {
+            throw Error(str("skin '", spec.file.string(), "' of body '", spec.body, "': ", e.what()));
+        }
+    }
+    io::MeshData frame(const Eigen::VectorXd& u) const override
+    {
+        return skin::skin_frame(skin_, rest_ + io::vertex_rows(u));
+    }
+
+private:
+    MatrixX3d rest_;
+    skin::Skin skin_;
+};
+
+}  // namespace
+
+std::unique_ptr<SkinObserver> make_skin_observer(const SkinSpec& skin, const BodySpec& body)
 {
-    // Chapter 13 plugs in here: embed skin.file in the body's tets (point location, barycentric
-    // weights W) and return an observer whose frame(u) is the surface at x = W q.
-    throw Error(str("skin '", skin.file.string(), "' of body '", skin.body,
-                    "': skin needs chapter 13 (skinning), which this build does not have yet; remove [skin] from the scene"));
+    return std::make_unique<ChapterSkin>(skin, body);
 }
 
 namespace {
@@ -438,8 +467,14 @@ std::string describe_segments(const std::vector<Segment>& segments, const std::s
 
 RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
 {
-    if (scene.skin)
-        make_skin_observer(*scene.skin, scene.bodies.front().mesh);
+    // The skin (chapter 13) is bound before anything runs or is written: a bad one is refused early.
+    std::unique_ptr<SkinObserver> skin;
+    std::size_t skin_body = 0;
+    if (scene.skin) {
+        while (scene.bodies[skin_body].name != scene.skin->body)
+            ++skin_body;  // read_scene checked that the name exists
+        skin = make_skin_observer(*scene.skin, scene.bodies[skin_body]);
+    }
     std::vector<BodyRun> bodies;
     for (const BodySpec& spec : scene.bodies)
         bodies.push_back(start_body(spec, scene, options.model));
@@ -452,6 +487,9 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
     std::optional<io::MotionRecorder> recorder;
     if (run != nullptr && scene.output.pvd)
         recorder.emplace(run->file(stem + ".pvd"), png ? 1 : 0);
+    std::optional<io::MotionRecorder> skin_recorder;  // the skin's .vtp frames beside the tets' .vtu
+    if (run != nullptr && scene.output.pvd && skin)
+        skin_recorder.emplace(run->file(stem + "_skin.pvd"), 0, io::FrameFile::surface);
     Table history("Steps", {{"step", Format::integer}, {"time (s)", Format::fixed, 4}, {"body", Format::text},
                             {"model", Format::text}, {"kinetic (J)", Format::scientific, 6},
                             {"elastic (J)", Format::scientific, 6}, {"load potential (J)", Format::scientific, 6},
@@ -465,6 +503,8 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
             const io::MeshData data = scene_frame(bodies, scene.output);
             if (recorder)
                 recorder->add(bodies.front().state.time, data);
+            if (skin_recorder)
+                skin_recorder->add(bodies[skin_body].state.time, skin->frame(bodies[skin_body].state.u));
             if (options.on_frame)
                 options.on_frame(data, bodies.front().state.step, bodies.front().state.time);
         }

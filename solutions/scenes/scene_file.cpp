@@ -2,6 +2,8 @@
 // docs/scenes.md#the-scene-file
 #include "scenes/scene_file.hpp"
 
+#include "13_skinning/skinning.hpp"
+
 #include "10_linear_dynamics/time_integration.hpp"
 
 #include "common/error.hpp"
@@ -401,7 +403,7 @@ TetMesh build_mesh(const Fields& fields, const std::filesystem::path& scene_file
             for (int i = 0; i < 3; ++i)
                 spec.cells[i] = fields.integer_of(*cells.get(static_cast<std::size_t>(i)), str("cells[", i, "]"), 1, 200);
         }
-        for (const std::string key : {"tetgen"})
+        for (const std::string key : {"tetgen", "lattice"})
             if (fields.has(key))
                 fields.fail(*fields.get(key), key, "belongs to a surface file");
         mesh = box_mesh(spec.cells.x(), spec.cells.y(), spec.cells.z(), spec.size);
@@ -417,11 +419,20 @@ TetMesh build_mesh(const Fields& fields, const std::filesystem::path& scene_file
         const std::string extension = spec.file.extension().string();
         try {
             if (extension == ".obj" || extension == ".stl" || extension == ".ply") {
-                spec.tetgen = fields.text("tetgen", spec.tetgen);
-                mesh = tetrahedralize(io::read_tri_mesh(spec.file), spec.tetgen, spec.file.string());
+                if (fields.has("lattice")) {
+                    // Chapter 13's coarse mesh: the cubes of a lattice that enclose the surface.
+                    if (fields.has("tetgen"))
+                        fields.fail(*fields.get("tetgen"), "tetgen", "give either tetgen or lattice, not both");
+                    spec.lattice = fields.integer_of(*fields.get("lattice"), "lattice", 1, 100);
+                    mesh = skin::enclosing_lattice(io::read_tri_mesh(spec.file), spec.lattice);
+                } else {
+                    spec.tetgen = fields.text("tetgen", spec.tetgen);
+                    mesh = tetrahedralize(io::read_tri_mesh(spec.file), spec.tetgen, spec.file.string());
+                }
             } else if (extension == ".node" || extension == ".ele" || extension == ".vtu") {
-                if (fields.has("tetgen"))
-                    fields.fail(*fields.get("tetgen"), "tetgen", "belongs to a surface file (.obj, .stl, .ply)");
+                for (const std::string key : {"tetgen", "lattice"})
+                    if (fields.has(key))
+                        fields.fail(*fields.get(key), key, "belongs to a surface file (.obj, .stl, .ply)");
                 mesh = io::read_tet_mesh(spec.file);
             } else {
                 fields.fail(node, "file", str("has the extension '", extension,
@@ -455,7 +466,7 @@ BodySpec read_body(const toml::table& table, const std::string& name, const Sour
     if (mesh_table == nullptr)
         fields.missing("mesh", "give [body.mesh] with file = \"...\" or generator = \"box\"");
     const Fields mesh(*mesh_table, fields.field("mesh"), file,
-                      {"file", "generator", "size", "cells", "scale", "translate", "tetgen"});
+                      {"file", "generator", "size", "cells", "scale", "translate", "tetgen", "lattice"});
     body.mesh = build_mesh(mesh, scene_file, body.mesh_spec);
 
     const toml::table* material_table = fields.subtable("material");

@@ -101,9 +101,9 @@ TEST_CASE("overrides of --set are checked like the file and reach every body wit
     CHECK(error_of(pair, {"body.5.name=x"}).find("no 5") != std::string::npos);
 }
 
-TEST_CASE("a skin section is refused until chapter 13 lands", "[scenes]")
+TEST_CASE("a skin section is read and checked: the file and the body it names", "[scenes]")
 {
-    // The scene reads (the [skin] fields are checked); the runner's make_skin_observer refuses it.
+    // The scene reads; binding the skin (chapter 13) is the runner's, which refuses this one.
     const SceneSpec scene = read_scene(bad / "skin.toml");
     REQUIRE(scene.skin.has_value());
     CHECK(scene.skin->body == "body0");
