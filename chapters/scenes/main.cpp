@@ -79,8 +79,8 @@ int main(int argc, char** argv)
             throw Error("--view: plays one run; --compare runs many without frames");
         for (const std::string& file : files) {
             scenes.push_back(read_scene(file, settings, quick));
-            if (scenes.back().skin)
-                make_skin_observer(*scenes.back().skin, scenes.back().bodies.front().mesh);
+            if (const SceneSpec& scene = scenes.back(); scene.skin)
+                make_skin_observer(*scene.skin, scene.bodies[skin_body(scene)]);  // refused before anything runs
         }
     });
     bool stopped = false;

@@ -114,6 +114,9 @@ public:
 /// and translate apply). fem::Error naming the skin's file and body for a surface chapter 13
 /// refuses (empty, degenerate, or a vertex farther outside the tets than its limit).
 std::unique_ptr<SkinObserver> make_skin_observer(const SkinSpec& skin, const BodySpec& body);
+/// The index of the body the scene's skin names (the scene must have a skin; read_scene checked
+/// the name).
+std::size_t skin_body(const SceneSpec& scene);
 
 /// A stretch of steps one body ran at one level.
 struct Segment {

@@ -202,6 +202,16 @@ std::unique_ptr<SkinObserver> make_skin_observer(const SkinSpec& skin, const Bod
     return std::make_unique<ChapterSkin>(skin, body);
 }
 
+std::size_t skin_body(const SceneSpec& scene)
+{
+    if (!scene.skin)
+        throw Error("skin_body: the scene has no skin");
+    for (std::size_t i = 0; i < scene.bodies.size(); ++i)
+        if (scene.bodies[i].name == scene.skin->body)
+            return i;
+    throw Error(str("skin: no body is called '", scene.skin->body, "'"));
+}
+
 namespace {
 
 /// One body of a running scene.
@@ -469,12 +479,9 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
 {
     // The skin (chapter 13) is bound before anything runs or is written: a bad one is refused early.
     std::unique_ptr<SkinObserver> skin;
-    std::size_t skin_body = 0;
-    if (scene.skin) {
-        while (scene.bodies[skin_body].name != scene.skin->body)
-            ++skin_body;  // read_scene checked that the name exists
-        skin = make_skin_observer(*scene.skin, scene.bodies[skin_body]);
-    }
+    const std::size_t skinned = scene.skin ? skin_body(scene) : 0;
+    if (scene.skin)
+        skin = make_skin_observer(*scene.skin, scene.bodies[skinned]);
     std::vector<BodyRun> bodies;
     for (const BodySpec& spec : scene.bodies)
         bodies.push_back(start_body(spec, scene, options.model));
@@ -489,7 +496,7 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
         recorder.emplace(run->file(stem + ".pvd"), png ? 1 : 0);
     std::optional<io::MotionRecorder> skin_recorder;  // the skin's .vtp frames beside the tets' .vtu
     if (run != nullptr && scene.output.pvd && skin)
-        skin_recorder.emplace(run->file(stem + "_skin.pvd"), 0, io::FrameFile::surface);
+        skin_recorder.emplace(run->file(stem + "_skin.pvd"), png ? 1 : 0, io::FrameFile::surface);
     Table history("Steps", {{"step", Format::integer}, {"time (s)", Format::fixed, 4}, {"body", Format::text},
                             {"model", Format::text}, {"kinetic (J)", Format::scientific, 6},
                             {"elastic (J)", Format::scientific, 6}, {"load potential (J)", Format::scientific, 6},
@@ -504,7 +511,7 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
             if (recorder)
                 recorder->add(bodies.front().state.time, data);
             if (skin_recorder)
-                skin_recorder->add(bodies[skin_body].state.time, skin->frame(bodies[skin_body].state.u));
+                skin_recorder->add(bodies[skinned].state.time, skin->frame(bodies[skinned].state.u));
             if (options.on_frame)
                 options.on_frame(data, bodies.front().state.step, bodies.front().state.time);
         }
@@ -605,8 +612,17 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
     }
     if (recorder && png && !result.interrupted) {
         const int written = recorder->render_png_frames(run->file(stem), frame_view(scene), scene.output.warp);
+        // A skinned scene's picture is its skin (the bunny, not the lattice that carries it), coloured
+        // by its displacement, the one field a skin frame has besides its normals; the video shows it.
+        int skin_written = 0;
+        if (skin_recorder) {
+            fig::RenderOptions view = frame_view(scene);
+            view.field = "displacement";
+            view.range.reset();
+            skin_written = skin_recorder->render_png_frames(run->file(stem + "_skin"), view, scene.output.warp);
+        }
         if (written > 0 && scene.output.video != "none")
-            make_video(*run, stem, scene.output);
+            make_video(*run, skin_written > 0 ? stem + "_skin" : stem, scene.output);
     }
     return result;
 }

@@ -5,6 +5,7 @@
 #include "06_assembly/assembly.hpp"
 
 #include "common/error.hpp"
+#include "common/mesh_io.hpp"
 #include "common/vtk_io.hpp"
 
 #include <catch2/catch.hpp>
@@ -407,4 +408,40 @@ TEST_CASE("the live view's keys: space pauses, the right arrow steps, space resu
     REQUIRE(!frames.empty());
     CHECK(frames.front().first == 0.0);
     CHECK(frames.size() < static_cast<std::size_t>(before_restart));  // the restarted run's frames only
+
+TEST_CASE("a skin: the bunny's surface in its body's coordinates, carrying an affine motion exactly", "[scenes]")
+{
+    const SceneSpec scene = read_scene(gallery / "skinned_bunny.toml", {}, true);
+    REQUIRE(scene.skin.has_value());
+    const BodySpec& body = scene.bodies.front();
+    const std::unique_ptr<SkinObserver> skin = make_skin_observer(*scene.skin, body);
+    // An affine motion of the coarse tets, x = A X + b: every skin vertex must move by the same map
+    // (barycentric weights reproduce affine maps, inside the tets and by the outside rule alike).
+    Eigen::Matrix3d A;
+    A << 1.02, 0.1, 0.0, -0.05, 0.97, 0.03, 0.0, 0.2, 1.01;
+    const Eigen::Vector3d b(0.01, -0.02, 0.005);
+    const MatrixX3d X = body.mesh.V;
+    Eigen::VectorXd u(3 * X.rows());
+    for (Eigen::Index v = 0; v < X.rows(); ++v)
+        u.segment<3>(3 * v) = A * X.row(v).transpose() + b - X.row(v).transpose();
+    const io::MeshData frame = skin->frame(u);
+    const TriMesh surface = io::read_tri_mesh(std::filesystem::path(FEM_SCENES_DIR) / ".." / "data" / "bunny.obj");
+    REQUIRE(frame.points.rows() == surface.V.rows());
+    CHECK((frame.points - 0.01 * surface.V).cwiseAbs().maxCoeff() <= 1e-15);  // the body's scale applies
+    const Eigen::MatrixXd& displacement = frame.field("displacement").values;
+    double largest = 0.0;
+    for (Eigen::Index s = 0; s < frame.points.rows(); ++s) {
+        const Eigen::Vector3d Xs = frame.points.row(s).transpose();
+        largest = std::max(largest, (displacement.row(s).transpose() - (A * Xs + b - Xs)).norm());
+    }
+    CHECK(largest <= 1e-14);  // round-off of metres-sized products
+    // The runner writes the skin's .vtp series beside the tets', one skin frame for each.
+    const std::filesystem::path out = output / "skinned";
+    std::filesystem::remove_all(out);
+    const std::string command = "'" FEM_SCENE_EXE "' '" + (gallery / "skinned_bunny.toml").string() +
+                                "' --quick --no-figures --out '" + out.string() + "' >/dev/null 2>&1";
+    REQUIRE(std::system(command.c_str()) == 0);
+    const auto skin_frames = io::read_pvd(out / "skinned_bunny_skin.pvd");
+    CHECK(skin_frames.size() == io::read_pvd(out / "skinned_bunny.pvd").size());
+    CHECK(skin_frames.size() >= 2);
 }

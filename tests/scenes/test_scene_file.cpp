@@ -107,6 +107,16 @@ TEST_CASE("a skin section is read and checked: the file and the body it names", 
     const SceneSpec scene = read_scene(bad / "skin.toml");
     REQUIRE(scene.skin.has_value());
     CHECK(scene.skin->body == "body0");
+
+    // The gallery's skinned bunny: a lattice (chapter 13) instead of TetGen, its fields checked.
+    const std::filesystem::path skinned = gallery / "skinned_bunny.toml";
+    const SceneSpec lattice = read_scene(skinned);
+    CHECK(lattice.bodies.front().mesh_spec.lattice == 6);
+    CHECK(lattice.bodies.front().mesh.T.rows() % 6 == 0);  // whole cubes of six tets
+    CHECK(error_of(skinned, {"body.mesh.tetgen=pq1.5Y"}).find("either tetgen or lattice") != std::string::npos);
+    CHECK(error_of(skinned, {"body.mesh.lattice=0"}).find("body[0].mesh.lattice") != std::string::npos);
+    CHECK(error_of(skinned, {"skin.body=nobody"}).find("no body is called 'nobody'") != std::string::npos);
+    CHECK(error_of(skinned, {"skin.file=nothing.obj"}).find("nothing.obj' does not exist") != std::string::npos);
 }
 
 TEST_CASE("selectors: box, plane, list, and the vertices of a box mesh they pick", "[scenes]")
