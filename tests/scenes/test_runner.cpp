@@ -408,6 +408,7 @@ TEST_CASE("the live view's keys: space pauses, the right arrow steps, space resu
     REQUIRE(!frames.empty());
     CHECK(frames.front().first == 0.0);
     CHECK(frames.size() < static_cast<std::size_t>(before_restart));  // the restarted run's frames only
+}
 
 TEST_CASE("a skin: the bunny's surface in its body's coordinates, carrying an affine motion exactly", "[scenes]")
 {
