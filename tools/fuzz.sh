@@ -4,7 +4,7 @@
 # bounded time, one target after the other. Exits 1 at the first finding, naming the input that
 # caused it. New inputs that reach new code are kept in build/fuzz/corpus/<target>/ for the next run.
 #
-#   tools/fuzz.sh                         every target, 25 s each (the CI stage of tools/test.sh)
+#   tools/fuzz.sh                         every target, 15 s each (the CI stage of tools/test.sh)
 #   tools/fuzz.sh --seconds 3600 ply      one target for an hour
 #   tools/fuzz.sh --runs 1000000 obj stl  until a million inputs each
 #
@@ -18,7 +18,7 @@ source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 cd "$FEM_ROOT"
 export ASAN_OPTIONS="detect_leaks=0"
 
-seconds=25
+seconds=15
 runs=-1
 formats=()
 while [ $# -gt 0 ]; do

@@ -9,7 +9,7 @@
 #   4. release   every test passes on the reference solutions: unit tests, the layout and
 #                exercise-sync checks, each executable's --quick run against stored numbers, and
 #                each chapter's docs against its executable
-#   5. fuzz      every file reader's libFuzzer target runs 25 s from its seed corpus without a
+#   5. fuzz      every file reader's libFuzzer target runs 15 s from its seed corpus without a
 #                finding (tools/fuzz.sh; clang, ASan + UBSan)
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
@@ -43,7 +43,7 @@ cmake --preset release -DFEM_WERROR=ON >/dev/null
 cmake --build --preset release -j "$JOBS"
 with_display ctest --preset release
 
-step "5/5 the file readers fuzzed: each libFuzzer target 25 s from its seeds, no crash, sanitizer report, stray exception or runaway allocation"
-tools/fuzz.sh --seconds 25
+step "5/5 the file readers fuzzed: each libFuzzer target 15 s from its seeds, no crash, sanitizer report, stray exception or runaway allocation"
+tools/fuzz.sh --seconds 15
 
 step "done: every stage passed"
