@@ -12,6 +12,8 @@
 // OpenMP (g++ -fopenmp, linked through fem_common) runs the loop; OMP_NUM_THREADS sets the number
 // of threads. Built without OpenMP, parallel_for is a plain loop.
 
+#include "common/error.hpp"
+
 #include <Eigen/Core>
 
 #include <exception>
@@ -34,14 +36,15 @@ inline int thread_count()
 #endif
 }
 
-/// Sets the number of threads of the next parallel_for loops (omp_set_num_threads; ≥ 1), e.g. to
+/// Sets the number of threads of the next parallel_for loops (omp_set_num_threads), e.g. to
 /// measure the speed-up or to check that the results do not change. Ignored without OpenMP.
+/// fem::Error for threads < 1.
 inline void set_thread_count(int threads)
 {
+    if (threads < 1)
+        throw Error(str("set_thread_count: the number of threads must be >= 1, got ", threads));
 #ifdef _OPENMP
-    omp_set_num_threads(threads < 1 ? 1 : threads);
-#else
-    (void)threads;
+    omp_set_num_threads(threads);
 #endif
 }
 

@@ -464,4 +464,5 @@ TEST_CASE("the element loops on 1 and 2 threads: the same energy, forces and Hes
     fem::set_thread_count(1);
     CHECK_THROWS_WITH(neo.evaluate(squashed, forces), Contains("tet 0 "));
     fem::set_thread_count(original);
+    CHECK_THROWS_WITH(fem::set_thread_count(0), Contains("must be >= 1"));
 }
