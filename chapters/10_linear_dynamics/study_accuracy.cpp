@@ -258,8 +258,10 @@ void hard_cases_study(const RunContext& run, const Settings& settings)
         try {
             simulation.run(c.steps, [&](const State& state, const StepRecord& record) {
                 largest = std::max(largest, state.u.norm());
-                // A rise above the round-off of evaluating H (1e-12 of its size) counts.
-                never_rose = never_rose && record.energies.total() <= previous + 1e-12 * record.energies.magnitude();
+                // A rise above round-off counts: 1e-10 of H's size bounds the error of evaluating H
+                // from a solve with condition number up to 10⁶ (the midpoint run's rises are
+                // ~1e-12); a real gain is orders larger (the explicit run below its limit: ~1e-5).
+                never_rose = never_rose && record.energies.total() <= previous + 1e-10 * record.energies.magnitude();
                 previous = record.energies.total();
             });
         } catch (const Error& error) {

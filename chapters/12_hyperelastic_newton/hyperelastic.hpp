@@ -78,9 +78,14 @@ private:
     Eigen::VectorXd volumes_;
     assembly::AssemblyPattern pattern_;
     dynamics::SparseMatrix K_;
-    // Per-tet results of the parallel loops (common/parallel.hpp), added up in tet order after them.
+    /// One tet's share of evaluate(): V ψ(F) and f_e.
+    struct ElementForces {
+        double energy = 0.0;
+        Vector12d forces;
+    };
+    // The slots of the parallel loops (common/parallel.hpp), added up in tet order after them.
     std::vector<double> element_energies_;
-    std::vector<Vector12d> element_forces_;
+    std::vector<ElementForces> element_forces_;
     std::vector<Matrix12d> element_matrices_;
 };
 

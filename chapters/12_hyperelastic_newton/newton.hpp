@@ -82,8 +82,9 @@ struct NewtonProblem {
     std::function<double(const Eigen::VectorXd& x, double* magnitude)> objective;  ///< +∞ outside the
                                                       ///< domain; magnitude: the size of its terms
     std::function<Eigen::VectorXd(const Eigen::VectorXd& x)> gradient;
-    /// The Hessian at x, exact or made positive semi-definite (definite = true).
-    std::function<dynamics::SparseMatrix(const Eigen::VectorXd& x, bool definite)> hessian;
+    /// The Hessian at x, exact or made positive semi-definite (definite = true): a reference to a
+    /// matrix the problem keeps (refilled in its fixed pattern), valid until the next call.
+    std::function<const dynamics::SparseMatrix&(const Eigen::VectorXd& x, bool definite)> hessian;
     double scale = 0.0;   ///< converged when ‖gradient‖ ≤ relative_tolerance × scale
     std::string what;     ///< names the problem in error messages, e.g. "step 12 (t = 0.2 s)"
 };

@@ -39,21 +39,28 @@ void require_valid(const SolverOptions& options, const std::string& who)
 
 using SparseMatrix = Eigen::SparseMatrix<double>;
 
-/// fem::Error unless A is square, not empty and finite; returns max |A_ij|.
+/// fem::Error unless A is square, not empty and finite; returns max |A_ij|. One pass over the
+/// values; only a matrix that fails is searched for the entry to name.
 double check_square_and_finite(const SparseMatrix& A)
 {
     if (A.rows() == 0 || A.rows() != A.cols())
         throw Error(str("LinearSolver::prepare: the matrix is ", A.rows(), "×", A.cols(),
                         "; it must be square and not empty"));
-    double largest = 0.0;
+    SparseMatrix compressed;
+    if (!A.isCompressed()) {
+        compressed = A;
+        compressed.makeCompressed();
+    }
+    const auto values = (A.isCompressed() ? A : compressed).coeffs();  // the stored values, in order
+    // (x · 0) is 0 for every finite x and NaN for ±∞ or NaN, so the sum is 0 exactly when all are finite.
+    if ((values * 0.0).sum() == 0.0)
+        return values.cwiseAbs().maxCoeff();
     for (Eigen::Index j = 0; j < A.outerSize(); ++j)
-        for (SparseMatrix::InnerIterator it(A, j); it; ++it) {
+        for (SparseMatrix::InnerIterator it(A, j); it; ++it)
             if (!std::isfinite(it.value()))
                 throw Error(str("LinearSolver::prepare: A(", it.row(), ", ", it.col(), ") = ", it.value(),
                                 " is not finite"));
-            largest = std::max(largest, std::abs(it.value()));
-        }
-    return largest;
+    return 0.0;  // not reached: some value is not finite
 }
 
 /// For every stored entry k = (i, j) of a compressed A, the position of its mirror (j, i) in the
@@ -78,7 +85,7 @@ std::vector<Eigen::Index> mirror_entries(const SparseMatrix& A)
 }
 
 /// fem::Error unless max |A_ij − A_ji| ≤ symmetry_tolerance · largest (an entry without a mirror
-/// counts against zero).
+/// counts against zero). Each pair is compared once, at its first entry.
 void check_symmetric(const SparseMatrix& A, const std::vector<Eigen::Index>& mirror, double largest)
 {
     const auto* outer = A.outerIndexPtr();
@@ -87,6 +94,8 @@ void check_symmetric(const SparseMatrix& A, const std::vector<Eigen::Index>& mir
     for (Eigen::Index j = 0; j < A.outerSize(); ++j)
         for (auto k = outer[j]; k < outer[j + 1]; ++k) {
             const Eigen::Index m = mirror[static_cast<std::size_t>(k)];
+            if (m >= 0 && m < k)
+                continue;
             const double difference = m >= 0 ? value[m] - value[k] : -value[k];
             if (std::abs(difference) > symmetry_tolerance * largest)
                 throw Error(str("LinearSolver::prepare: A is not symmetric: A(", j, ", ", inner[k], ") − A(",
@@ -259,11 +268,15 @@ void LinearSolver::set_relative_tolerance(double tolerance)
 void LinearSolver::prepare(const Eigen::SparseMatrix<double>& A)
 {
     const double largest = check_square_and_finite(A);
-    const bool same = A_.rows() > 0 && same_pattern(A, A_);
+    const bool same = A_.rows() > 0 && A.isCompressed() && same_pattern(A, A_);
     // The solver keeps its own copy: Eigen's iterative solvers hold a reference to their matrix,
     // and the residual check needs it too. After a failed prepare the solver is unprepared.
-    A_ = A;
-    A_.makeCompressed();
+    if (same) {
+        std::copy(A.valuePtr(), A.valuePtr() + A.nonZeros(), A_.valuePtr());  // the pattern is A_'s already
+    } else {
+        A_ = A;
+        A_.makeCompressed();
+    }
     stats_ = SolveStats{};
     Timer timer;
     try {

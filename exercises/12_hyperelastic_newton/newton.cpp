@@ -112,6 +112,8 @@ NewtonResult newton_minimize(const NewtonProblem& problem, Eigen::VectorXd x0, c
         double tolerance;
         ~Restore() { solver.set_relative_tolerance(tolerance); }
     } restore{solver, solver_tolerance};
+    // E(x) and the size of its terms: the line search's accepted trial is the next start.
+    double objective = std::numeric_limits<double>::quiet_NaN(), magnitude = 0.0;
     for (int iteration = 0;; ++iteration) {
         const Eigen::VectorXd gradient = problem.gradient(x);
         const double norm = gradient.norm();
@@ -139,14 +141,16 @@ NewtonResult newton_minimize(const NewtonProblem& problem, Eigen::VectorXd x0, c
         // Backtracking: the largest α = shrinkᵏ with E(x + α d) ≤ E(x) + c α ∇ᵀd.
         double alpha = 1.0;
         if (options.line_search) {
-            double magnitude = 0.0;
-            const double start = problem.objective(x, &magnitude);
+            if (std::isnan(objective))
+                objective = problem.objective(x, &magnitude);
+            const double start = objective;
             // E is a sum of terms that cancel; differences below its round-off carry no information.
             const double noise = objective_round_off * magnitude;
             // EXERCISE 12.9 (line_search): see docs/12_hyperelastic_newton.md#newton-with-line-search
-            // HINT: while problem.objective(x + α d, nullptr) > start + c α slope + noise (c is
-            // HINT: options.armijo; +∞ never passes): α ← shrink · α, and throw fem::Error once α falls
-            // HINT: below options.smallest_step.
+            // HINT: objective = problem.objective(x + α d, &magnitude) (+∞ never passes); while it is
+            // HINT: above start + c α slope + noise (c is options.armijo): α ← shrink · α, and throw
+            // HINT: fem::Error once α falls below options.smallest_step. The accepted trial's objective
+            // HINT: and magnitude stay in `objective` and `magnitude`: the next iteration starts there.
             throw fem::NotImplemented("12.9", "line_search", "docs/12_hyperelastic_newton.md#newton-with-line-search");
         }
         result.step_lengths.push_back(alpha);
@@ -178,9 +182,11 @@ Eigen::VectorXd solve_static(dynamics::Body& body, const NewtonOptions& options)
         model.evaluate(full(x), forces);
         return Eigen::VectorXd(dofs.gather(-forces - load));
     };
-    problem.hessian = [&](const Eigen::VectorXd& x, bool definite) {
+    dynamics::SparseMatrix hessian;
+    problem.hessian = [&](const Eigen::VectorXd& x, bool definite) -> const dynamics::SparseMatrix& {
         const Eigen::VectorXd u = full(x);
-        return dofs.reduce(definite ? model.definite_stiffness(u) : model.stiffness(u));
+        hessian = dofs.reduce(definite ? model.definite_stiffness(u) : model.stiffness(u));
+        return hessian;
     };
     problem.scale = dofs.gather(load).norm();
     problem.what = "the static solve";
@@ -207,7 +213,7 @@ dynamics::StepInfo NewtonBackwardEuler::step(dynamics::Body& body, double time_s
     problem.gradient = [&](const Eigen::VectorXd& x) {
         return Eigen::VectorXd(dofs.gather(backward_euler_gradient(body, state, time_step, full(x))));
     };
-    problem.hessian = [&](const Eigen::VectorXd& x, bool definite) {
+    problem.hessian = [&](const Eigen::VectorXd& x, bool definite) -> const dynamics::SparseMatrix& {
         const Eigen::VectorXd u = state.u + time_step * full(x);
         const dynamics::SparseMatrix& K = definite ? body.model().definite_stiffness(u) : body.model().stiffness(u);
         const dynamics::SparseMatrix& M = body.mass_matrix();

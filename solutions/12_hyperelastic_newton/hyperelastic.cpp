@@ -109,25 +109,24 @@ double HyperelasticElasticity::evaluate(const Eigen::VectorXd& u, Eigen::VectorX
     // Every tet's energy and forces on every core, each into its own slot, then the sums in tet
     // order (common/parallel.hpp: the same bits on any number of threads, and the same tet named
     // when one is inverted: the lowest-numbered).
-    element_energies_.resize(static_cast<std::size_t>(mesh_.T.rows()));
-    element_forces_.resize(static_cast<std::size_t>(mesh_.T.rows()));
-    parallel_for(mesh_.T.rows(), [&](Eigen::Index t) {
-        const auto k = static_cast<std::size_t>(t);
-        const Eigen::Matrix3d H = displacement_gradient(x, t);
-        element_energies_[k] = element_energy(*material_, volumes_[t], H);
-        if (!std::isfinite(element_energies_[k]))
-            throw Error(str(material_->name(), ": tet ", t, " has det F = ", 1.0 + volume_change(H),
-                            ", where the material is undefined (inverted)"));
-        element_forces_[k] = element_forces(*material_, volumes_[t], B_[k], H);
-    });
-    forces = Eigen::VectorXd::Zero(u.size());
+    Eigen::VectorXd sum = Eigen::VectorXd::Zero(u.size());
     double total = 0.0;
-    for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t) {
-        const auto k = static_cast<std::size_t>(t);
-        total += element_energies_[k];
-        for (int i = 0; i < 4; ++i)
-            forces.segment<3>(3 * mesh_.T(t, i)) += element_forces_[k].segment<3>(3 * i);
-    }
+    parallel_for_then_add(
+        mesh_.T.rows(), element_forces_,
+        [&](Eigen::Index t, ElementForces& slot) {
+            const Eigen::Matrix3d H = displacement_gradient(x, t);
+            slot.energy = element_energy(*material_, volumes_[t], H);
+            if (!std::isfinite(slot.energy))
+                throw Error(str(material_->name(), ": tet ", t, " has det F = ", 1.0 + volume_change(H),
+                                ", where the material is undefined (inverted)"));
+            slot.forces = element_forces(*material_, volumes_[t], B_[static_cast<std::size_t>(t)], H);
+        },
+        [&](Eigen::Index t, const ElementForces& slot) {
+            total += slot.energy;
+            for (int i = 0; i < 4; ++i)
+                sum.segment<3>(3 * mesh_.T(t, i)) += slot.forces.segment<3>(3 * i);
+        });
+    forces.swap(sum);  // only now: a failed evaluation leaves forces as it was
     return total;
 }
 
@@ -150,13 +149,13 @@ const dynamics::SparseMatrix& HyperelasticElasticity::assemble_hessian(const Eig
     double* values = K_.valuePtr();
     std::fill(values, values + K_.nonZeros(), 0.0);
     // Every tet's Hessian on every core, then added into the pattern in tet order.
-    element_matrices_.resize(static_cast<std::size_t>(mesh_.T.rows()));
-    parallel_for(mesh_.T.rows(), [&](Eigen::Index t) {
-        const auto k = static_cast<std::size_t>(t);
-        element_matrices_[k] = element_hessian(*material_, volumes_[t], B_[k], displacement_gradient(x, t), projection);
-    });
-    for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t)
-        pattern_.add_element(t, element_matrices_[static_cast<std::size_t>(t)], values);
+    parallel_for_then_add(
+        mesh_.T.rows(), element_matrices_,
+        [&](Eigen::Index t, Matrix12d& slot) {
+            slot = element_hessian(*material_, volumes_[t], B_[static_cast<std::size_t>(t)], displacement_gradient(x, t),
+                                   projection);
+        },
+        [&](Eigen::Index t, const Matrix12d& slot) { pattern_.add_element(t, slot, values); });
     return K_;
 }
 

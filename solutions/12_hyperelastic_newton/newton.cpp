@@ -114,6 +114,8 @@ NewtonResult newton_minimize(const NewtonProblem& problem, Eigen::VectorXd x0, c
         double tolerance;
         ~Restore() { solver.set_relative_tolerance(tolerance); }
     } restore{solver, solver_tolerance};
+    // E(x) and the size of its terms: the line search's accepted trial is the next start.
+    double objective = std::numeric_limits<double>::quiet_NaN(), magnitude = 0.0;
     for (int iteration = 0;; ++iteration) {
         const Eigen::VectorXd gradient = problem.gradient(x);
         const double norm = gradient.norm();
@@ -141,15 +143,20 @@ NewtonResult newton_minimize(const NewtonProblem& problem, Eigen::VectorXd x0, c
         // Backtracking: the largest α = shrinkᵏ with E(x + α d) ≤ E(x) + c α ∇ᵀd.
         double alpha = 1.0;
         if (options.line_search) {
-            double magnitude = 0.0;
-            const double start = problem.objective(x, &magnitude);
+            if (std::isnan(objective))
+                objective = problem.objective(x, &magnitude);
+            const double start = objective;
             // E is a sum of terms that cancel; differences below its round-off carry no information.
             const double noise = objective_round_off * magnitude;
             // BEGIN EXERCISE 12.9 line_search #newton-with-line-search
-            // HINT: while problem.objective(x + α d, nullptr) > start + c α slope + noise (c is
-            // HINT: options.armijo; +∞ never passes): α ← shrink · α, and throw fem::Error once α falls
-            // HINT: below options.smallest_step.
-            while (!(problem.objective(x + alpha * direction, nullptr) <= start + options.armijo * alpha * slope + noise)) {
+            // HINT: objective = problem.objective(x + α d, &magnitude) (+∞ never passes); while it is
+            // HINT: above start + c α slope + noise (c is options.armijo): α ← shrink · α, and throw
+            // HINT: fem::Error once α falls below options.smallest_step. The accepted trial's objective
+            // HINT: and magnitude stay in `objective` and `magnitude`: the next iteration starts there.
+            for (;;) {
+                objective = problem.objective(x + alpha * direction, &magnitude);
+                if (objective <= start + options.armijo * alpha * slope + noise)
+                    break;
                 alpha *= options.shrink;
                 if (alpha < options.smallest_step)
                     throw Error(str("Newton: ", problem.what, ": the line search found no decrease down to α = ",
@@ -186,9 +193,11 @@ Eigen::VectorXd solve_static(dynamics::Body& body, const NewtonOptions& options)
         model.evaluate(full(x), forces);
         return Eigen::VectorXd(dofs.gather(-forces - load));
     };
-    problem.hessian = [&](const Eigen::VectorXd& x, bool definite) {
+    dynamics::SparseMatrix hessian;
+    problem.hessian = [&](const Eigen::VectorXd& x, bool definite) -> const dynamics::SparseMatrix& {
         const Eigen::VectorXd u = full(x);
-        return dofs.reduce(definite ? model.definite_stiffness(u) : model.stiffness(u));
+        hessian = dofs.reduce(definite ? model.definite_stiffness(u) : model.stiffness(u));
+        return hessian;
     };
     problem.scale = dofs.gather(load).norm();
     problem.what = "the static solve";
@@ -215,7 +224,7 @@ dynamics::StepInfo NewtonBackwardEuler::step(dynamics::Body& body, double time_s
     problem.gradient = [&](const Eigen::VectorXd& x) {
         return Eigen::VectorXd(dofs.gather(backward_euler_gradient(body, state, time_step, full(x))));
     };
-    problem.hessian = [&](const Eigen::VectorXd& x, bool definite) {
+    problem.hessian = [&](const Eigen::VectorXd& x, bool definite) -> const dynamics::SparseMatrix& {
         const Eigen::VectorXd u = state.u + time_step * full(x);
         const dynamics::SparseMatrix& K = definite ? body.model().definite_stiffness(u) : body.model().stiffness(u);
         const dynamics::SparseMatrix& M = body.mass_matrix();
