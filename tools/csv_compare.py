@@ -20,6 +20,11 @@ A column whose header ends with "[round-off]" holds round-off amplified by a con
 (e.g. "max deviation / max tip [round-off]": 1e-13…1e-10): each new value passes when it is at most
 ROUNDOFF_GROWTH (100) times the stored one, or ≤ ROUNDOFF_BOUND.
 
+A column whose header names iterations ("CG iterations per step") counts the steps of an iterative
+solver until a residual test passes. The last test compares a round-off-affected residual with a
+tolerance, so a different rounding can move a count by one: counts (and their averages) agree
+within ITERATION_SLACK (1). A solver gone wrong misses by far more.
+
 A number the docs quote in a sentence (check_docs.py, <!-- fem:value … -->) is read with
 quoted_number and holds when the table's value, rounded to the digits the sentence shows, is it.
 """
@@ -38,6 +43,8 @@ ROUNDOFF = re.compile(r"\[round-off\]\s*$")
 ROUNDOFF_LEVEL = 1e-12
 ROUNDOFF_BOUND = 1e-10
 ROUNDOFF_GROWTH = 100.0
+ITERATIONS = re.compile(r"\biterations\b", re.IGNORECASE)
+ITERATION_SLACK = 1.0
 
 
 def is_measured(header):
@@ -110,8 +117,11 @@ def compare_tables(expected_header, expected_rows, actual_header, actual_rows, r
             a, b = as_number(want[c]), as_number(got[c])
             if a is not None and b is not None:
                 roundoff_column = is_roundoff(header)
+                if ITERATIONS.search(header) and abs(a - b) <= ITERATION_SLACK:
+                    continue
                 if not close(a, b, rtol, roundoff_column):
                     rule = (f"a round-off column may grow {ROUNDOFF_GROWTH:g}x" if roundoff_column
+                            else f"iteration counts agree within {ITERATION_SLACK:g}" if ITERATIONS.search(header)
                             else f"a round-off value must stay at most {ROUNDOFF_BOUND:g}" if abs(a) <= ROUNDOFF_LEVEL
                             else f"relative tolerance {rtol:g}")
                     problems.append(f"{name}, row {r + 1}, column '{header}': expected {want[c]}, "
@@ -136,6 +146,9 @@ def self_test():
     header = ["x", "error", "time [s]"]
     assert compare_tables(header, [["1", "1e-15", "3"]], header, [["1", "4e-14", "9"]], 1e-6, "t") == []
     assert len(compare_tables(header, [["1", "1e-15", "3"]], header, [["2", "4e-10", "9"]], 1e-6, "t")) == 2
+    header = ["CG iterations per step"]
+    assert compare_tables(header, [["20.25"]], header, [["20.75"]], 1e-6, "t") == []
+    assert len(compare_tables(header, [["20.25"]], header, [["23"]], 1e-6, "t")) == 1
     header = ["deviation [round-off]"]
     assert compare_tables(header, [["2e-11"]], header, [["7e-11"]], 1e-6, "t") == []
     assert quoted_number("6·10⁻³") == (0.006, 1) and quoted_number("6 × 10⁻³") == (0.006, 1)

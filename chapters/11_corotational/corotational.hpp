@@ -67,16 +67,18 @@ Eigen::Matrix3d polar_rotation(const Eigen::Matrix3d& F);
 
 /// The same rotation as polar_rotation, by Higham's scaled Newton iteration on the polar factor:
 /// X₀ = F, X_{k+1} = ½(ζ_k X_k + ζ_k⁻¹ X_k⁻ᵀ), ζ_k = |det X_k|^(−1/3) while X_k is far from
-/// orthogonal, 1 after; X⁻ᵀ from cross products of X's columns. Each step maps every singular
-/// value σ to ½(σ + 1/σ) and leaves the singular vectors alone, so it converges quadratically from
-/// any rotation, in about four steps for an element's F (σ near 1). Stops when a step changes X by
-/// less than 1e-9 (the next error is below round-off) and takes one more. Falls back to the SVD
+/// orthogonal (and det X_k not within 1 % of 1), 1 after; X⁻ᵀ from cross products of X's columns.
+/// Each step maps every singular value σ to ½(σ + 1/σ) and leaves the singular vectors alone, so it
+/// converges quadratically: an error ε becomes about ε²/2, and a step's change is about the error
+/// it removed. Stops after a step that changed X by less than 1e-8 (the new error, ~1e-16, is
+/// round-off): three steps for an element's F at strains of 1e-3. Falls back to the SVD
 /// (polar_rotation) when det F ≤ 1e-6 ‖F‖³ — inverted or nearly flat, where the iteration would
 /// reach a reflection or crawl — or after 40 steps. N. J. Higham, Functions of Matrices, §8.9.
 /// docs/11_corotational.md#a-faster-polar-decomposition
 Eigen::Matrix3d polar_rotation_newton(const Eigen::Matrix3d& F);
 
-/// R̂ K_e R̂ᵀ with R̂ = diag(R, R, R, R): every 3×3 block (a, b) becomes R K_ab Rᵀ (12×12).
+/// R̂ K_e R̂ᵀ with R̂ = diag(R, R, R, R): every 3×3 block (a, b) becomes R K_ab Rᵀ (12×12). K_e must
+/// be symmetric (an element stiffness): the ten blocks a ≤ b are computed, the others transposed.
 /// docs/11_corotational.md#forces-and-warped-stiffness
 Matrix12d rotated_stiffness(const Matrix12d& K_e, const Eigen::Matrix3d& R);
 
@@ -149,9 +151,13 @@ private:
     Eigen::VectorXd rotated_at_;                  // the u of rotations_
     std::vector<Eigen::Matrix3d> rotations_;
     std::vector<Eigen::Matrix3d> rest_edges_inverse_;  // T_X⁻¹ of every tet (chapter 04), for F
-    // Per-tet results of the parallel loops (common/parallel.hpp), added up in tet order after them.
-    std::vector<Vector12d> element_forces_;
-    std::vector<double> element_energies_;
+    /// One tet's share of evaluate(): its energy and f_e.
+    struct ElementForces {
+        double energy = 0.0;
+        Vector12d forces;
+    };
+    // The slots of the parallel loops (common/parallel.hpp), added up in tet order after them.
+    std::vector<ElementForces> element_forces_;
     std::vector<Matrix12d> element_matrices_;
 };
 

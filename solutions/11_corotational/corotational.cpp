@@ -93,18 +93,15 @@ Eigen::Matrix3d polar_rotation_newton(const Eigen::Matrix3d& F)
         inverse_transpose.col(2) = X.col(0).cross(X.col(1));
         const double det = X.col(0).dot(inverse_transpose.col(0));
         inverse_transpose /= det;
-        const double zeta = scaled ? std::cbrt(1.0 / std::abs(det)) : 1.0;
+        // Scaling pays where the singular values are far from 1; near det = 1 it would only cost a cube root.
+        const double zeta = scaled && std::abs(det - 1.0) > 1e-2 ? std::cbrt(1.0 / std::abs(det)) : 1.0;
         const Eigen::Matrix3d next = 0.5 * (zeta * X + inverse_transpose / zeta);
         const double change = (next - X).norm();
         X = next;
         if (change < 1e-2)
             scaled = false;  // near orthogonal: plain Newton converges quadratically
-        if (change < 1e-9) {
-            inverse_transpose.col(0) = X.col(1).cross(X.col(2));
-            inverse_transpose.col(1) = X.col(2).cross(X.col(0));
-            inverse_transpose.col(2) = X.col(0).cross(X.col(1));
-            return 0.5 * (X + inverse_transpose / X.col(0).dot(inverse_transpose.col(0)));
-        }
+        if (change < 1e-8)
+            return X;  // X's error is about change² / 2: below round-off
     }
     return polar_rotation(F);
 }
@@ -113,10 +110,15 @@ Matrix12d rotated_stiffness(const Matrix12d& K_e, const Eigen::Matrix3d& R)
 {
     Matrix12d rotated;
     // BEGIN EXERCISE 11.4 rotated_stiffness #forces-and-warped-stiffness
-    // HINT: block (a, b) of the result is R K_ab Rᵀ, K_ab the 3×3 block K_e(3a…3a+2, 3b…3b+2).
+    // HINT: block (a, b) of the result is R K_ab Rᵀ, K_ab the 3×3 block K_e(3a…3a+2, 3b…3b+2);
+    // HINT: K_e is symmetric, so block (b, a) is the transpose of block (a, b).
     for (int a = 0; a < 4; ++a)
-        for (int b = 0; b < 4; ++b)
-            rotated.block<3, 3>(3 * a, 3 * b) = R * K_e.block<3, 3>(3 * a, 3 * b) * R.transpose();
+        for (int b = a; b < 4; ++b) {
+            const Eigen::Matrix3d block = R * K_e.block<3, 3>(3 * a, 3 * b) * R.transpose();
+            rotated.block<3, 3>(3 * a, 3 * b) = block;
+            if (b != a)
+                rotated.block<3, 3>(3 * b, 3 * a) = block.transpose();
+        }
     // END EXERCISE
     return rotated;
 }
@@ -215,27 +217,26 @@ double CorotationalElasticity::evaluate(const Eigen::VectorXd& u, Eigen::VectorX
     const MatrixX3d x = mesh_.V + io::vertex_rows(u);
     // Every tet's force and energy on every core, each into its own slot; then the sums, one tet
     // after another in order (common/parallel.hpp: the same bits on any number of threads).
-    element_forces_.resize(static_cast<std::size_t>(mesh_.T.rows()));
-    element_energies_.resize(static_cast<std::size_t>(mesh_.T.rows()));
-    parallel_for(mesh_.T.rows(), [&](Eigen::Index t) {
-        const auto e = static_cast<std::size_t>(t);
-        const Vector12d x_e = element_vector(mesh_, x, t), X_e = element_vector(mesh_, mesh_.V, t);
-        element_forces_[e] = corotated_force(K_e_[e], R[e], x_e, X_e);
-        // U_e = ½ dᵀ K_e d = −½ Σᵢ (R dᵢ)·f_e,i, since f_e,i = −R (K_e d)ᵢ: no second product with K_e
-        const Vector12d d = corotated_displacement(R[e], x_e, X_e);
-        double energy = 0.0;
-        for (int i = 0; i < 4; ++i)
-            energy -= 0.5 * (R[e] * d.segment<3>(3 * i)).dot(element_forces_[e].segment<3>(3 * i));
-        element_energies_[e] = energy;
-    });
-    forces = Eigen::VectorXd::Zero(u.size());
+    Eigen::VectorXd sum = Eigen::VectorXd::Zero(u.size());
     double energy = 0.0;
-    for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t) {
-        const auto e = static_cast<std::size_t>(t);
-        energy += element_energies_[e];
-        for (int i = 0; i < 4; ++i)
-            forces.segment<3>(3 * mesh_.T(t, i)) += element_forces_[e].segment<3>(3 * i);
-    }
+    parallel_for_then_add(
+        mesh_.T.rows(), element_forces_,
+        [&](Eigen::Index t, ElementForces& slot) {
+            const auto e = static_cast<std::size_t>(t);
+            const Vector12d x_e = element_vector(mesh_, x, t), X_e = element_vector(mesh_, mesh_.V, t);
+            slot.forces = corotated_force(K_e_[e], R[e], x_e, X_e);
+            // U_e = ½ dᵀ K_e d = −½ Σᵢ (R dᵢ)·f_e,i, since f_e,i = −R (K_e d)ᵢ: no second product with K_e
+            const Vector12d d = corotated_displacement(R[e], x_e, X_e);
+            slot.energy = 0.0;
+            for (int i = 0; i < 4; ++i)
+                slot.energy -= 0.5 * (R[e] * d.segment<3>(3 * i)).dot(slot.forces.segment<3>(3 * i));
+        },
+        [&](Eigen::Index t, const ElementForces& slot) {
+            energy += slot.energy;
+            for (int i = 0; i < 4; ++i)
+                sum.segment<3>(3 * mesh_.T(t, i)) += slot.forces.segment<3>(3 * i);
+        });
+    forces.swap(sum);
     return energy;
 }
 
@@ -247,17 +248,17 @@ const dynamics::SparseMatrix& CorotationalElasticity::stiffness(const Eigen::Vec
     double* values = K_R_.valuePtr();
     std::fill(values, values + K_R_.nonZeros(), 0.0);
     // BEGIN EXERCISE 11.6 warped_stiffness #forces-and-warped-stiffness
-    // HINT: per tet t, element_matrices_[t] = rotated_stiffness(K_e_[t], R[t]), on every core
-    // HINT: (parallel_for of common/parallel.hpp: each tet writes its own slot); then, one tet after
-    // HINT: another in order, pattern_.add_element(t, element_matrices_[t], values) (chapter 06's
-    // HINT: route c into the fixed pattern; in order, so the sums do not depend on the threads).
-    element_matrices_.resize(static_cast<std::size_t>(mesh_.T.rows()));
-    parallel_for(mesh_.T.rows(), [&](Eigen::Index t) {
-        const auto e = static_cast<std::size_t>(t);
-        element_matrices_[e] = rotated_stiffness(K_e_[e], R[e]);
-    });
-    for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t)
-        pattern_.add_element(t, element_matrices_[static_cast<std::size_t>(t)], values);
+    // HINT: parallel_for_then_add of common/parallel.hpp over the tets, with the slots
+    // HINT: element_matrices_: compute each tet's slot = rotated_stiffness(K_e_[t], R[t]) (on every
+    // HINT: core), then add it with pattern_.add_element(t, slot, values) (chapter 06's route c into
+    // HINT: the fixed pattern; in tet order, so the sums do not depend on the threads).
+    parallel_for_then_add(
+        mesh_.T.rows(), element_matrices_,
+        [&](Eigen::Index t, Matrix12d& slot) {
+            const auto e = static_cast<std::size_t>(t);
+            slot = rotated_stiffness(K_e_[e], R[e]);
+        },
+        [&](Eigen::Index t, const Matrix12d& slot) { pattern_.add_element(t, slot, values); });
     // END EXERCISE
     return K_R_;
 }
