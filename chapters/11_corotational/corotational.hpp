@@ -131,8 +131,9 @@ public:
     std::vector<Eigen::Matrix3d> rotations(const Eigen::VectorXd& u) const;
 
     /// One rotation per vertex (#V), at the u of the last evaluate() or stiffness() call (identity
-    /// before any): the polar rotation of Σ_t vol_t R_t over the tets around the vertex — the frame
-    /// the vertex turned with. fem::Error before the model was evaluated.
+    /// before any): the polar rotation of the volume-weighted mean Σ_t vol_t R_t / Σ_t vol_t over
+    /// the tets around the vertex — the frame the vertex turned with. fem::Error before the model
+    /// was evaluated.
     std::vector<Eigen::Matrix3d> vertex_rotations() const;
 
 private:

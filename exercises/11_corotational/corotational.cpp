@@ -181,11 +181,17 @@ std::vector<Eigen::Matrix3d> CorotationalElasticity::vertex_rotations() const
     if (rotations_.empty())
         throw Error("vertex_rotations: the model has not been evaluated yet (call evaluate or stiffness first)");
     std::vector<Eigen::Matrix3d> sums(static_cast<std::size_t>(mesh_.V.rows()), Eigen::Matrix3d::Zero());
+    Eigen::VectorXd weights = Eigen::VectorXd::Zero(mesh_.V.rows());
     for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t)
-        for (int i = 0; i < 4; ++i)
+        for (int i = 0; i < 4; ++i) {
             sums[static_cast<std::size_t>(mesh_.T(t, i))] += volumes_[t] * rotations_[static_cast<std::size_t>(t)];
-    for (Eigen::Matrix3d& sum : sums)
-        sum = sum.isZero(0.0) ? Eigen::Matrix3d::Identity() : polar_rotation_newton(sum);
+            weights[mesh_.T(t, i)] += volumes_[t];
+        }
+    // The weighted mean of rotations, det near 1 (Newton's iteration then needs no scaling).
+    for (std::size_t v = 0; v < sums.size(); ++v)
+        sums[v] = weights[static_cast<Eigen::Index>(v)] > 0.0
+                      ? polar_rotation_newton(sums[v] / weights[static_cast<Eigen::Index>(v)])
+                      : Eigen::Matrix3d::Identity();
     return sums;
 }
 

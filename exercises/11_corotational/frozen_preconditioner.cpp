@@ -59,10 +59,11 @@ int FrozenFactorPcg::do_solve(const Eigen::VectorXd& b, Eigen::VectorXd& x)
     settings.max_iterations = options().max_iterations;
     cg::CgResult result;
     // EXERCISE 11.7 (frozen_factor_pcg): see docs/11_corotational.md#solving-a-changing-matrix
-    // HINT: chapter 09's preconditioned_conjugate_gradient on the current matrix (cg::EigenOperator of
-    // HINT: *A_) from x, with a cg::FunctionOperator preconditioner that applies the frozen factor,
-    // HINT: turned by the blocks' rotations when there are any: z = Q A₀⁻¹ Qᵀ r (turn_[i] = Qᵢ),
-    // HINT: else z = apply_factor(r) (A₀⁻¹ r in the factor's precision).
+    // HINT: chapter 09's preconditioned_conjugate_gradient on the current matrix from x (a
+    // HINT: cg::FunctionOperator that multiplies by *A_ without copying it), with a cg::FunctionOperator
+    // HINT: preconditioner that applies the frozen factor, turned by the blocks' rotations when there
+    // HINT: are any: z = Q A₀⁻¹ Qᵀ r (turn_[i] = Qᵢ), else z = apply_factor(r) (A₀⁻¹ r in the factor's
+    // HINT: precision).
     throw fem::NotImplemented("11.7", "frozen_factor_pcg", "docs/11_corotational.md#solving-a-changing-matrix");
     if (!result.converged)
         throw Error(str(name(), ": CG missed its tolerance ", options().relative_tolerance, " within ",

@@ -57,11 +57,16 @@ int FrozenFactorPcg::do_solve(const Eigen::VectorXd& b, Eigen::VectorXd& x)
     settings.max_iterations = options().max_iterations;
     cg::CgResult result;
     // BEGIN EXERCISE 11.7 frozen_factor_pcg #solving-a-changing-matrix
-    // HINT: chapter 09's preconditioned_conjugate_gradient on the current matrix (cg::EigenOperator of
-    // HINT: *A_) from x, with a cg::FunctionOperator preconditioner that applies the frozen factor,
-    // HINT: turned by the blocks' rotations when there are any: z = Q A₀⁻¹ Qᵀ r (turn_[i] = Qᵢ),
-    // HINT: else z = apply_factor(r) (A₀⁻¹ r in the factor's precision).
-    const cg::EigenOperator A(*A_);
+    // HINT: chapter 09's preconditioned_conjugate_gradient on the current matrix from x (a
+    // HINT: cg::FunctionOperator that multiplies by *A_ without copying it), with a cg::FunctionOperator
+    // HINT: preconditioner that applies the frozen factor, turned by the blocks' rotations when there
+    // HINT: are any: z = Q A₀⁻¹ Qᵀ r (turn_[i] = Qᵢ), else z = apply_factor(r) (A₀⁻¹ r in the factor's
+    // HINT: precision).
+    // A x as Aᵀ x (A is symmetric): Eigen multiplies the transpose of a column-major matrix row by
+    // row, a dot product per row, instead of scattering column by column.
+    const cg::FunctionOperator A(A_->rows(), [&](const Eigen::VectorXd& v, Eigen::VectorXd& Av) {
+        Av.noalias() = A_->transpose() * v;
+    });
     const cg::FunctionOperator preconditioner(A_->rows(), [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) {
         if (turn_.empty()) {
             z = apply_factor(r);
