@@ -18,7 +18,9 @@
 
 #include <Eigen/Core>
 
+#include <cmath>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -61,6 +63,12 @@ struct NewtonOptions {
 /// difference of E says nothing. Near convergence that is what keeps a step from failing.
 inline constexpr double objective_round_off = 1e-13;
 
+/// The smallest gradient norm newton_minimize can measure: √(smallest normal double) ≈ 1.5·10⁻¹⁵⁴.
+/// Below it the squares in a norm underflow, and products such as ∇Eᵀd vanish, so the relative
+/// test says nothing: a motion that has decayed this far (a vibration damped out without gravity,
+/// after a few hundred steps) is at rest in any units, and the iteration has converged.
+inline const double smallest_measurable_norm = std::sqrt(std::numeric_limits<double>::min());
+
 /// E(v) of the header comment for the full velocity v (3n), with model's energy at qᵗ + Δt v
 /// (+∞ where the model is undefined); magnitude (if given) receives |½ΔvᵀMΔv| + |U| + |Δt vᵀf_ext|,
 /// the scale of E's round-off. fem::Error on sizes or Δt ≤ 0.
@@ -100,8 +108,9 @@ struct NewtonResult {
 /// Newton's method with a backtracking (Armijo) line search from x₀ (where the objective must be
 /// finite): solve H d = −∇ with `solver`, the Hessian chosen as options.hessian says, take the
 /// largest α = shrinkᵏ with objective(x + αd) ≤ objective(x) + c α ∇ᵀd (+ its round-off), until
-/// ‖∇‖ ≤ tolerance × scale. fem::Error naming problem.what when the cap is reached, the line search
-/// fails, or no Hessian gives a descent direction. docs/12_hyperelastic_newton.md#newton-with-line-search
+/// ‖∇‖ ≤ tolerance × scale (or ≤ smallest_measurable_norm). fem::Error naming problem.what when
+/// the cap is reached, the line search fails, or no Hessian gives a descent direction.
+/// docs/12_hyperelastic_newton.md#newton-with-line-search
 NewtonResult newton_minimize(const NewtonProblem& problem, Eigen::VectorXd x0, const NewtonOptions& options,
                              cg::LinearSolver& solver);
 

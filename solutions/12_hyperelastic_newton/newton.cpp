@@ -121,7 +121,7 @@ NewtonResult newton_minimize(const NewtonProblem& problem, Eigen::VectorXd x0, c
         const double norm = gradient.norm();
         const double relative = problem.scale > 0.0 ? norm / problem.scale : norm;
         result.gradient_history.push_back(relative);
-        if (norm <= options.relative_tolerance * problem.scale)
+        if (norm <= options.relative_tolerance * problem.scale || norm <= smallest_measurable_norm)
             return result;
         if (options.forcing > 0.0)
             solver.set_relative_tolerance(std::max(solver_tolerance, std::min(options.forcing, relative)));
