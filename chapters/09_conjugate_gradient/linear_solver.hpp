@@ -84,7 +84,10 @@ public:
     /// The same, with x on entry the starting guess of an iterative solver (a warm start; a
     /// direct solver ignores it) and on exit the solution. An x of the wrong size starts from 0.
     /// fem::Error before prepare(), if b has not size() entries or is not finite, if an
-    /// iterative solver misses its tolerance within its cap, or meets pᵀAp ≤ 0.
+    /// iterative solver misses its tolerance within its cap, or meets pᵀAp ≤ 0. A b whose largest
+    /// entry lies outside [2⁻³⁰⁰, 2³⁰⁰] (a motion decaying towards underflow) is solved scaled by
+    /// a power of two, which is exact: the same x, bit for bit, as the scaled solve times 2ᵏ,
+    /// where unscaled the squares inside CG would underflow to 0.
     void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x);
 
     const SolveStats& stats() const { return stats_; }

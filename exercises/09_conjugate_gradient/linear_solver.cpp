@@ -309,8 +309,25 @@ void LinearSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x)
         throw Error(str(name_, ": b has a non-finite entry"));
     if (x.size() != A_.rows() || !x.allFinite())
         x = Eigen::VectorXd::Zero(A_.rows());
+    // Solving A (2⁻ᵏx) = 2⁻ᵏb does the same operations on numbers scaled by 2⁻ᵏ, exactly; far from
+    // 1 (below 2⁻³⁰⁰ ≈ 5e-91) the squares in CG's inner products would underflow, so such a b is
+    // brought near 1 first.
+    const double largest = b.cwiseAbs().maxCoeff();
+    int exponent = 0;
+    if (largest > 0.0 && (largest < 0x1p-300 || largest > 0x1p300))
+        std::frexp(largest, &exponent);
     Timer timer;
-    stats_.iterations = do_solve(b, x);
+    if (exponent == 0) {
+        stats_.iterations = do_solve(b, x);
+    } else {
+        // Entry by entry: 2ᵏ itself overflows for a subnormal b (k > 1023).
+        const auto scale = [](const Eigen::VectorXd& v, int power) {
+            return Eigen::VectorXd(v.unaryExpr([power](double entry) { return std::ldexp(entry, power); }));
+        };
+        x = scale(x, -exponent);
+        stats_.iterations = do_solve(scale(b, -exponent), x);
+        x = scale(x, exponent);
+    }
     stats_.solve_seconds = timer.seconds();
     const double b_norm = b.norm();
     stats_.relative_residual = b_norm > 0.0 ? (b - A_ * x).norm() / b_norm : x.norm();

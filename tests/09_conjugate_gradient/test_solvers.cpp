@@ -65,6 +65,33 @@ TEST_CASE("every solver of the interface solves the elastic box and a Laplacian"
     }
 }
 
+TEST_CASE("a right-hand side near underflow or overflow: every solver returns the scaled solution", "[ex09.5]")
+{
+    // A motion decaying to rest drives b towards 1e-300; CG's inner products (squares of 1e-160)
+    // would underflow to 0 and fail. Scaling by powers of two is exact, so the answer is the
+    // normal-sized one scaled back.
+    const Eigen::SparseMatrix<double> A = fem::sparse::to_eigen(fem::direct::laplacian_3d(6));
+    Eigen::VectorXd b = random_vector(A.rows(), 3u);
+    b /= 2.0 * b.cwiseAbs().maxCoeff();  // largest entry ½: solved as it is
+    for (const std::string& name : solver_names()) {
+        CAPTURE(name);
+        const std::unique_ptr<LinearSolver> solver = make_solver(name);
+        solver->prepare(A);
+        const auto times_power_of_two = [](const Eigen::VectorXd& v, int power) {
+            return Eigen::VectorXd(v.unaryExpr([power](double entry) { return std::ldexp(entry, power); }));
+        };
+        for (const int power : {-700, -1000, -1060, 700}) {  // 2⁻¹⁰⁶⁰ b: subnormal, fewer bits kept
+            CAPTURE(power);
+            const Eigen::VectorXd tiny = times_power_of_two(b, power);
+            // The answer for the b it holds, taken to that size too (where it may round as well).
+            const Eigen::VectorXd x = times_power_of_two(solver->solve(times_power_of_two(tiny, -power)), power);
+            Eigen::VectorXd scaled;
+            REQUIRE_NOTHROW(scaled = solver->solve(tiny));
+            CHECK((times_power_of_two(scaled - x, -power)).norm() <= 1e-12 * times_power_of_two(x, -power).norm());
+        }
+    }
+}
+
 TEST_CASE("the solver names, the default and CHOLMOD", "[solvers]")
 {
     for (const char* name : {"ours-cholesky", "ours-cg", "ours-pcg-jacobi", "ours-pcg-ic0", "eigen-llt", "eigen-cg"})
