@@ -154,12 +154,15 @@ function(fem_add_chapter number name)
              COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/check_run.py
                      --exe $<TARGET_FILE:${exe}> --expected ${FEM_ROOT}/tests/${id}/expected
                      --out ${CMAKE_BINARY_DIR}/check_runs/${id})
-    set_tests_properties(ch${number}_quick_run PROPERTIES LABELS "ch${number};run")
+    # COST: ctest -j starts the costliest tests first (before it has timed a run of its own), so
+    # that the docs checks (whole runs of the executable, up to minutes) do not start last and keep
+    # one core busy alone at the end; then the quick runs, then the unit tests.
+    set_tests_properties(ch${number}_quick_run PROPERTIES LABELS "ch${number};run" COST 10)
     add_test(NAME ch${number}_docs
              COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/check_docs.py --root ${FEM_ROOT}
                      --chapter ${id} --bin ${CMAKE_BINARY_DIR}/bin
                      --out ${CMAKE_BINARY_DIR}/check_docs/${id})
-    set_tests_properties(ch${number}_docs PROPERTIES LABELS "ch${number};docs")
+    set_tests_properties(ch${number}_docs PROPERTIES LABELS "ch${number};docs" COST 100)
     add_test(NAME ch${number}_test_target
              COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/check_targets.py --build ${CMAKE_BINARY_DIR}
                      --chapter ${id})

@@ -32,7 +32,7 @@ if(FEM_BUILD_TESTS)
              COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/check_run.py
                      --exe $<TARGET_FILE:fem_scene> --expected ${FEM_ROOT}/tests/scenes/expected/${scene}
                      --out ${CMAKE_BINARY_DIR}/check_runs/scenes/${scene} -- ${scene_file} --no-progress)
-    set_tests_properties(scenes_quick_run_${scene} PROPERTIES LABELS "scenes;run")
+    set_tests_properties(scenes_quick_run_${scene} PROPERTIES LABELS "scenes;run" COST 10)  # as chNN_quick_run
   endforeach()
 endif()
 
@@ -41,7 +41,7 @@ if(FEM_BUILD_TESTS)
   add_test(NAME scenes_docs
            COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/check_docs.py --root ${FEM_ROOT}
                    --chapter scenes --bin ${CMAKE_BINARY_DIR}/bin --out ${CMAKE_BINARY_DIR}/check_docs/scenes)
-  set_tests_properties(scenes_docs PROPERTIES LABELS "scenes;docs")
+  set_tests_properties(scenes_docs PROPERTIES LABELS "scenes;docs" COST 100)  # as chNN_docs
   # Bad command lines: refused before anything is computed or written.
   add_test(NAME scenes_bad_options
            COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/check_bad_options.py
