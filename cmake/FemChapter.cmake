@@ -177,8 +177,9 @@ function(fem_add_chapter number name)
 
   # A chapter's own additions to the build (e.g. an optional reference library for its
   # executable) go in chapters/NN_name/chapter.cmake, included here, where ${lib}, ${exe} and
-  # ${test_exe} name its targets and ${chapter_libraries} lists every library built from its
-  # sources: ${lib}, in a student build also its reference twin ${lib}_reference, and with
+  # ${test_exe} name its targets (the test sources compile in ${test_exe}_objects: a compile
+  # option or definition for them goes there) and ${chapter_libraries} lists every library built
+  # from its sources: ${lib}, in a student build also its reference twin ${lib}_reference, and with
   # FEM_GRADING its graded twin ${lib}_graded. A package the chapter's code needs is linked to
   # each of them.
   set(chapter_libraries ${lib})
