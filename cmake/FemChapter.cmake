@@ -2,13 +2,16 @@
 #
 # Registers chapter NN_name, the one way a chapter enters the build:
 #   fem_chNN            its library: the chapter's functions, compiled from solutions/NN_name
-#                       (default), exercises/NN_name (when NN is in FEM_EXERCISES or it is "all"),
-#                       or, in the grading build, from solutions with run-time stub switches;
+#                       (default) or exercises/NN_name (when NN is in FEM_EXERCISES or it is "all");
 #   fem_chNN_reference  what later chapters link: always the reference solution, so a student
 #                       working on chapter 05 keeps chapters 06+ running;
 #   chNN_name           its executable in <build>/bin, from chapters/NN_name/main.cpp;
 #   test_chNN           its Catch2 tests from tests/NN_name/*.cpp (ctest label chNN); a target of
 #                       its own: `cmake --build --preset student --target test_chNN`;
+#   fem_chNN_graded,    with FEM_GRADING=ON, built by the target fem_graded_tests only: the
+#   test_chNN_graded    solutions with every exercise region behind a run-time stub switch, and the
+#                       same test objects as test_chNN linked against it, as <build>/bin/graded/
+#                       test_chNN (for tools/exercises.py grade; no ctest entries);
 #   chNN_quick_run      ctest: the executable in --quick mode, its files and figures against
 #                       tests/NN_name/expected (label chNN, run);
 #   chNN_docs           ctest: docs/NN_name.md names only functions and exercises that exist and
@@ -23,6 +26,9 @@
 set(FEM_ALL_CHAPTERS "" CACHE INTERNAL "registered chapters")
 add_custom_target(fem_tests)
 add_custom_target(fem_chapter_libs)
+if(FEM_GRADING)
+  add_custom_target(fem_graded_tests)
+endif()
 
 include(${CMAKE_CURRENT_LIST_DIR}/FemExercises.cmake)
 
@@ -60,21 +66,7 @@ function(fem_add_chapter number name)
     set(from_exercises ON)
   endif()
 
-  if(FEM_GRADING)
-    # Solutions with every exercise region behind a run-time switch, generated at build time.
-    set(graded_dir ${CMAKE_BINARY_DIR}/graded/${id})
-    set(sources "")
-    foreach(src IN LISTS solution_sources)
-      get_filename_component(file_name ${src} NAME)
-      list(APPEND sources ${graded_dir}/${file_name})
-    endforeach()
-    add_custom_command(
-      OUTPUT ${sources}
-      COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/exercises.py graded --root ${FEM_ROOT}
-              --chapter ${id} --out ${graded_dir}
-      DEPENDS ${solution_sources} ${FEM_ROOT}/tools/exercises.py
-      COMMENT "Generating graded sources of chapter ${id}")
-  elseif(from_exercises)
+  if(from_exercises)
     message(STATUS "chapter ${number}: from exercises/ (your code; later chapters keep the reference solution)")
     set(sources "")
     foreach(src IN LISTS solution_sources)
@@ -91,7 +83,7 @@ function(fem_add_chapter number name)
   foreach(dep IN LISTS CH_DEPENDS)
     target_link_libraries(${lib} PUBLIC fem_ch${dep}_reference)
   endforeach()
-  if(from_exercises AND NOT FEM_GRADING)
+  if(from_exercises)
     # A stub leaves its parameters and the helpers its solution used unused.
     target_compile_options(${lib} PRIVATE -Wno-unused-parameter -Wno-unused-variable
                            -Wno-unused-but-set-variable -Wno-unused-function)
@@ -117,22 +109,60 @@ function(fem_add_chapter number name)
       message(FATAL_ERROR "chapter ${id}: no tests in tests/${id}")
     endif()
     set(test_exe test_ch${number})
-    add_executable(${test_exe} ${test_sources})
-    target_link_libraries(${test_exe} PRIVATE ${lib} fem_test_main fem_flags)
-    target_compile_definitions(${test_exe} PRIVATE FEM_TEST_OUTPUT_DIR="${CMAKE_BINARY_DIR}/test_output/${id}")
+    # The test sources are compiled once (an object library), for test_chNN and its graded twin;
+    # they see the chapters' headers, not a chapter library, so that each links its own.
+    add_library(${test_exe}_objects OBJECT ${test_sources})
+    target_include_directories(${test_exe}_objects PRIVATE ${FEM_ROOT}/chapters)
+    target_link_libraries(${test_exe}_objects PRIVATE fem_test_main fem_flags)
+    target_compile_definitions(${test_exe}_objects PRIVATE FEM_TEST_OUTPUT_DIR="${CMAKE_BINARY_DIR}/test_output/${id}")
+    fem_test_pch_for(${test_exe}_objects)
+    add_executable(${test_exe})
+    target_link_libraries(${test_exe} PRIVATE ${test_exe}_objects ${lib} fem_test_main fem_flags)
     fem_discover_tests(${test_exe} "ch${number}")
     add_dependencies(fem_tests ${test_exe})
+    if(FEM_GRADING)
+      # The solutions with every exercise region behind a run-time switch (environment variable
+      # FEM_STUB_EXERCISE=05.2), generated at build time, so that tools/exercises.py grade can prove,
+      # one exercise at a time, that the tests fail on a stub without rebuilding. Earlier chapters
+      # stay the reference solutions (grading stubs only the chapter's own exercises).
+      set(graded_dir ${CMAKE_BINARY_DIR}/graded/${id})
+      set(graded_sources "")
+      foreach(src IN LISTS solution_sources)
+        get_filename_component(file_name ${src} NAME)
+        list(APPEND graded_sources ${graded_dir}/${file_name})
+      endforeach()
+      add_custom_command(
+        OUTPUT ${graded_sources}
+        COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/exercises.py graded --root ${FEM_ROOT}
+                --chapter ${id} --out ${graded_dir}
+        DEPENDS ${solution_sources} ${FEM_ROOT}/tools/exercises.py
+        COMMENT "Generating graded sources of chapter ${id}")
+      add_library(${lib}_graded STATIC EXCLUDE_FROM_ALL ${graded_sources})
+      target_include_directories(${lib}_graded PUBLIC ${FEM_ROOT}/chapters)
+      target_link_libraries(${lib}_graded PUBLIC fem_common PRIVATE fem_flags)
+      foreach(dep IN LISTS CH_DEPENDS)
+        target_link_libraries(${lib}_graded PUBLIC fem_ch${dep}_reference)
+      endforeach()
+      add_executable(${test_exe}_graded EXCLUDE_FROM_ALL)
+      target_link_libraries(${test_exe}_graded PRIVATE ${test_exe}_objects ${lib}_graded fem_test_main fem_flags)
+      set_target_properties(${test_exe}_graded PROPERTIES OUTPUT_NAME ${test_exe}
+                            RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/bin/graded)
+      add_dependencies(fem_graded_tests ${test_exe}_graded)
+    endif()
 
     add_test(NAME ch${number}_quick_run
              COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/check_run.py
                      --exe $<TARGET_FILE:${exe}> --expected ${FEM_ROOT}/tests/${id}/expected
                      --out ${CMAKE_BINARY_DIR}/check_runs/${id})
-    set_tests_properties(ch${number}_quick_run PROPERTIES LABELS "ch${number};run")
+    # COST: ctest -j starts the costliest tests first (before it has timed a run of its own), so
+    # that the docs checks (whole runs of the executable, up to minutes) do not start last and keep
+    # one core busy alone at the end; then the quick runs, then the unit tests.
+    set_tests_properties(ch${number}_quick_run PROPERTIES LABELS "ch${number};run" COST 10)
     add_test(NAME ch${number}_docs
              COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/check_docs.py --root ${FEM_ROOT}
                      --chapter ${id} --bin ${CMAKE_BINARY_DIR}/bin
                      --out ${CMAKE_BINARY_DIR}/check_docs/${id})
-    set_tests_properties(ch${number}_docs PROPERTIES LABELS "ch${number};docs")
+    set_tests_properties(ch${number}_docs PROPERTIES LABELS "ch${number};docs" COST 100)
     add_test(NAME ch${number}_test_target
              COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/check_targets.py --build ${CMAKE_BINARY_DIR}
                      --chapter ${id})
@@ -147,13 +177,18 @@ function(fem_add_chapter number name)
 
   # A chapter's own additions to the build (e.g. an optional reference library for its
   # executable) go in chapters/NN_name/chapter.cmake, included here, where ${lib}, ${exe} and
-  # ${test_exe} name its targets and ${chapter_libraries} lists every library built from its
-  # sources: ${lib}, and in a student build also its reference twin ${lib}_reference. A package
-  # the chapter's code needs is linked to each of them.
+  # ${test_exe} name its targets (the test sources compile in ${test_exe}_objects: a compile
+  # option or definition for them goes there) and ${chapter_libraries} lists every library built
+  # from its sources: ${lib}, in a student build also its reference twin ${lib}_reference, and with
+  # FEM_GRADING its graded twin ${lib}_graded. A package the chapter's code needs is linked to
+  # each of them.
   set(chapter_libraries ${lib})
   get_target_property(reference_aliased ${lib}_reference ALIASED_TARGET)
   if(NOT reference_aliased)
     list(APPEND chapter_libraries ${lib}_reference)
+  endif()
+  if(TARGET ${lib}_graded)
+    list(APPEND chapter_libraries ${lib}_graded)
   endif()
   if(EXISTS ${FEM_ROOT}/chapters/${id}/chapter.cmake)
     include(${FEM_ROOT}/chapters/${id}/chapter.cmake)

@@ -18,7 +18,7 @@ if(NOT FEM_EXERCISES STREQUAL "all")
 endif()
 
 function(fem_check_exercise_chapters)
-  if(FEM_GRADING OR FEM_EXERCISES STREQUAL "all")
+  if(FEM_EXERCISES STREQUAL "all")
     return()
   endif()
   foreach(number IN LISTS FEM_EXERCISES)

@@ -15,8 +15,10 @@ Commands:
   check     fail if exercises/ is not what `generate` would write
   list      print every exercise: id, function, docs section, file:line
   graded    write one chapter's solutions with each region behind the run-time switch
-            fem::exercise_stubbed(id), for the grading build (-DFEM_GRADING=ON)
-  grade     with a grading build, check every exercise's tests against its stubs (see command_grade)
+            fem::exercise_stubbed(id), for the graded twins of a build (-DFEM_GRADING=ON)
+  grade     with a build configured with -DFEM_GRADING=ON whose target fem_graded_tests is built
+            (<build>/bin/graded/test_chNN), check every exercise's tests against its stubs
+            (see command_grade)
 
 What an exercise builds on is written in its chapter's docs, on the line right under its heading:
 
@@ -378,10 +380,11 @@ def command_grade(args):
     print(f"{'':9} {'':30} {'':24} {'':>6} {'passed':>9} {'failed':>8} {'passed':>9}")
     problems = []
     for chapter in sorted({e.chapter for e in exercises}):
-        binary = build / "bin" / f"test_ch{chapter[:2]}"
+        binary = build / "bin" / "graded" / f"test_ch{chapter[:2]}"
         in_chapter = [e for e in exercises if e.chapter == chapter]
         if not binary.exists():
-            problems.append(f"chapter {chapter}: no test binary {binary}")
+            problems.append(f"chapter {chapter}: no test binary {binary} (configure with -DFEM_GRADING=ON "
+                            f"and build the target fem_graded_tests)")
             continue
         listed = prerequisites(root, chapter)
         chapter_ids = [e.id for e in all_exercises(root) if e.chapter == chapter]
@@ -410,7 +413,8 @@ def main():
     parser.add_argument("--root", default=Path(__file__).resolve().parent.parent)
     parser.add_argument("--chapter", help="graded: the chapter folder, e.g. 01_finite_differences")
     parser.add_argument("--out", help="graded: the folder for the generated sources")
-    parser.add_argument("--build", help="grade: a build configured with -DFEM_GRADING=ON")
+    parser.add_argument("--build", help="grade: a build configured with -DFEM_GRADING=ON, "
+                        "its target fem_graded_tests built")
     parser.add_argument("--chapters", nargs="*", help="grade: only these chapter numbers (01 05 ...)")
     args = parser.parse_args()
     try:

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Fuzzes the course's file readers: builds the fuzz preset (clang, libFuzzer + ASan + UBSan; common/
 # and fuzz/ only) and runs each reader's target from its seed corpus (fuzz/corpus/<target>/) for a
-# bounded time, one target after the other. Exits 1 at the first finding, naming the input that
-# caused it. New inputs that reach new code are kept in build/fuzz/corpus/<target>/ for the next run.
+# bounded time, as many targets at once as there are cores. Exits 1 if any target found something,
+# naming the input that caused it. New inputs that reach new code are kept in
+# build/fuzz/corpus/<target>/ for the next run.
 #
 #   tools/fuzz.sh                         every target, 15 s each (the CI stage of tools/test.sh)
 #   tools/fuzz.sh --seconds 3600 ply      one target for an hour
@@ -25,7 +26,7 @@ while [ $# -gt 0 ]; do
     case "$1" in
         --seconds) seconds="$2"; shift 2 ;;
         --runs) runs="$2"; seconds=0; shift 2 ;;
-        -h|--help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        -h|--help) sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         -*) echo "error: unknown option '$1'; allowed: --seconds N, --runs N, formats" >&2; exit 1 ;;
         *) formats+=("$1"); shift ;;
     esac
@@ -38,20 +39,42 @@ done
 cmake --preset fuzz -DFEM_WERROR=ON >/dev/null
 cmake --build --preset fuzz -j "$JOBS"
 
-printf '\n%-8s %12s %10s %8s\n' target executions "exec/s" seconds
-for format in "${formats[@]}"; do
-    work="build/fuzz/corpus/$format" findings="build/fuzz/findings/$format"
+# One target per core at a time (JOBS, tools/common.sh): each is one libFuzzer process on one thread,
+# so each still runs its full time on a core of its own.
+fuzz_target() {
+    local format="$1" work="build/fuzz/corpus/$1" findings="build/fuzz/findings/$1" log="build/fuzz/fuzz_$1.log"
+    local start=$SECONDS status=0
     mkdir -p "$work" "$findings"
+    "build/fuzz/bin/fuzz_$format" -max_total_time="$seconds" -runs="$runs" -timeout=10 \
+        -rss_limit_mb=2048 -malloc_limit_mb=512 -detect_leaks=0 -max_len=8192 -print_final_stats=1 \
+        -artifact_prefix="$findings/" "$work" "fuzz/corpus/$format" >"$log" 2>&1 || status=$?
+    echo "$status $((SECONDS - start))" >"build/fuzz/result_$format"
+}
+
+rm -f build/fuzz/result_*
+for format in "${formats[@]}"; do
+    while [ "$(jobs -pr | wc -l)" -ge "$JOBS" ]; do
+        wait -n || true
+    done
+    fuzz_target "$format" &
+done
+wait
+
+printf '\n%-8s %12s %10s %8s\n' target executions "exec/s" seconds
+failed=()
+for format in "${formats[@]}"; do
     log="build/fuzz/fuzz_$format.log"
-    start=$SECONDS
-    if ! "build/fuzz/bin/fuzz_$format" -max_total_time="$seconds" -runs="$runs" -timeout=10 \
-            -rss_limit_mb=2048 -malloc_limit_mb=512 -detect_leaks=0 -max_len=8192 -print_final_stats=1 \
-            -artifact_prefix="$findings/" "$work" "fuzz/corpus/$format" >"$log" 2>&1; then
-        tail -n 40 "$log" >&2
-        echo "error: fuzz_$format found a bug; the input is in $findings/ (full log: $log)" >&2
-        exit 1
+    read -r status took <"build/fuzz/result_$format"
+    if [ "$status" -ne 0 ]; then
+        failed+=("$format")
+        continue
     fi
     executions=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log")
     rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log")
-    printf '%-8s %12s %10s %8s\n' "$format" "$executions" "$rate" $((SECONDS - start))
+    printf '%-8s %12s %10s %8s\n' "$format" "$executions" "$rate" "$took"
 done
+for format in "${failed[@]}"; do
+    tail -n 40 "build/fuzz/fuzz_$format.log" >&2
+    echo "error: fuzz_$format found a bug; the input is in build/fuzz/findings/$format/ (full log: build/fuzz/fuzz_$format.log)" >&2
+done
+[ ${#failed[@]} -eq 0 ]

@@ -1,14 +1,15 @@
 #!/usr/bin/env bash
 # The course's full check (what CI runs): every stage must pass.
 #   1. grading   each exercise, stubbed alone, fails at least one of its tagged tests, and they
-#                pass with only it and what its docs say it builds on done (a table)
+#                pass with only it and what its docs say it builds on done (a table); built in
+#                build/release (-DFEM_GRADING=ON: graded twins of the tests, target fem_graded_tests)
 #   2. exercises every chapter compiles from exercises/ (the stubs students start from)
 #   3. asan      under AddressSanitizer + UndefinedBehaviorSanitizer (and float-cast-overflow):
 #                the unit tests, and each executable's --quick run, bad command lines and the
 #                output-folder rule
-#   4. release   every test passes on the reference solutions: unit tests, the layout and
-#                exercise-sync checks, each executable's --quick run against stored numbers, and
-#                each chapter's docs against its executable
+#   4. release   (the rest of build/release) every test passes on the reference solutions: unit
+#                tests, the layout and exercise-sync checks, each executable's --quick run against
+#                stored numbers, and each chapter's docs against its executable
 #   5. fuzz      every file reader's libFuzzer target runs 15 s from its seed corpus without a
 #                finding (tools/fuzz.sh; clang, ASan + UBSan)
 set -euo pipefail
@@ -24,10 +25,12 @@ export OMP_NUM_THREADS=1
 step "exercises/ in sync with solutions/"
 python3 tools/exercises.py check
 
+# The grading stage builds in the release build folder: its graded twins (-DFEM_GRADING=ON) link
+# the same compiled test objects as the release tests, which stage 4 then only links and runs.
 step "1/5 grading build: every exercise fails its tests as a stub and needs only what it builds on"
-cmake --preset grading -DFEM_WERROR=ON >/dev/null
-cmake --build --preset grading -j "$JOBS"
-with_display python3 tools/exercises.py grade --build build/grading
+cmake --preset release -DFEM_GRADING=ON -DFEM_WERROR=ON >/dev/null
+cmake --build --preset release --target fem_graded_tests -j "$JOBS"
+with_display python3 tools/exercises.py grade --build build/release
 
 step "2/5 every chapter library compiles from exercises/"
 cmake --preset exercises -DFEM_WERROR=ON >/dev/null
@@ -39,7 +42,6 @@ cmake --build --preset asan -j "$JOBS"
 with_display ctest --preset asan
 
 step "4/5 release: all tests on the reference solutions"
-cmake --preset release -DFEM_WERROR=ON >/dev/null
 cmake --build --preset release -j "$JOBS"
 with_display ctest --preset release
 

@@ -115,7 +115,7 @@ int main(int argc, char** argv)
                 result = run_scene(scenes.front(), options);
                 break;
             } catch (const LiveView::Restart&) {  // the live view's r: the run starts over
-                std::cout << "restarted\n";
+                std::cout << "restarted" << std::endl;  // flushed: a script driving the window waits for it
                 std::filesystem::remove_all(run.file(scenes.front().file.stem().string()));
             }
         }

@@ -20,6 +20,7 @@ if(FEM_BUILD_TESTS)
                              FEM_SCENES_DIR="${FEM_ROOT}/scenes" FEM_SCENE_EXE="$<TARGET_FILE:fem_scene>"
                              FEM_SCENE_BAD_DIR="${FEM_ROOT}/tests/scenes/bad_scenes")
   add_dependencies(test_scenes fem_scene)
+  fem_test_pch_for(test_scenes)
   fem_discover_tests(test_scenes "scenes")
   add_dependencies(fem_tests test_scenes)
 
@@ -31,7 +32,7 @@ if(FEM_BUILD_TESTS)
              COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/check_run.py
                      --exe $<TARGET_FILE:fem_scene> --expected ${FEM_ROOT}/tests/scenes/expected/${scene}
                      --out ${CMAKE_BINARY_DIR}/check_runs/scenes/${scene} -- ${scene_file} --no-progress)
-    set_tests_properties(scenes_quick_run_${scene} PROPERTIES LABELS "scenes;run")
+    set_tests_properties(scenes_quick_run_${scene} PROPERTIES LABELS "scenes;run" COST 10)  # as chNN_quick_run
   endforeach()
 endif()
 
@@ -40,7 +41,7 @@ if(FEM_BUILD_TESTS)
   add_test(NAME scenes_docs
            COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/check_docs.py --root ${FEM_ROOT}
                    --chapter scenes --bin ${CMAKE_BINARY_DIR}/bin --out ${CMAKE_BINARY_DIR}/check_docs/scenes)
-  set_tests_properties(scenes_docs PROPERTIES LABELS "scenes;docs")
+  set_tests_properties(scenes_docs PROPERTIES LABELS "scenes;docs" COST 100)  # as chNN_docs
   # Bad command lines: refused before anything is computed or written.
   add_test(NAME scenes_bad_options
            COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/check_bad_options.py

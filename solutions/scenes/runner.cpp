@@ -692,12 +692,14 @@ void LiveView::frame(const io::MeshData& frame, int step, double time)
     while (!paused_ && clock_.seconds() < 1.0 / scene_.output.frame_rate)
         std::this_thread::sleep_for(std::chrono::milliseconds(5));
     clock_.restart();
-    bool advance = false;
+    bool advance = false, announced = false;
     do {
         for (char key : window_.poll_keys()) {
-            if (key == ' ')
+            if (key == ' ') {
                 paused_ = !paused_;
-            else if (key == '>' && paused_)
+                if (!paused_)
+                    std::cout << "resumed" << std::endl;
+            } else if (key == '>' && paused_)
                 advance = true;
             else if (key == 'r')
                 throw Restart{};
@@ -707,6 +709,12 @@ void LiveView::frame(const io::MeshData& frame, int step, double time)
                 field_ = (field_ + 1) % fields_.size();
                 draw();
             }
+        }
+        if (paused_ && !advance && !announced) {
+            // Said once per frame it waits on, when this frame's files are written and it is shown:
+            // a script driving the window waits for the line (tests/scenes/test_runner.cpp).
+            std::cout << "paused at step " << step << " (t = " << time << " s)" << std::endl;
+            announced = true;
         }
         if (paused_ && !advance)
             std::this_thread::sleep_for(std::chrono::milliseconds(20));

@@ -19,6 +19,7 @@
 #include <fstream>
 #include <sstream>
 #include <thread>
+#include <poll.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -58,19 +59,32 @@ std::string pushed_cube(const std::string& model, const std::string& load)
            "[time]\nstep = 0.02\nduration = 0.2\n";
 }
 
-/// Starts fem_scene with these arguments in a child process (its output discarded); returns its id.
-pid_t start_scene(const std::vector<std::string>& arguments)
+/// Starts fem_scene with these arguments in a child process; returns its id. Its output is discarded,
+/// or, given output_fd, its standard output goes to a pipe whose reading end is stored there.
+pid_t start_scene(const std::vector<std::string>& arguments, int* output_fd = nullptr)
 {
+    int pipe_ends[2] = {-1, -1};
+    if (output_fd != nullptr && ::pipe(pipe_ends) != 0)
+        return -1;
     const pid_t child = ::fork();
     if (child == 0) {
         std::freopen("/dev/null", "w", stdout);
         std::freopen("/dev/null", "w", stderr);
+        if (output_fd != nullptr) {
+            ::dup2(pipe_ends[1], STDOUT_FILENO);
+            ::close(pipe_ends[0]);
+            ::close(pipe_ends[1]);
+        }
         std::vector<char*> argv{const_cast<char*>(FEM_SCENE_EXE)};
         for (const std::string& argument : arguments)
             argv.push_back(const_cast<char*>(argument.c_str()));
         argv.push_back(nullptr);
         ::execv(FEM_SCENE_EXE, argv.data());
         std::_Exit(127);
+    }
+    if (output_fd != nullptr) {
+        ::close(pipe_ends[1]);
+        *output_fd = pipe_ends[0];
     }
     return child;
 }
@@ -357,11 +371,48 @@ int frames_so_far(const std::filesystem::path& out, const std::string& stem)
     return count;
 }
 
+/// The lines a running process prints on a pipe, read as they come.
+class LineReader {
+public:
+    explicit LineReader(int fd) : fd_(fd) {}
+    ~LineReader() { ::close(fd_); }
+    LineReader(const LineReader&) = delete;
+    LineReader& operator=(const LineReader&) = delete;
+
+    /// Reads lines until one that starts with prefix and returns it; "" when the output ends or none
+    /// came within timeout_seconds (ample on a loaded machine: "" means the line never comes).
+    std::string wait_for(const std::string& prefix, double timeout_seconds = 120.0)
+    {
+        const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_seconds);
+        for (;;) {
+            for (std::size_t end; (end = buffer_.find('\n')) != std::string::npos;) {
+                std::string line = buffer_.substr(0, end);
+                buffer_.erase(0, end + 1);
+                if (line.rfind(prefix, 0) == 0)
+                    return line;
+            }
+            const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+            pollfd readable{fd_, POLLIN, 0};
+            if (left.count() <= 0 || ::poll(&readable, 1, static_cast<int>(left.count())) <= 0)
+                return "";
+            char chunk[4096];
+            const ssize_t count = ::read(fd_, chunk, sizeof chunk);
+            if (count <= 0)
+                return "";
+            buffer_.append(chunk, static_cast<std::size_t>(count));
+        }
+    }
+
+private:
+    int fd_;
+    std::string buffer_;
+};
+
 }  // namespace
 
-// Hidden ([.timing]): it races the run against the X key events and failed once in a release build
-// (the run stepped on after the pause key). Run it by hand: test_scenes "[.timing]".
-TEST_CASE("the live view's keys: space pauses, the right arrow steps, space resumes, r restarts, q stops", "[scenes][.timing]")
+// Deterministic: after each key the test waits for the line fem_scene prints once it has handled
+// it (paused at step ..., resumed, restarted), not for a time, before it counts the frames written.
+TEST_CASE("the live view's keys: space pauses, the right arrow steps, space resumes, r restarts, q stops", "[scenes]")
 {
     Display* display = std::getenv("DISPLAY") ? XOpenDisplay(nullptr) : nullptr;
     if (display == nullptr) {
@@ -371,45 +422,63 @@ TEST_CASE("the live view's keys: space pauses, the right arrow steps, space resu
     const std::filesystem::path out = output / "keys";
     std::filesystem::remove_all(out);
     const std::string scene = (gallery / "cantilever.toml").string();
+    int output_fd = -1;
     const pid_t child = start_scene({scene, "--quick", "--view", "--no-figures", "--no-progress", "--set", "time.duration=600",
-                                     "--out", out.string()});
+                                     "--out", out.string()}, &output_fd);
     REQUIRE(child > 0);
+    LineReader printed(output_fd);
+    struct StopOnFailure {  // a failed REQUIRE leaves no window running its 600 s
+        pid_t child;
+        bool reaped = false;
+        ~StopOnFailure()
+        {
+            if (!reaped) {
+                ::kill(child, SIGKILL);
+                ::waitpid(child, nullptr, 0);
+            }
+        }
+    } running{child};
     Window window = 0;
-    for (int poll = 0; poll < 600 && (window == 0 || frames_so_far(out, "cantilever") < 3); ++poll) {
+    for (int poll = 0; poll < 1200 && (window == 0 || frames_so_far(out, "cantilever") < 3); ++poll) {
         std::this_thread::sleep_for(std::chrono::milliseconds(50));
         if (window == 0)
             window = find_window(display, DefaultRootWindow(display), "fem_scene: ");
     }
     REQUIRE(window != 0);
-    press(display, window, XK_space);  // pause
-    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    press(display, window, XK_space);  // pause: the frame shown is the last one written
+    REQUIRE(printed.wait_for("paused at step ") != "");
     const int paused = frames_so_far(out, "cantilever");
     std::this_thread::sleep_for(std::chrono::milliseconds(1000));
     CHECK(frames_so_far(out, "cantilever") == paused);
     press(display, window, XK_Right);  // one frame on, still paused
-    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    REQUIRE(printed.wait_for("paused at step ") != "");
     CHECK(frames_so_far(out, "cantilever") == paused + 1);
     press(display, window, XK_c);  // another colour field: the run goes on drawing
     press(display, window, XK_space);  // resume: 12 frames a second
-    std::this_thread::sleep_for(std::chrono::milliseconds(1000));
-    CHECK(frames_so_far(out, "cantilever") > paused);
-    // r: the run starts over (its frames so far are dropped and written again from the start).
-    for (int poll = 0; poll < 600 && frames_so_far(out, "cantilever") < paused + 8; ++poll)
+    REQUIRE(printed.wait_for("resumed") != "");
+    for (int poll = 0; poll < 2400 && frames_so_far(out, "cantilever") < paused + 8; ++poll)
         std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    CHECK(frames_so_far(out, "cantilever") >= paused + 8);
+    // r: the run starts over, its frames so far dropped. Pressed while paused: the pause holds, so the
+    // restarted run waits at its first frame, and what it wrote can be counted.
+    press(display, window, XK_space);
+    REQUIRE(printed.wait_for("paused at step ") != "");
     const int before_restart = frames_so_far(out, "cantilever");
+    CHECK(before_restart >= paused + 8);
     press(display, window, XK_r);
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));
-    CHECK(frames_so_far(out, "cantilever") < before_restart);
+    REQUIRE(printed.wait_for("restarted") != "");
+    CHECK(printed.wait_for("paused at step ") == "paused at step 0 (t = 0 s)");
+    CHECK(frames_so_far(out, "cantilever") == 1);
     press(display, window, XK_q);  // stop, as Ctrl-C does
     int status = 0;
     ::waitpid(child, &status, 0);
+    running.reaped = true;
     XCloseDisplay(display);
     REQUIRE(WIFEXITED(status));
     CHECK(WEXITSTATUS(status) == 130);
     const auto frames = io::read_pvd(out / "cantilever.pvd");
-    REQUIRE(!frames.empty());
+    REQUIRE(frames.size() == 1);  // the restarted run's first frame, not those before the restart
     CHECK(frames.front().first == 0.0);
-    CHECK(frames.size() < static_cast<std::size_t>(before_restart));  // the restarted run's frames only
 }
 
 TEST_CASE("a skin: the bunny's surface in its body's coordinates, carrying an affine motion exactly", "[scenes]")
