@@ -422,9 +422,12 @@ TEST_CASE("the live view's keys: space pauses, the right arrow steps, space resu
     const std::filesystem::path out = output / "keys";
     std::filesystem::remove_all(out);
     const std::string scene = (gallery / "cantilever.toml").string();
+    // A title of its own: ctest runs another test's live view (same scene) on the same display at
+    // times, and the keys must go to this run's window.
+    const std::string title = "live_view_keys_" + std::to_string(::getpid());
     int output_fd = -1;
     const pid_t child = start_scene({scene, "--quick", "--view", "--no-figures", "--no-progress", "--set", "time.duration=600",
-                                     "--out", out.string()}, &output_fd);
+                                     "--set", "title=" + title, "--out", out.string()}, &output_fd);
     REQUIRE(child > 0);
     LineReader printed(output_fd);
     struct StopOnFailure {  // a failed REQUIRE leaves no window running its 600 s
@@ -442,7 +445,7 @@ TEST_CASE("the live view's keys: space pauses, the right arrow steps, space resu
     for (int poll = 0; poll < 1200 && (window == 0 || frames_so_far(out, "cantilever") < 3); ++poll) {
         std::this_thread::sleep_for(std::chrono::milliseconds(50));
         if (window == 0)
-            window = find_window(display, DefaultRootWindow(display), "fem_scene: ");
+            window = find_window(display, DefaultRootWindow(display), "fem_scene: " + title);
     }
     REQUIRE(window != 0);
     press(display, window, XK_space);  // pause: the frame shown is the last one written
