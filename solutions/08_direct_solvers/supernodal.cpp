@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <cstring>
 #include <numeric>
+#include <type_traits>
 #include <vector>
 
 #if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
@@ -170,62 +171,60 @@ __attribute__((target("avx2,fma"))) void subtract_product_avx2(int m, int n, int
 // the two AVX2 kernels below (8 floats or 4 doubles per fused multiply-add, four columns of L per
 // pass over the short vector) reach it. Chosen at run time, like the product kernel above.
 
-/// The AVX2 register of one scalar type (8 floats or 4 doubles) and what the kernels do with it.
+/// The AVX2 register of one scalar type (8 floats or 4 doubles) and what the kernels do with it:
+/// each operation once, its float and double intrinsics side by side.
 template <class Scalar>
-struct Avx2Lanes;
-
+struct Avx2Register;
 template <>
-struct Avx2Lanes<float> {
-    using Register = __m256;
-    static constexpr int width = 8;
-    __attribute__((target("avx2,fma"))) static Register zero() { return _mm256_setzero_ps(); }
-    __attribute__((target("avx2,fma"))) static Register load(const float* p) { return _mm256_loadu_ps(p); }
-    __attribute__((target("avx2,fma"))) static void store(float* p, Register v) { _mm256_storeu_ps(p, v); }
-    __attribute__((target("avx2,fma"))) static Register broadcast(float x) { return _mm256_set1_ps(x); }
+struct Avx2Register<float> { using type = __m256; };
+template <>
+struct Avx2Register<double> { using type = __m256d; };
+
+template <class Scalar>
+struct Avx2Lanes {
+    static constexpr bool single = std::is_same_v<Scalar, float>;
+    using Register = typename Avx2Register<Scalar>::type;
+    static constexpr int width = 32 / sizeof(Scalar);
+    __attribute__((target("avx2,fma"))) static Register zero()
+    {
+        if constexpr (single) return _mm256_setzero_ps(); else return _mm256_setzero_pd();
+    }
+    __attribute__((target("avx2,fma"))) static Register load(const Scalar* p)
+    {
+        if constexpr (single) return _mm256_loadu_ps(p); else return _mm256_loadu_pd(p);
+    }
+    __attribute__((target("avx2,fma"))) static void store(Scalar* p, Register v)
+    {
+        if constexpr (single) _mm256_storeu_ps(p, v); else _mm256_storeu_pd(p, v);
+    }
+    __attribute__((target("avx2,fma"))) static Register broadcast(Scalar x)
+    {
+        if constexpr (single) return _mm256_set1_ps(x); else return _mm256_set1_pd(x);
+    }
     __attribute__((target("avx2,fma"))) static Register fma(Register a, Register b, Register c)
     {
-        return _mm256_fmadd_ps(a, b, c);
+        if constexpr (single) return _mm256_fmadd_ps(a, b, c); else return _mm256_fmadd_pd(a, b, c);
     }
-    __attribute__((target("avx2,fma"))) static float sum(Register v)
+    __attribute__((target("avx2,fma"))) static Scalar sum(Register v)
     {
-        const __m128 half = _mm_add_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
-        const __m128 quarter = _mm_add_ps(half, _mm_movehl_ps(half, half));
-        return _mm_cvtss_f32(_mm_add_ss(quarter, _mm_shuffle_ps(quarter, quarter, 1)));
+        if constexpr (single) {
+            const __m128 half = _mm_add_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
+            const __m128 quarter = _mm_add_ps(half, _mm_movehl_ps(half, half));
+            return _mm_cvtss_f32(_mm_add_ss(quarter, _mm_shuffle_ps(quarter, quarter, 1)));
+        } else {
+            const __m128d half = _mm_add_pd(_mm256_castpd256_pd128(v), _mm256_extractf128_pd(v, 1));
+            return _mm_cvtsd_f64(_mm_add_sd(half, _mm_unpackhi_pd(half, half)));
+        }
     }
 };
 
-template <>
-struct Avx2Lanes<double> {
-    using Register = __m256d;
-    static constexpr int width = 4;
-    __attribute__((target("avx2,fma"))) static Register zero() { return _mm256_setzero_pd(); }
-    __attribute__((target("avx2,fma"))) static Register load(const double* p) { return _mm256_loadu_pd(p); }
-    __attribute__((target("avx2,fma"))) static void store(double* p, Register v) { _mm256_storeu_pd(p, v); }
-    __attribute__((target("avx2,fma"))) static Register broadcast(double x) { return _mm256_set1_pd(x); }
-    __attribute__((target("avx2,fma"))) static Register fma(Register a, Register b, Register c)
-    {
-        return _mm256_fmadd_pd(a, b, c);
-    }
-    __attribute__((target("avx2,fma"))) static double sum(Register v)
-    {
-        const __m128d half = _mm_add_pd(_mm256_castpd256_pd128(v), _mm256_extractf128_pd(v, 1));
-        return _mm_cvtsd_f64(_mm_add_sd(half, _mm_unpackhi_pd(half, half)));
-    }
-};
-
-/// t −= B x for a column-major B (r×c, c ≤ 4, leading dimension ld): the c columns in one pass over t.
+/// t −= B x for a column-major B (r×4, leading dimension ld): the four columns in one pass over t.
 template <class Scalar>
-__attribute__((target("avx2,fma"))) void subtract_product_avx2(int r, int c, const Scalar* B, long long ld,
-                                                               const Scalar* x, Scalar* t)
+__attribute__((target("avx2,fma"))) void subtract_product_avx2(int r, const Scalar* B, long long ld, const Scalar* x,
+                                                               Scalar* t)
 {
     using Lanes = Avx2Lanes<Scalar>;
     constexpr int w = Lanes::width;
-    if (c < 4) {
-        for (int j = 0; j < c; ++j)
-            for (int i = 0; i < r; ++i)
-                t[i] -= B[i + j * ld] * x[j];
-        return;
-    }
     const Scalar *const b0 = B, *const b1 = b0 + ld, *const b2 = b1 + ld, *const b3 = b2 + ld;
     const auto x0 = Lanes::broadcast(-x[0]), x1 = Lanes::broadcast(-x[1]), x2 = Lanes::broadcast(-x[2]),
                x3 = Lanes::broadcast(-x[3]);
@@ -240,22 +239,13 @@ __attribute__((target("avx2,fma"))) void subtract_product_avx2(int r, int c, con
         t[i] -= b0[i] * x[0] + b1[i] * x[1] + b2[i] * x[2] + b3[i] * x[3];
 }
 
-/// x −= Bᵀ t for a column-major B (r×c, c ≤ 4, leading dimension ld): c dot products in one pass over t.
+/// x −= Bᵀ t for a column-major B (r×4, leading dimension ld): four dot products in one pass over t.
 template <class Scalar>
-__attribute__((target("avx2,fma"))) void subtract_transposed_product_avx2(int r, int c, const Scalar* B, long long ld,
+__attribute__((target("avx2,fma"))) void subtract_transposed_product_avx2(int r, const Scalar* B, long long ld,
                                                                           const Scalar* t, Scalar* x)
 {
     using Lanes = Avx2Lanes<Scalar>;
     constexpr int w = Lanes::width;
-    if (c < 4) {
-        for (int j = 0; j < c; ++j) {
-            Scalar d = 0;
-            for (int i = 0; i < r; ++i)
-                d += B[i + j * ld] * t[i];
-            x[j] -= d;
-        }
-        return;
-    }
     const Scalar *const b0 = B, *const b1 = b0 + ld, *const b2 = b1 + ld, *const b3 = b2 + ld;
     auto s0 = Lanes::zero(), s1 = Lanes::zero(), s2 = Lanes::zero(), s3 = Lanes::zero();
     int i = 0;
@@ -280,37 +270,29 @@ __attribute__((target("avx2,fma"))) void subtract_transposed_product_avx2(int r,
 }
 #endif
 
-/// t −= B x for a column-major B (r×c, c ≤ 4, leading dimension ld); the AVX2 kernel where it runs.
-template <class Scalar>
-void subtract_product(int r, int c, const Scalar* B, int ld, const Scalar* x, Scalar* t)
+/// The substitutions' update with the panel columns B (column-major r×c, c ≤ 4, leading
+/// dimension ld): forward, out (r) −= B in (c); backward (transposed), out (c) −= Bᵀ in (r). The
+/// AVX2 kernel for four columns where it runs; Eigen's product otherwise (and for a supernode's
+/// last one to three columns).
+template <bool transposed, class Scalar>
+void subtract_panel_product(int r, int c, const Scalar* B, int ld, const Scalar* in, Scalar* out)
 {
 #ifdef FEM_AVX2_KERNEL
-    if (avx2_available()) {
-        subtract_product_avx2(r, c, B, ld, x, t);
+    if (c == 4 && avx2_available()) {
+        if constexpr (transposed)
+            subtract_transposed_product_avx2(r, B, ld, in, out);
+        else
+            subtract_product_avx2(r, B, ld, in, out);
         return;
     }
 #endif
     using Matrix = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;
     using Vector = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;
-    Eigen::Map<Vector>(t, r).noalias() -=
-        Eigen::Map<const Matrix, 0, Eigen::OuterStride<>>(B, r, c, Eigen::OuterStride<>(ld)) * Eigen::Map<const Vector>(x, c);
-}
-
-/// x −= Bᵀ t for a column-major B (r×c, c ≤ 4, leading dimension ld); the AVX2 kernel where it runs.
-template <class Scalar>
-void subtract_transposed_product(int r, int c, const Scalar* B, int ld, const Scalar* t, Scalar* x)
-{
-#ifdef FEM_AVX2_KERNEL
-    if (avx2_available()) {
-        subtract_transposed_product_avx2(r, c, B, ld, t, x);
-        return;
-    }
-#endif
-    using Matrix = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;
-    using Vector = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;
-    Eigen::Map<Vector>(x, c).noalias() -=
-        Eigen::Map<const Matrix, 0, Eigen::OuterStride<>>(B, r, c, Eigen::OuterStride<>(ld)).transpose() *
-        Eigen::Map<const Vector>(t, r);
+    const Eigen::Map<const Matrix, 0, Eigen::OuterStride<>> panel(B, r, c, Eigen::OuterStride<>(ld));
+    if constexpr (transposed)
+        Eigen::Map<Vector>(out, c).noalias() -= panel.transpose() * Eigen::Map<const Vector>(in, r);
+    else
+        Eigen::Map<Vector>(out, r).noalias() -= panel * Eigen::Map<const Vector>(in, c);
 }
 
 /// C −= A Bᵀ for column-major C (m×n, leading dimension ldc), A (m×k) and B (n×k).
@@ -682,7 +664,8 @@ void SupernodalCholesky::solve_vector(const Scalar* values, Scalar* x) const
                 for (int i = j + 1; i < j0 + jb; ++i)
                     w[i] -= P[i + static_cast<long long>(j) * m] * w[j];
             }
-            subtract_product(m - j0 - jb, jb, P + j0 + jb + static_cast<long long>(j0) * m, m, w + j0, w + j0 + jb);
+            subtract_panel_product<false>(m - j0 - jb, jb, P + j0 + jb + static_cast<long long>(j0) * m, m, w + j0,
+                                          w + j0 + jb);
         }
         std::copy(w, w + ns, x + f);
         for (int i = 0; i < m - ns; ++i)
@@ -697,8 +680,8 @@ void SupernodalCholesky::solve_vector(const Scalar* values, Scalar* x) const
             w[ns + i] = x[below[i]];
         for (int j0 = (ns - 1) / step * step; j0 >= 0; j0 -= step) {
             const int jb = std::min(step, ns - j0);
-            subtract_transposed_product(m - j0 - jb, jb, P + j0 + jb + static_cast<long long>(j0) * m, m, w + j0 + jb,
-                                        w + j0);
+            subtract_panel_product<true>(m - j0 - jb, jb, P + j0 + jb + static_cast<long long>(j0) * m, m, w + j0 + jb,
+                                         w + j0);
             for (int j = j0 + jb - 1; j >= j0; --j) {
                 for (int i = j + 1; i < j0 + jb; ++i)
                     w[j] -= P[i + static_cast<long long>(j) * m] * w[i];
