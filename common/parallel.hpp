@@ -86,11 +86,13 @@ void parallel_for(Eigen::Index n, Body&& body)
 /// parallel_for over all slots followed by one ordered loop, so the same bits on any number of
 /// threads; but only batch slots (e.g. 512 12×12 matrices, 0.6 MB) are written and read back, in
 /// the cache, instead of one slot per element in memory. An exception is rethrown as parallel_for
-/// does (the smallest i); the batches before it have been added by then.
+/// does (the smallest i); the batches before it have been added by then. fem::Error for batch < 1.
 template <class Slot, class Compute, class Add>
 void parallel_for_then_add(Eigen::Index n, std::vector<Slot>& slots, Compute&& compute, Add&& add,
                            Eigen::Index batch = 512)
 {
+    if (batch < 1)
+        throw Error(str("parallel_for_then_add: the batch must hold >= 1 element, got ", batch));
     slots.resize(static_cast<std::size_t>(std::max<Eigen::Index>(0, std::min(batch, n))));
     for (Eigen::Index first = 0; first < n; first += batch) {
         const Eigen::Index count = std::min(batch, n - first);

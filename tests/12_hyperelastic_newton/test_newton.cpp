@@ -488,4 +488,14 @@ TEST_CASE("the element loops on 1 and 2 threads: the same energy, forces and Hes
     CHECK_THROWS_WITH(neo.evaluate(squashed, forces), Contains("tet 0 "));
     fem::set_thread_count(original);
     CHECK_THROWS_WITH(fem::set_thread_count(0), Contains("must be >= 1"));
+    // A failed evaluation leaves the caller's forces as they were (the sums go into a vector of
+    // their own, swapped in only at the end).
+    Eigen::VectorXd kept = Eigen::VectorXd::Constant(3 * mesh.V.rows(), 7.0);
+    const Eigen::VectorXd before = kept;
+    CHECK_THROWS(neo.evaluate(squashed, kept));
+    CHECK(kept == before);
+    std::vector<double> slots;
+    CHECK_THROWS_WITH(fem::parallel_for_then_add(
+                          4, slots, [](Eigen::Index, double&) {}, [](Eigen::Index, const double&) {}, 0),
+                      Contains("batch must hold >= 1"));
 }
