@@ -7,8 +7,9 @@
 // ratio ("fraction of triad [measured]"). Those columns are reported but never compared against
 // stored numbers; every other column must reproduce. Round-off is held to a bound, not to its
 // digits: a stored value ≤ 1e-12 passes while it stays ≤ 1e-10, and a column named "… [round-off]"
-// (round-off amplified by a condition number) passes while it grows less than 100× (see
-// tools/csv_compare.py). A parameter with a unit is written "dt (s)", not "dt [s]".
+// (round-off amplified by a condition number) passes while it grows less than 100×; a column named
+// "… [±X]" holds values known to ±X (digits below X are round-off), and an "iterations" column
+// agrees within one iteration (see tools/csv_compare.py). A parameter with a unit is written "dt (s)", not "dt [s]".
 
 #include <filesystem>
 #include <iosfwd>

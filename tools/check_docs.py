@@ -12,12 +12,14 @@ Checks:
   3. the tables between <!-- fem:table NAME.csv --> and <!-- /fem:table --> hold the numbers the
      executable prints today: the page's <!-- fem:run chNN_name [args] --> line says how to run it
      ({root} in args: the project's folder);
-     measured columns (times, rates) are skipped (see csv_compare.py);
+     cell by cell by the rules of csv_compare.cells_differ (measured columns such as times are
+     skipped, iteration counts agree within one, round-off is held to bounds);
   4. every number a sentence quotes from a table, marked
          <!-- fem:value NAME.csv KEY=VALUE … "COLUMN" -->6·10⁻³<!-- /fem:value -->
      (the row whose KEY columns hold those VALUEs, quoted with "" when they contain spaces), is the
      executable's value rounded to the significant digits the sentence shows (see
-     csv_compare.quoted_number);
+     csv_compare.quoted_number), or agrees with it by the column's rules (csv_compare.cells_differ:
+     iteration counts within one, a "[±X]" column within X);
   5. every image the page shows exists.
 
 --update reruns the executable, rewrites the tables and copies the figures named by
@@ -36,7 +38,7 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from csv_compare import as_number, close, is_measured, is_roundoff, quoted_number, read_csv, rounded  # noqa: E402
+from csv_compare import as_number, cells_differ, is_measured, quoted_number, read_csv, rounded  # noqa: E402
 from exercises import EXERCISE_HEADING, all_exercises, builds_on, exercise_key  # noqa: E402
 
 RUN = re.compile(r"<!-- fem:run (?P<exe>\S+)(?P<args>[^>]*?)\s*-->")
@@ -134,7 +136,10 @@ def check_quotes(text, out):
         cell = found[0][header.index(column)]
         value, digits = number
         actual = as_number(cell)
-        if actual is None or not math.isclose(rounded(actual, digits), rounded(value, digits), rel_tol=1e-9):
+        # The quote holds when it is the cell rounded to the quote's digits, or when the two agree by
+        # the column's own rules (iteration counts within one, a ±X column within X, round-off bounds).
+        if actual is None or not (math.isclose(rounded(actual, digits), rounded(value, digits), rel_tol=1e-9)
+                                  or cells_differ(column, repr(value), cell, 0.0) is None):
             problems.append(f"{where}: the executable prints {cell}, which to {digits} significant "
                             f"digit(s) is not {quoted}: rewrite the sentence around the new number")
     return problems
@@ -239,14 +244,10 @@ def check_tables(text, out):
                 problems.append(f"{name}, row {r + 1}: the docs row has {len(want)} cells, expected {len(header)}")
                 continue
             for c, column in enumerate(header):
-                if is_measured(column):
-                    continue
-                a, b = as_number(want[c]), as_number(got[c])
-                same = (close(a, b, RELATIVE_TOLERANCE, is_roundoff(column)) if a is not None and b is not None
-                        else want[c] == got[c])
-                if not same:
+                rule = cells_differ(column, want[c], got[c], RELATIVE_TOLERANCE)
+                if rule:
                     problems.append(f"{name}, row {r + 1}, column '{column}': the docs say {want[c]}, "
-                                    f"the executable prints {got[c]}")
+                                    f"the executable prints {got[c]} ({rule})")
     return problems
 
 

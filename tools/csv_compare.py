@@ -20,6 +20,11 @@ A column whose header ends with "[round-off]" holds round-off amplified by a con
 (e.g. "max deviation / max tip [round-off]": 1e-13…1e-10): each new value passes when it is at most
 ROUNDOFF_GROWTH (100) times the stored one, or ≤ ROUNDOFF_BOUND.
 
+A column whose header ends with "[±X]" (e.g. "final relative error [±1e-10]") holds values whose
+digits below X are round-off of that computation (an error measured against a reference that is
+itself exact only to round-off times a condition number): two values that differ by at most X agree.
+The header says so to the reader as well.
+
 A column whose header names iterations ("CG iterations per step") counts the steps of an iterative
 solver until a residual test passes. The last test compares a round-off-affected residual with a
 tolerance, so a different rounding can move a count by one: counts (and their averages) agree
@@ -43,6 +48,7 @@ ROUNDOFF = re.compile(r"\[round-off\]\s*$")
 ROUNDOFF_LEVEL = 1e-12
 ROUNDOFF_BOUND = 1e-10
 ROUNDOFF_GROWTH = 100.0
+UNCERTAINTY = re.compile(r"\[±(?P<amount>[0-9.]+(?:e[-+]?[0-9]+)?)\]\s*$")
 ITERATIONS = re.compile(r"\biterations\b", re.IGNORECASE)
 ITERATION_SLACK = 1.0
 
@@ -70,15 +76,38 @@ def is_roundoff(header):
     return bool(ROUNDOFF.search(header))
 
 
-def close(expected, actual, rtol, roundoff_column=False):
-    """Within rtol of each other, or within the round-off rules above."""
+def close(expected, actual, rtol, roundoff_column=False, uncertainty=0.0):
+    """Within rtol of each other, or within the round-off rules above (uncertainty: a column's ±X)."""
     if math.isnan(expected) or math.isnan(actual):
         return False
     if roundoff_column:
         return abs(actual) <= max(ROUNDOFF_GROWTH * abs(expected), ROUNDOFF_BOUND)
     if abs(expected) <= ROUNDOFF_LEVEL:
         return abs(actual) <= ROUNDOFF_BOUND
-    return abs(actual - expected) <= max(rtol * max(abs(expected), abs(actual)), ROUNDOFF_LEVEL)
+    return abs(actual - expected) <= max(rtol * max(abs(expected), abs(actual)), ROUNDOFF_LEVEL, uncertainty)
+
+
+def cells_differ(header, expected, actual, rtol):
+    """None when a stored cell and a new one of the column `header` agree by the rules above (text
+    cells: exactly), else the rule they break, for the message. Measured columns always agree."""
+    if is_measured(header):
+        return None
+    a, b = as_number(expected), as_number(actual)
+    if a is None or b is None:
+        return None if expected == actual else "text must match"
+    if ITERATIONS.search(header):
+        return None if abs(a - b) <= ITERATION_SLACK and not math.isnan(a - b) else \
+            f"iteration counts agree within {ITERATION_SLACK:g}"
+    uncertainty = UNCERTAINTY.search(header)
+    if close(a, b, rtol, is_roundoff(header), float(uncertainty["amount"]) if uncertainty else 0.0):
+        return None
+    if is_roundoff(header):
+        return f"a round-off column may grow {ROUNDOFF_GROWTH:g}x"
+    if abs(a) <= ROUNDOFF_LEVEL:
+        return f"a round-off value must stay at most {ROUNDOFF_BOUND:g}"
+    if uncertainty:
+        return f"values agree within ±{uncertainty['amount']} or relative tolerance {rtol:g}"
+    return f"relative tolerance {rtol:g}"
 
 
 def quoted_number(text):
@@ -112,23 +141,10 @@ def compare_tables(expected_header, expected_rows, actual_header, actual_rows, r
     problems = []
     for r, (want, got) in enumerate(zip(expected_rows, actual_rows)):
         for c, header in enumerate(expected_header):
-            if is_measured(header):
-                continue
-            a, b = as_number(want[c]), as_number(got[c])
-            if a is not None and b is not None:
-                roundoff_column = is_roundoff(header)
-                if ITERATIONS.search(header) and abs(a - b) <= ITERATION_SLACK:
-                    continue
-                if not close(a, b, rtol, roundoff_column):
-                    rule = (f"a round-off column may grow {ROUNDOFF_GROWTH:g}x" if roundoff_column
-                            else f"iteration counts agree within {ITERATION_SLACK:g}" if ITERATIONS.search(header)
-                            else f"a round-off value must stay at most {ROUNDOFF_BOUND:g}" if abs(a) <= ROUNDOFF_LEVEL
-                            else f"relative tolerance {rtol:g}")
-                    problems.append(f"{name}, row {r + 1}, column '{header}': expected {want[c]}, "
-                                    f"got {got[c]} ({rule})")
-            elif want[c] != got[c]:
+            rule = cells_differ(header, want[c], got[c], rtol)
+            if rule:
                 problems.append(f"{name}, row {r + 1}, column '{header}': expected '{want[c]}', "
-                                f"got '{got[c]}'")
+                                f"got '{got[c]}' ({rule})")
     return problems
 
 
@@ -149,6 +165,12 @@ def self_test():
     header = ["CG iterations per step"]
     assert compare_tables(header, [["20.25"]], header, [["20.75"]], 1e-6, "t") == []
     assert len(compare_tables(header, [["20.25"]], header, [["23"]], 1e-6, "t")) == 1
+    header = ["final relative error [±1e-10]"]
+    assert compare_tables(header, [["1.650e-11"]], header, [["1.831e-11"]], 1e-6, "t") == []
+    assert compare_tables(header, [["3.610e-09"]], header, [["3.65e-09"]], 1e-6, "t") == []
+    assert len(compare_tables(header, [["3.610e-09"]], header, [["3.8e-09"]], 1e-6, "t")) == 1
+    assert len(compare_tables(["a"], [["yes"]], ["a"], [["no"]], 1e-6, "t")) == 1
+    assert len(compare_tables(["CG iterations"], [["nan"]], ["CG iterations"], [["nan"]], 1e-6, "t")) == 1
     header = ["deviation [round-off]"]
     assert compare_tables(header, [["2e-11"]], header, [["7e-11"]], 1e-6, "t") == []
     assert quoted_number("6·10⁻³") == (0.006, 1) and quoted_number("6 × 10⁻³") == (0.006, 1)

@@ -10,8 +10,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <numeric>
+#include <string_view>
 #include <type_traits>
 #include <vector>
 
@@ -44,9 +46,17 @@ constexpr int panel_width = 64;
 constexpr int kernel_rows = 8, kernel_cols = 6;                    // the register block of C
 constexpr int depth_block = 256, row_block = 96, col_block = 2400;  // what stays in L1 / L2 / L3
 
+/// True when the processor has AVX2 and FMA and the environment variable FEM_NO_AVX2 is unset or
+/// "0". FEM_NO_AVX2=1 runs Eigen's products instead, as on a machine without AVX2: to test that
+/// path and to see what the kernels' different rounding changes (tools/test.sh runs chapter 08's
+/// tests both ways).
 bool avx2_available()
 {
-    static const bool available = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+    static const bool available = [] {
+        const char* off = std::getenv("FEM_NO_AVX2");
+        return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
+               (off == nullptr || std::string_view(off).empty() || std::string_view(off) == "0");
+    }();
     return available;
 }
 
