@@ -110,6 +110,10 @@ protected:
     virtual void do_prepare(const Eigen::SparseMatrix<double>& A, bool same_pattern) = 0;
     /// Solve into x (for iterative solvers x holds the start, sized n); returns the iterations.
     virtual int do_solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) = 0;
+    /// For do_solve: the true relative residual ‖b − A x‖₂ / ‖b‖₂ of the x it returns, when it
+    /// computed it anyway (chapter 09's CG does, with a product by this A), so that solve() does not
+    /// multiply by A once more for stats().relative_residual. Unreported, solve() computes it.
+    void report_true_residual(double relative_residual) { reported_residual_ = relative_residual; }
 
 private:
     std::string name_;
@@ -117,6 +121,7 @@ private:
     Eigen::SparseMatrix<double> A_;  // for the residual check and the pattern comparison
     std::vector<Eigen::Index> mirror_;  // per entry of A_, where its transpose entry is (or −1)
     SolveStats stats_;
+    double reported_residual_ = -1.0;  // report_true_residual's value during a solve (< 0: none)
 };
 
 /// The solver called `name` (see the list at the top of this header), with options for the

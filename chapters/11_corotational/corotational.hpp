@@ -93,6 +93,32 @@ Vector12d corotated_displacement(const Eigen::Matrix3d& R, const Vector12d& x_e,
 /// and X_e). docs/11_corotational.md#forces-and-warped-stiffness
 Vector12d corotated_force(const Matrix12d& K_e, const Eigen::Matrix3d& R, const Vector12d& x_e, const Vector12d& X_e);
 
+/// The shape-gradient form of the same element force (a linear tet with Lamé parameters λ, μ and
+/// rest volume V; g_a the gradient of corner a's shape function, g₀ = −g₁ − g₂ − g₃, so that the
+/// rest edge inverse T_X⁻¹ has rows g₁, g₂, g₃ and F = T_x T_X⁻¹ = Σ_a x_a g_aᵀ):
+///   ε = sym(RᵀF) − I (3×3),  σ = λ tr(ε) I + 2μ ε,  U_e = V (μ ε:ε + ½ λ tr(ε)²),  f_a = −V R σ g_a.
+/// It is the lecture's −R̂ K_e (R̂ᵀ x_e − X_e) written out for K_e = V Bᵀ C B (chapter 05): the
+/// strain from F, which the rotation needed anyway, instead of a 12×12 product; and F from edges is
+/// free of a far translation's round-off, as corotated_displacement's mean removal is.
+/// docs/11_corotational.md#the-shape-gradient-form
+struct GradientFormElement {
+    double energy = 0.0;                 ///< U_e
+    Eigen::Matrix<double, 3, 4> forces;  ///< column a: f_a
+};
+
+/// U_e and the corner forces f_a = −V R σ g_a of one tet in the shape-gradient form above:
+/// F the deformation gradient, R its rotation, rest_edges_inverse T_X⁻¹ (rows g₁, g₂, g₃), volume V.
+GradientFormElement gradient_form_forces(const Eigen::Matrix3d& F, const Eigen::Matrix3d& R,
+                                         const Eigen::Matrix3d& rest_edges_inverse, double volume,
+                                         const elastic::Lame& lame);
+
+/// How CorotationalElasticity computes each element's force and energy (the same numbers to
+/// round-off; K_R is R K_ab Rᵀ of the stored K_e in both). docs/11_corotational.md#the-shape-gradient-form
+enum class ForceForm {
+    stiffness_matrix,  ///< corotated_force of the stored K_e (the lecture's form, the exercises; the default)
+    shape_gradients,   ///< gradient_form_forces (no 12×12 product: the faster one)
+};
+
 /// Which rotation an element uses (docs/11_corotational.md#edges-centroid-or-polar-decomposition).
 enum class RotationFit {
     polar,     ///< polar_rotation of the deformation gradient (the default: order-independent, and
@@ -116,7 +142,8 @@ public:
     /// K_e of every tet at rest (chapter 06's element_stiffnesses) and the assembly pattern.
     /// fem::Error for bad indices, a zero-volume rest tet (naming it) or a bad material.
     CorotationalElasticity(const TetMesh& mesh, const dynamics::Material& material,
-                           RotationFit fit = RotationFit::polar, PolarAlgorithm algorithm = PolarAlgorithm::newton);
+                           RotationFit fit = RotationFit::polar, PolarAlgorithm algorithm = PolarAlgorithm::newton,
+                           ForceForm form = ForceForm::stiffness_matrix);
 
     std::string name() const override { return "corotational"; }
     /// Rotations at u, then U = Σ U_e and f = Σ E_eᵀ f_e. fem::Error if u has not 3n entries.
@@ -138,19 +165,24 @@ public:
 
 private:
     /// rotations(u), kept for the last u: a step asks for the forces and then K_R at the same u,
-    /// and the SVDs are the expensive part of both.
+    /// and the SVDs are the expensive part of both. With ForceForm::shape_gradients it also keeps
+    /// each tet's F (gradients_).
     const std::vector<Eigen::Matrix3d>& rotations_at(const Eigen::VectorXd& u);
+    /// The rotation of every tet at u by the chosen fit, and its F into gradients (when not null).
+    std::vector<Eigen::Matrix3d> rotations(const Eigen::VectorXd& u, std::vector<Eigen::Matrix3d>* gradients) const;
 
     TetMesh mesh_;
     elastic::Lame lame_;
     RotationFit fit_;
     PolarAlgorithm algorithm_;
+    ForceForm form_;
     assembly::ElementMatrices K_e_;
     assembly::AssemblyPattern pattern_;
     dynamics::SparseMatrix K_R_;                  // the pattern's arrays, values rewritten per call
     Eigen::VectorXd volumes_;                     // rest volume of every tet
     Eigen::VectorXd rotated_at_;                  // the u of rotations_
     std::vector<Eigen::Matrix3d> rotations_;
+    std::vector<Eigen::Matrix3d> gradients_;           // F of every tet at rotated_at_ (shape_gradients only)
     std::vector<Eigen::Matrix3d> rest_edges_inverse_;  // T_X⁻¹ of every tet (chapter 04), for F
     /// One tet's share of evaluate(): its energy and f_e.
     struct ElementForces {

@@ -31,6 +31,21 @@ using BlockRotations = std::function<std::vector<Eigen::Matrix3d>()>;
 /// corrects the rounding as it corrects the factor's age.
 enum class FactorPrecision { single_precision, double_precision };
 
+/// When FrozenFactorPcg factors the current matrix again (at the next prepare()); both rules may be
+/// on, e.g. RefreshRule{.iterations_above = 30} or RefreshRule{.balance_cost = true}.
+struct RefreshRule {
+    /// Refactor after a solve that needed more than this many CG iterations (0: no such limit).
+    int iterations_above = 0;
+    /// Refactor once the iterations beyond a fresh factor's (those of the first solve after a
+    /// factorization), summed over the solves since it, cost as much as a factorization did. Costs
+    /// in flops, counted, not timed (the same refreshes on any machine): a factorization Σ_j c_j²
+    /// (c_j: nonzeros of column j of L), an iteration 4 × the factor's stored entries (two
+    /// substitutions) + 2 nnz(A). When the iterations grow steadily, by s a solve, the mean cost of
+    /// a solve F/N + (b + s N/2)·c over a refresh interval of N solves is least at N = √(2F/(s c)),
+    /// where the extra iterations have cost s c N²/2 = F: this rule stops there.
+    bool balance_cost = false;
+};
+
 /// PCG preconditioned by a frozen sparse Cholesky factor (chapter 08's supernodal factorization), behind
 /// chapter 09's solver interface so that chapter 10's ThetaMethod can use it
 /// (ImplicitOptions::make_solver). docs/11_corotational.md#solving-a-changing-matrix
@@ -42,11 +57,11 @@ enum class FactorPrecision { single_precision, double_precision };
 /// element-to-element variation of the rotations costs iterations.
 class FrozenFactorPcg final : public cg::LinearSolver {
 public:
-    /// options: CG's relative tolerance and cap; refresh_iterations: refactor the preconditioner
-    /// when a solve needed more iterations than this (0: never); rotations: the blocks' rotations
-    /// (empty: a plain frozen factor); precision: of the factor's substitutions.
+    /// options: CG's relative tolerance and cap; refresh: when to refactor the preconditioner
+    /// (RefreshRule{}: never); rotations: the blocks' rotations (empty: a plain frozen factor);
+    /// precision: of the factor's substitutions.
     /// fem::Error for a tolerance outside (0, 1) or negative counts.
-    explicit FrozenFactorPcg(const cg::SolverOptions& options = {}, int refresh_iterations = 0,
+    explicit FrozenFactorPcg(const cg::SolverOptions& options = {}, RefreshRule refresh = {},
                              BlockRotations rotations = {},
                              FactorPrecision precision = FactorPrecision::single_precision);
 
@@ -64,7 +79,7 @@ private:
     /// A₀⁻¹ r with the frozen factor, in the chosen precision.
     Eigen::VectorXd apply_factor(const Eigen::VectorXd& r) const;
 
-    int refresh_iterations_;
+    RefreshRule refresh_rule_;
     BlockRotations rotations_;
     FactorPrecision precision_;
     std::optional<direct::SparseCholesky> factor_;   // used directly: no residual check per application
@@ -73,6 +88,9 @@ private:
     std::vector<Eigen::Matrix3d> turn_;               // Qᵢ = Rᵢ R₀ᵢᵀ
     bool refresh_ = true;
     int factorizations_ = 0;
+    // RefreshRule::balance_cost's accounts, in flops (reset at each factorization)
+    double factorization_cost_ = 0.0, iteration_cost_ = 0.0, extra_cost_ = 0.0;
+    int fresh_iterations_ = -1;  // of the first solve after the factorization (-1: none yet)
 };
 
 }  // namespace fem::corot

@@ -44,7 +44,7 @@ dynamics::ImplicitOptions solver_option(const std::string& name, double toleranc
         options.make_solver = [tolerance] {
             cg::SolverOptions pcg;
             pcg.relative_tolerance = tolerance;
-            return std::make_unique<FrozenFactorPcg>(pcg, 30);
+            return std::make_unique<FrozenFactorPcg>(pcg, RefreshRule{.balance_cost = true});
         };
     } else if (name == "rotated-frozen-factor-pcg" || name == "rotated-frozen-factor-pcg double") {
         auto* model = dynamic_cast<CorotationalElasticity*>(&body.model());
@@ -56,7 +56,7 @@ dynamics::ImplicitOptions solver_option(const std::string& name, double toleranc
             cg::SolverOptions pcg;
             pcg.relative_tolerance = tolerance;
             return std::make_unique<FrozenFactorPcg>(
-                pcg, 30, [model, &dofs] { return free_vertex_rotations(*model, dofs); }, precision);
+                pcg, RefreshRule{.balance_cost = true}, [model, &dofs] { return free_vertex_rotations(*model, dofs); }, precision);
         };
     } else {
         throw Error(str("unknown solver option '", name, "'"));

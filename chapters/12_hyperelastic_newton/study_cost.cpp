@@ -113,7 +113,8 @@ void cost_study(const RunContext& run, const Settings& settings)
     for (const std::string solver : {"refactor", "frozen-factor-pcg"}) {
         NewtonOptions options;
         if (solver == "frozen-factor-pcg")
-            options.make_solver = [] { return std::make_unique<corot::FrozenFactorPcg>(cg::SolverOptions{1e-8, 0}, 10); };
+            options.make_solver = [] { return std::make_unique<corot::FrozenFactorPcg>(cg::SolverOptions{1e-8, 0},
+                                                                                  corot::RefreshRule{.iterations_above = 10}); };
         NewtonBackwardEuler newton(options);
         dynamics::State state = dynamics::initial_state(body);
         newton.step(body, vega.time_step, state);  // the first step orders and factors: not counted

@@ -9,15 +9,17 @@
 
 #include "common/error.hpp"
 
+#include <algorithm>
+
 namespace fem::corot {
 
-FrozenFactorPcg::FrozenFactorPcg(const cg::SolverOptions& options, int refresh_iterations, BlockRotations rotations,
+FrozenFactorPcg::FrozenFactorPcg(const cg::SolverOptions& options, RefreshRule refresh, BlockRotations rotations,
                                  FactorPrecision precision)
     : cg::LinearSolver(rotations ? "rotated-frozen-cholesky-pcg" : "frozen-cholesky-pcg", options),
-      refresh_iterations_(refresh_iterations), rotations_(std::move(rotations)), precision_(precision)
+      refresh_rule_(refresh), rotations_(std::move(rotations)), precision_(precision)
 {
-    if (refresh_iterations < 0)
-        throw Error(str(name(), ": the refresh count must be >= 0, got ", refresh_iterations));
+    if (refresh.iterations_above < 0)
+        throw Error(str(name(), ": the refresh iteration count must be >= 0, got ", refresh.iterations_above));
 }
 
 void FrozenFactorPcg::do_prepare(const Eigen::SparseMatrix<double>& A, bool same_pattern)
@@ -40,6 +42,10 @@ void FrozenFactorPcg::do_prepare(const Eigen::SparseMatrix<double>& A, bool same
         }
         ++factorizations_;
         refresh_ = false;
+        factorization_cost_ = factor_->flops();
+        iteration_cost_ = 4.0 * static_cast<double>(factor_->stored_entries()) + 2.0 * static_cast<double>(A.nonZeros());
+        extra_cost_ = 0.0;
+        fresh_iterations_ = -1;
         frozen_rotations_ = current;
     }
     turn_.resize(current.size());
@@ -68,8 +74,16 @@ int FrozenFactorPcg::do_solve(const Eigen::VectorXd& b, Eigen::VectorXd& x)
     if (!result.converged)
         throw Error(str(name(), ": CG missed its tolerance ", options().relative_tolerance, " within ",
                         result.iterations, " iterations"));
-    if (refresh_iterations_ > 0 && result.iterations > refresh_iterations_)
-        refresh_ = true;  // the next prepare() factors the current matrix
+    report_true_residual(result.relative_residual);  // CG's product with the same A
+    // The next prepare() factors the current matrix when a rule says so.
+    if (refresh_rule_.iterations_above > 0 && result.iterations > refresh_rule_.iterations_above)
+        refresh_ = true;
+    if (fresh_iterations_ < 0)
+        fresh_iterations_ = result.iterations;
+    else
+        extra_cost_ += std::max(0, result.iterations - fresh_iterations_) * iteration_cost_;
+    if (refresh_rule_.balance_cost && extra_cost_ >= factorization_cost_)
+        refresh_ = true;
     return result.iterations;
 }
 

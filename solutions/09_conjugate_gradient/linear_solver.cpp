@@ -172,6 +172,7 @@ private:
                                     : conjugate_gradient(*operator_, b, x, settings);
         require_converged(name(), result.iterations, result.residual_history.back(), settings.relative_tolerance,
                           result.converged);
+        report_true_residual(result.relative_residual);  // CG's last product with A (the same one)
         return result.iterations;
     }
     Kind kind_;
@@ -315,6 +316,7 @@ void LinearSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x)
     if (largest > 0.0 && (largest < 0x1p-300 || largest > 0x1p300))
         std::frexp(largest, &exponent);
     Timer timer;
+    reported_residual_ = -1.0;
     if (exponent == 0) {
         stats_.iterations = do_solve(b, x);
     } else {
@@ -327,8 +329,11 @@ void LinearSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x)
         x = scale(x, exponent);
     }
     stats_.solve_seconds = timer.seconds();
+    // (The relative residual of a solve scaled by 2ᵏ is the unscaled one: the scaling is exact.)
     const double b_norm = b.norm();
-    stats_.relative_residual = b_norm > 0.0 ? (b - A_ * x).norm() / b_norm : x.norm();
+    stats_.relative_residual = b_norm == 0.0            ? x.norm()
+                               : reported_residual_ >= 0.0 ? reported_residual_
+                                                           : (b - A_ * x).norm() / b_norm;
 }
 
 std::unique_ptr<LinearSolver> make_solver(std::string_view name, const SolverOptions& options)

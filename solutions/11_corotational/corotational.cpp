@@ -149,12 +149,29 @@ Vector12d corotated_force(const Matrix12d& K_e, const Eigen::Matrix3d& R, const 
     return force;
 }
 
+GradientFormElement gradient_form_forces(const Eigen::Matrix3d& F, const Eigen::Matrix3d& R,
+                                         const Eigen::Matrix3d& rest_edges_inverse, double volume,
+                                         const elastic::Lame& lame)
+{
+    const Eigen::Matrix3d rotated = R.transpose() * F;
+    const Eigen::Matrix3d strain = 0.5 * (rotated + rotated.transpose()) - Eigen::Matrix3d::Identity();
+    const double trace = strain.trace();
+    Eigen::Matrix3d stress = 2.0 * lame.mu * strain;
+    stress.diagonal().array() += lame.lambda * trace;
+    GradientFormElement element;
+    element.energy = volume * (lame.mu * strain.squaredNorm() + 0.5 * lame.lambda * trace * trace);
+    // f_a = −V R σ g_a for a = 1, 2, 3 (g_a: row a − 1 of T_X⁻¹), and f₀ = −(f₁ + f₂ + f₃)
+    element.forces.rightCols<3>().noalias() = (-volume * (R * stress)) * rest_edges_inverse.transpose();
+    element.forces.col(0) = -element.forces.rightCols<3>().rowwise().sum();
+    return element;
+}
+
 // --- CorotationalElasticity ------------------------------------------------------------------------
 
 CorotationalElasticity::CorotationalElasticity(const TetMesh& mesh, const dynamics::Material& material, RotationFit fit,
-                                               PolarAlgorithm algorithm)
+                                               PolarAlgorithm algorithm, ForceForm form)
     : mesh_(mesh), lame_(elastic::lame_parameters(material.youngs_modulus, material.poisson_ratio)), fit_(fit),
-      algorithm_(algorithm), K_e_(assembly::element_stiffnesses(mesh, lame_)), pattern_(mesh),
+      algorithm_(algorithm), form_(form), K_e_(assembly::element_stiffnesses(mesh, lame_)), pattern_(mesh),
       K_R_(assembly::csc_of_symmetric(pattern_.zero_matrix())), volumes_(mesh.T.rows()),
       rest_edges_inverse_(static_cast<std::size_t>(mesh.T.rows()))
 {
@@ -167,23 +184,35 @@ CorotationalElasticity::CorotationalElasticity(const TetMesh& mesh, const dynami
 
 std::vector<Eigen::Matrix3d> CorotationalElasticity::rotations(const Eigen::VectorXd& u) const
 {
+    return rotations(u, nullptr);
+}
+
+std::vector<Eigen::Matrix3d> CorotationalElasticity::rotations(const Eigen::VectorXd& u,
+                                                               std::vector<Eigen::Matrix3d>* gradients) const
+{
     if (u.size() != 3 * mesh_.V.rows())
         throw Error(str("displacement has ", u.size(), " entries, expected 3n = ", 3 * mesh_.V.rows()));
     const MatrixX3d x = mesh_.V + io::vertex_rows(u);
     std::vector<Eigen::Matrix3d> R(static_cast<std::size_t>(mesh_.T.rows()));
+    if (gradients)
+        gradients->resize(R.size());
     parallel_for(mesh_.T.rows(), [&](Eigen::Index t) {  // each tet's own rotation: on every core
-        const tet::TetVertices rest = tet::tet_vertices(mesh_, mesh_.V, static_cast<int>(t));
+        const auto e = static_cast<std::size_t>(t);
         const tet::TetVertices now = tet::tet_vertices(mesh_, x, static_cast<int>(t));
-        Eigen::Matrix3d& R_t = R[static_cast<std::size_t>(t)];
+        // F = T_x T_X⁻¹ (chapter 04's deformation_gradient, with the rest inverse kept)
+        const Eigen::Matrix3d F = tet::edge_matrix(now) * rest_edges_inverse_[e];
+        if (gradients)
+            (*gradients)[e] = F;
         switch (fit_) {
-        case RotationFit::polar: {
-            // F = T_x T_X⁻¹ (chapter 04's deformation_gradient, with the rest inverse kept)
-            const Eigen::Matrix3d F = tet::edge_matrix(now) * rest_edges_inverse_[static_cast<std::size_t>(t)];
-            R_t = algorithm_ == PolarAlgorithm::newton ? polar_rotation_newton(F) : polar_rotation(F);
+        case RotationFit::polar:
+            R[e] = algorithm_ == PolarAlgorithm::newton ? polar_rotation_newton(F) : polar_rotation(F);
             break;
-        }
-        case RotationFit::centroid: R_t = best_fit_rotation(centroid_covariance(rest, now)); break;
-        case RotationFit::edges: R_t = best_fit_rotation(edge_covariance(rest, now)); break;
+        case RotationFit::centroid:
+            R[e] = best_fit_rotation(centroid_covariance(tet::tet_vertices(mesh_, mesh_.V, static_cast<int>(t)), now));
+            break;
+        case RotationFit::edges:
+            R[e] = best_fit_rotation(edge_covariance(tet::tet_vertices(mesh_, mesh_.V, static_cast<int>(t)), now));
+            break;
         }
     });
     return R;
@@ -211,7 +240,7 @@ std::vector<Eigen::Matrix3d> CorotationalElasticity::vertex_rotations() const
 const std::vector<Eigen::Matrix3d>& CorotationalElasticity::rotations_at(const Eigen::VectorXd& u)
 {
     if (rotations_.empty() || rotated_at_.size() != u.size() || rotated_at_ != u) {
-        rotations_ = rotations(u);
+        rotations_ = rotations(u, form_ == ForceForm::shape_gradients ? &gradients_ : nullptr);
         rotated_at_ = u;
     }
     return rotations_;
@@ -229,6 +258,13 @@ double CorotationalElasticity::evaluate(const Eigen::VectorXd& u, Eigen::VectorX
         mesh_.T.rows(), element_forces_,
         [&](Eigen::Index t, ElementForces& slot) {
             const auto e = static_cast<std::size_t>(t);
+            if (form_ == ForceForm::shape_gradients) {
+                const GradientFormElement element =
+                    gradient_form_forces(gradients_[e], R[e], rest_edges_inverse_[e], volumes_[t], lame_);
+                slot.energy = element.energy;
+                slot.forces = element.forces.reshaped();
+                return;
+            }
             const Vector12d x_e = element_vector(mesh_, x, t), X_e = element_vector(mesh_, mesh_.V, t);
             slot.forces = corotated_force(K_e_[e], R[e], x_e, X_e);
             // U_e = ½ dᵀ K_e d = −½ Σᵢ (R dᵢ)·f_e,i, since f_e,i = −R (K_e d)ᵢ: no second product with K_e

@@ -300,6 +300,54 @@ TEST_CASE("corotational body: no force under rigid motion, rotation covariance o
     CHECK((f_x - f_svd).norm() <= 1e-12 * f_svd.norm());
 }
 
+TEST_CASE("shape-gradient form: the forces and energy of the stiffness-matrix form, to round-off",
+          "[ch11]")
+{
+    const elastic::Lame lame = elastic::lame_parameters(1e5, 0.3);
+    for (unsigned seed = 0; seed < 20; ++seed) {
+        const tet::TetVertices X = random_tet(100 + seed);
+        const Matrix12d K_e = elastic::element_stiffness(X, lame);
+        const Eigen::Matrix3d rest_inverse = tet::edge_matrix(X).inverse();
+        const double volume = std::abs(tet::signed_volume(X));
+        // A deformed tet: rotated by up to 3 rad and strained by up to 20 %, far from the origin.
+        tet::TetVertices x = X;
+        x += 0.2 * Eigen::Matrix<double, 4, 3>(fem::random_matrix(4, 3, 200 + seed));
+        const Eigen::Matrix3d Q = rotation(0.15 * seed, 300 + seed);
+        x = ((x * Q.transpose()).rowwise() + Eigen::RowVector3d(50.0, -20.0, 7.0)).eval();
+        const Eigen::Matrix3d F = tet::edge_matrix(x) * rest_inverse;
+        const Eigen::Matrix3d R = polar_rotation(F);
+        Vector12d x_e, X_e;
+        for (int i = 0; i < 4; ++i) {
+            x_e.segment<3>(3 * i) = x.row(i).transpose();
+            X_e.segment<3>(3 * i) = X.row(i).transpose();
+        }
+        CAPTURE(seed);
+        const Vector12d expected = corotated_force(K_e, R, x_e, X_e);
+        const Vector12d d = corotated_displacement(R, x_e, X_e);
+        const GradientFormElement element = gradient_form_forces(F, R, rest_inverse, volume, lame);
+        const Vector12d forces = element.forces.reshaped();
+        // x is 50 m from the origin: its round-off (1e-14) over the edges, times K_e, bounds both forms
+        CHECK((forces - expected).norm() <= 1e-11 * K_e.norm() * d.norm() + 1e-13 * K_e.norm());
+        CHECK(element.energy == Approx(0.5 * d.dot(K_e * d)).epsilon(1e-10));
+    }
+    // As a body's force model: the same forces and energy as the default form, and the same K_R.
+    const TetMesh mesh = box_mesh(3, 2, 2, Eigen::Vector3d(0.3, 0.2, 0.2));
+    CorotationalElasticity matrices(mesh, rubber);
+    CorotationalElasticity gradients(mesh, rubber, RotationFit::polar, PolarAlgorithm::newton,
+                                     ForceForm::shape_gradients);
+    const Eigen::VectorXd u = 0.05 * fem::random_vector(3 * mesh.V.rows(), 77);
+    Eigen::VectorXd f_matrices, f_gradients;
+    const double energy = matrices.evaluate(u, f_matrices);
+    CHECK(gradients.evaluate(u, f_gradients) == Approx(energy).epsilon(1e-12));
+    CHECK((f_gradients - f_matrices).norm() <= 1e-12 * f_matrices.norm());
+    const Eigen::MatrixXd K_matrices(matrices.stiffness(u)), K_gradients(gradients.stiffness(u));
+    CHECK(K_gradients == K_matrices);  // K_R is R K_ab Rᵀ in both: the same rotations, the same bits
+    // and after a step to another u (the kept F must follow u)
+    const Eigen::VectorXd v = u + 0.01 * fem::random_vector(u.size(), 78);
+    CHECK(gradients.evaluate(v, f_gradients) == Approx(matrices.evaluate(v, f_matrices)).epsilon(1e-12));
+    CHECK((f_gradients - f_matrices).norm() <= 1e-12 * f_matrices.norm());
+}
+
 TEST_CASE("small deformations: corotational and linear forces differ by O(eps^2)", "[ex11.6]")
 {
     const TetMesh mesh = box_mesh(2, 2, 2);
@@ -521,7 +569,7 @@ TEST_CASE("frozen-factor PCG: exact at rest, more iterations as the body turns, 
         return dynamics::SparseMatrix(M + dt * dt * model.stiffness(u));
     };
     const auto exact = FactorPrecision::double_precision;
-    FrozenFactorPcg frozen({}, 0, {}, exact);
+    FrozenFactorPcg frozen({}, {}, {}, exact);
     frozen.prepare(step_matrix(rest));
     const Eigen::VectorXd b = fem::random_vector(rest.size(), 71);
     Eigen::VectorXd x = frozen.solve(b);
@@ -546,7 +594,7 @@ TEST_CASE("frozen-factor PCG: exact at rest, more iterations as the body turns, 
     CAPTURE(iterations[0], iterations[1], iterations[2]);
     CHECK(iterations[0] < iterations[2]);
     CHECK(frozen.factorizations() == 1);
-    FrozenFactorPcg refreshing({}, 3, {}, exact);
+    FrozenFactorPcg refreshing({}, RefreshRule{.iterations_above = 3}, {}, exact);
     refreshing.prepare(step_matrix(rest));
     refreshing.solve(b);
     const dynamics::SparseMatrix turned_A =
@@ -559,7 +607,7 @@ TEST_CASE("frozen-factor PCG: exact at rest, more iterations as the body turns, 
     // Turned with the body: a rigidly rotated body's matrix is Q A₀ Qᵀ, so the rotated frozen factor
     // stays exact (one iteration) at any angle, where the plain one needs more and more.
     const dynamics::FreeDofs all(static_cast<int>(mesh.V.rows()), {});
-    FrozenFactorPcg turning({}, 0, [&] { return free_vertex_rotations(model, all); }, exact);
+    FrozenFactorPcg turning({}, {}, [&] { return free_vertex_rotations(model, all); }, exact);
     (void)model.stiffness(rest);
     turning.prepare(step_matrix(rest));
     for (const double angle : {0.3, 1.0, 2.0}) {
@@ -574,6 +622,63 @@ TEST_CASE("frozen-factor PCG: exact at rest, more iterations as the body turns, 
         CHECK((x - direct->solve(b)).norm() <= 1e-7 * x.norm());
     }
     CHECK(turning.factorizations() == 1);
-    FrozenFactorPcg wrong_size({}, 0, [] { return std::vector<Eigen::Matrix3d>(2, Eigen::Matrix3d::Identity()); });
+    FrozenFactorPcg wrong_size({}, {}, [] { return std::vector<Eigen::Matrix3d>(2, Eigen::Matrix3d::Identity()); });
     CHECK_THROWS_WITH(wrong_size.prepare(step_matrix(rest)), Contains("block rotations"));
+}
+
+TEST_CASE("frozen-factor PCG: the balanced refresh refactors once the extra iterations have cost a factorization",
+          "[ch11]")
+{
+    const TetMesh mesh = box_mesh(4, 2, 2, Eigen::Vector3d(0.4, 0.2, 0.2));
+    CorotationalElasticity model(mesh, rubber);
+    const auto M = assembly::lumped_mass_matrix(mesh, rubber.density);
+    const double dt = 1.0 / 60.0;
+    const auto step_matrix = [&](double angle) {
+        const Eigen::VectorXd u = displacement(rigidly_moved(mesh.V, rotation(angle, 91), Eigen::Vector3d::Zero()), mesh.V);
+        return dynamics::SparseMatrix(M + dt * dt * model.stiffness(u));
+    };
+    const Eigen::VectorXd b = fem::random_vector(3 * mesh.V.rows(), 92);
+    // The same matrix again and again: no solve needs more than the first, so it never refactors.
+    FrozenFactorPcg steady({}, RefreshRule{.balance_cost = true});
+    const dynamics::SparseMatrix A0 = step_matrix(0.0);
+    for (int k = 0; k < 20; ++k) {
+        steady.prepare(A0);
+        steady.solve(b);
+    }
+    CHECK(steady.factorizations() == 1);
+    // A body turning 0.002 rad a step under a factor that does not turn with it: the iterations grow.
+    // The costs the rule compares, from the same factorization of A0 (flops, stored entries, nnz(A)).
+    direct::CholeskyOptions factor_options;
+    factor_options.single_precision_copy = true;
+    const direct::SparseCholesky factor(A0, factor_options);
+    const double factorization = factor.flops();
+    const double iteration = 4.0 * double(factor.stored_entries()) + 2.0 * double(A0.nonZeros());
+    FrozenFactorPcg turning({}, RefreshRule{.balance_cost = true});
+    std::vector<int> iterations;
+    double extra = 0.0;
+    int refreshed_after = -1;  // the solve after which the account first reached a factorization
+    for (int k = 0; k < 40 && turning.factorizations() < 2; ++k) {
+        turning.prepare(step_matrix(0.002 * k));
+        turning.solve(b);
+        iterations.push_back(turning.stats().iterations);
+        if (k > 0)
+            extra += std::max(0, iterations.back() - iterations.front()) * iteration;
+        if (refreshed_after < 0 && extra >= factorization)
+            refreshed_after = k;
+    }
+    CAPTURE(iterations, factorization / iteration);
+    REQUIRE(refreshed_after > 0);
+    CHECK(refreshed_after > 1);  // the account took several solves to fill
+    CHECK(iterations[static_cast<std::size_t>(refreshed_after)] > iterations.front());
+    // It refactored at the prepare right after that solve, not before and not later.
+    CHECK(turning.factorizations() == 2);
+    CHECK(static_cast<int>(iterations.size()) == refreshed_after + 2);
+    // The same with a cap on the iterations instead: refactors after the first solve above it.
+    FrozenFactorPcg capped({}, RefreshRule{.iterations_above = iterations.front() + 1});
+    for (int k = 0; k < 40 && capped.factorizations() < 2; ++k) {
+        capped.prepare(step_matrix(0.002 * k));
+        capped.solve(b);
+    }
+    CHECK(capped.factorizations() == 2);
+    CHECK_THROWS_WITH(FrozenFactorPcg({}, RefreshRule{.iterations_above = -1}), Contains(">= 0"));
 }
