@@ -85,23 +85,23 @@ Eigen::Matrix3d polar_rotation_newton(const Eigen::Matrix3d& F)
     const double size = F.norm();
     if (!(F.determinant() > 1e-6 * size * size * size))
         return polar_rotation(F);  // inverted, flat or zero: the SVD and its reflection fix
-    Eigen::Matrix3d X = F, inverse_transpose;
+    Eigen::Matrix3d X = F, cofactors;  // cofactors / det X = X⁻ᵀ
     bool scaled = true;
     for (int step = 0; step < 40; ++step) {
-        inverse_transpose.col(0) = X.col(1).cross(X.col(2));
-        inverse_transpose.col(1) = X.col(2).cross(X.col(0));
-        inverse_transpose.col(2) = X.col(0).cross(X.col(1));
-        const double det = X.col(0).dot(inverse_transpose.col(0));
-        inverse_transpose /= det;
-        // Scaling pays where the singular values are far from 1; near det = 1 it would only cost a cube root.
+        cofactors.col(0) = X.col(1).cross(X.col(2));
+        cofactors.col(1) = X.col(2).cross(X.col(0));
+        cofactors.col(2) = X.col(0).cross(X.col(1));
+        const double det = X.col(0).dot(cofactors.col(0));
+        // Scaling pays where the singular values are far from 1; near det = 1 it would only cost a
+        // cube root. One division a step: X⁻ᵀ/ζ = cofactors · (1/(ζ det)).
         const double zeta = scaled && std::abs(det - 1.0) > 1e-2 ? std::cbrt(1.0 / std::abs(det)) : 1.0;
-        const Eigen::Matrix3d next = 0.5 * (zeta * X + inverse_transpose / zeta);
-        const double change = (next - X).norm();
+        const Eigen::Matrix3d next = 0.5 * (zeta * X + (1.0 / (zeta * det)) * cofactors);
+        const double change_squared = (next - X).squaredNorm();  // ‖X_{k+1} − X_k‖², no square root
         X = next;
-        if (change < 1e-2)
-            scaled = false;  // near orthogonal: plain Newton converges quadratically
-        if (change < 1e-8)
-            return X;  // X's error is about change² / 2: below round-off
+        if (change_squared < 1e-4)
+            scaled = false;  // a change below 1e-2, near orthogonal: plain Newton converges quadratically
+        if (change_squared < 1e-16)
+            return X;  // a change below 1e-8: X's error is about change² / 2, below round-off
     }
     return polar_rotation(F);
 }
