@@ -119,7 +119,7 @@ private:
     std::string name_;
     SolverOptions options_;
     Eigen::SparseMatrix<double> A_;  // for the residual check and the pattern comparison
-    std::vector<Eigen::Index> mirror_;  // per entry of A_, where its transpose entry is (or −1)
+    std::vector<std::pair<int, int>> mirror_;  // the entry pairs (k, m) the symmetry check compares
     SolveStats stats_;
     double reported_residual_ = -1.0;  // report_true_residual's value during a solve (< 0: none)
 };

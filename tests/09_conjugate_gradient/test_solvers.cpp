@@ -136,6 +136,10 @@ TEST_CASE("prepare checks the matrix, solve checks b", "[solvers]")
     Eigen::MatrixXd unsymmetric = Eigen::MatrixXd::Identity(3, 3);
     unsymmetric(0, 2) = 0.5;
     CHECK_THROWS_WITH(solver->prepare(unsymmetric.sparseView()), Contains("not symmetric"));
+    unsymmetric(2, 0) = 0.25;  // both entries stored, and different: the message names the pair
+    CHECK_THROWS_WITH(solver->prepare(unsymmetric.sparseView()), Contains("A(2, 0) − A(0, 2) = -0.25"));
+    unsymmetric(2, 0) = 0.5;
+    CHECK_NOTHROW(solver->prepare(unsymmetric.sparseView()));
     Eigen::MatrixXd not_finite = Eigen::MatrixXd::Identity(3, 3);
     not_finite(1, 1) = std::nan("");
     CHECK_THROWS_WITH(solver->prepare(not_finite.sparseView()), Contains("not finite"));
