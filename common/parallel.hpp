@@ -85,14 +85,26 @@ void parallel_for(Eigen::Index n, Body&& body)
 /// then add(i, slot) for each i of the batch in order. The same operations in the same order as
 /// parallel_for over all slots followed by one ordered loop, so the same bits on any number of
 /// threads; but only batch slots (e.g. 512 12×12 matrices, 0.6 MB) are written and read back, in
-/// the cache, instead of one slot per element in memory. An exception is rethrown as parallel_for
-/// does (the smallest i); the batches before it have been added by then. fem::Error for batch < 1.
+/// the cache, instead of one slot per element in memory. On one thread each element is added
+/// right after it is computed, in one slot that stays in the fastest cache: compute(i) depends on
+/// i alone, so these too are the same operations in the same order. An exception is rethrown as
+/// parallel_for does (the smallest i); some of the elements before it have been added by then.
+/// fem::Error for batch < 1.
 template <class Slot, class Compute, class Add>
 void parallel_for_then_add(Eigen::Index n, std::vector<Slot>& slots, Compute&& compute, Add&& add,
                            Eigen::Index batch = 512)
 {
     if (batch < 1)
         throw Error(str("parallel_for_then_add: the batch must hold >= 1 element, got ", batch));
+    if (thread_count() == 1) {
+        if (slots.empty())
+            slots.resize(1);
+        for (Eigen::Index i = 0; i < n; ++i) {
+            compute(i, slots.front());
+            add(i, std::as_const(slots.front()));
+        }
+        return;
+    }
     slots.resize(static_cast<std::size_t>(std::max<Eigen::Index>(0, std::min(batch, n))));
     for (Eigen::Index first = 0; first < n; first += batch) {
         const Eigen::Index count = std::min(batch, n - first);

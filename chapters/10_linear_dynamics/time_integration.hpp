@@ -114,7 +114,7 @@ private:
     };
     SparseMatrix A_;                            // A_ff, its pattern fixed
     Pattern M_pattern_, K_pattern_;
-    std::vector<Eigen::Index> M_slot_, K_slot_; // entry k of M or K (compressed order) → entry of A_ff, or −1
+    std::vector<int> M_slot_, K_slot_;          // entry k of M or K (compressed order) → entry of A_ff, or −1
 };
 
 /// The lecture's right-hand side b = M v + Δt (f + f_ext), i.e. M v − Δt [K u − f_ext] with the
