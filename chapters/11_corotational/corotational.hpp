@@ -28,6 +28,7 @@
 
 #include <Eigen/Core>
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -76,6 +77,13 @@ Eigen::Matrix3d polar_rotation(const Eigen::Matrix3d& F);
 /// reach a reflection or crawl — or after 40 steps. N. J. Higham, Functions of Matrices, §8.9.
 /// docs/11_corotational.md#a-faster-polar-decomposition
 Eigen::Matrix3d polar_rotation_newton(const Eigen::Matrix3d& F);
+
+/// R[k] = polar_rotation_newton(F[k]) for k < count, four at a time in AVX2 registers where the
+/// processor has them (common/simd.hpp): every lane does the same operations in the same order as
+/// the function above, so the same bits; four that include one needing more (the SVD, a scaled
+/// step) go one at a time. fem::Error for a non-finite F.
+/// docs/11_corotational.md#a-faster-polar-decomposition
+void polar_rotations_newton(const Eigen::Matrix3d* F, Eigen::Matrix3d* R, std::size_t count);
 
 /// R̂ K_e R̂ᵀ with R̂ = diag(R, R, R, R): every 3×3 block (a, b) becomes R K_ab Rᵀ (12×12). K_e must
 /// be symmetric (an element stiffness): the ten blocks a ≤ b are computed, the others transposed.

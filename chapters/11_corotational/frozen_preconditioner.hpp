@@ -7,7 +7,8 @@
 // and warm-started PCG with IC(0), a factorization can be kept frozen and used as the
 // preconditioner of CG on the current matrix: A₀⁻¹ A(u) is the identity while the body is at rest
 // and drifts away as its elements rotate, so the iterations grow with the rotation. The frozen
-// factor is refreshed when CG needs more than refresh_iterations.
+// factor is refreshed by a RefreshRule: after too many iterations, or when the extra iterations
+// have cost as much as a factorization.
 
 #include "08_direct_solvers/sparse_cholesky.hpp"
 #include "09_conjugate_gradient/linear_solver.hpp"

@@ -6,16 +6,15 @@
 #include "08_direct_solvers/supernodal.hpp"
 
 #include "common/error.hpp"
+#include "common/simd.hpp"
 
 #include <Eigen/Core>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstdlib>
 #include <cstring>
 #include <numeric>
-#include <string_view>
 #include <type_traits>
 #include <vector>
 
@@ -47,20 +46,6 @@ constexpr int panel_width = 64;
 #ifdef FEM_AVX2_KERNEL
 constexpr int kernel_rows = 8, kernel_cols = 6;                    // the register block of C
 constexpr int depth_block = 256, row_block = 96, col_block = 2400;  // what stays in L1 / L2 / L3
-
-/// True when the processor has AVX2 and FMA and the environment variable FEM_NO_AVX2 is unset or
-/// "0". FEM_NO_AVX2=1 runs Eigen's products instead, as on a machine without AVX2: to test that
-/// path and to see what the kernels' different rounding changes (tools/test.sh runs chapter 08's
-/// tests both ways).
-bool avx2_available()
-{
-    static const bool available = [] {
-        const char* off = std::getenv("FEM_NO_AVX2");
-        return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
-               (off == nullptr || std::string_view(off).empty() || std::string_view(off) == "0");
-    }();
-    return available;
-}
 
 /// A 64-byte aligned scratch area that grows as needed (one per thread).
 double* scratch(std::vector<double>& storage, std::size_t entries)
@@ -290,7 +275,7 @@ template <bool transposed, class Scalar>
 void subtract_panel_product(int r, int c, const Scalar* B, int ld, const Scalar* in, Scalar* out)
 {
 #ifdef FEM_AVX2_KERNEL
-    if (c == 4 && avx2_available()) {
+    if (c == 4 && avx2_enabled()) {
         if constexpr (transposed)
             subtract_transposed_product_avx2(r, B, ld, in, out);
         else
@@ -313,7 +298,7 @@ void subtract_product(int m, int n, int k, const double* A, int lda, const doubl
     if (m == 0 || n == 0 || k == 0)
         return;
 #ifdef FEM_AVX2_KERNEL
-    if (avx2_available() && m >= kernel_rows && n >= kernel_cols) {
+    if (avx2_enabled() && m >= kernel_rows && n >= kernel_cols) {
         subtract_product_avx2(m, n, k, A, lda, B, ldb, C, ldc);
         return;
     }

@@ -63,13 +63,13 @@ double check_square_and_finite(const SparseMatrix& A)
     return 0.0;  // not reached: some value is not finite
 }
 
-/// For every stored entry k = (i, j) of a compressed A, the position of its mirror (j, i) in the
-/// value array, or −1 when the pattern has no (j, i). Built once per pattern: a matrix that
-/// changes every step (chapters 11–12) is then checked for symmetry in one pass, without forming
-/// Aᵀ − A.
-std::vector<Eigen::Index> mirror_entries(const SparseMatrix& A)
+/// The pairs of stored entries a symmetry check compares, for a compressed A: each (k, m) with k
+/// the position of (i, j) and m that of its mirror (j, i), once per pair (k < m); an entry whose
+/// mirror is not stored is paired with −1 (it must be 0). Built once per pattern, so that a matrix
+/// that changes every step (chapters 11–12) is checked in one pass over the pairs, without Aᵀ − A.
+std::vector<std::pair<int, int>> mirror_pairs(const SparseMatrix& A)
 {
-    std::vector<Eigen::Index> mirror(static_cast<std::size_t>(A.nonZeros()), -1);
+    std::vector<std::pair<int, int>> pairs;
     const auto* outer = A.outerIndexPtr();
     const auto* inner = A.innerIndexPtr();
     for (Eigen::Index j = 0; j < A.outerSize(); ++j)
@@ -78,31 +78,31 @@ std::vector<Eigen::Index> mirror_entries(const SparseMatrix& A)
             const auto* first = inner + outer[i];
             const auto* last = inner + outer[i + 1];
             const auto* found = std::lower_bound(first, last, static_cast<int>(j));
-            if (found != last && *found == j)
-                mirror[static_cast<std::size_t>(k)] = found - inner;
+            const int m = found != last && *found == j ? static_cast<int>(found - inner) : -1;
+            if (m < 0 || k < m)
+                pairs.emplace_back(k, m);
         }
-    return mirror;
+    return pairs;
 }
 
 /// fem::Error unless max |A_ij − A_ji| ≤ symmetry_tolerance · largest (an entry without a mirror
-/// counts against zero). Each pair is compared once, at its first entry.
-void check_symmetric(const SparseMatrix& A, const std::vector<Eigen::Index>& mirror, double largest)
+/// counts as its own difference), over the pairs of mirror_pairs(A).
+void check_symmetric(const SparseMatrix& A, const std::vector<std::pair<int, int>>& pairs, double largest)
 {
-    const auto* outer = A.outerIndexPtr();
-    const auto* inner = A.innerIndexPtr();
     const double* value = A.valuePtr();
-    for (Eigen::Index j = 0; j < A.outerSize(); ++j)
-        for (auto k = outer[j]; k < outer[j + 1]; ++k) {
-            const Eigen::Index m = mirror[static_cast<std::size_t>(k)];
-            if (m >= 0 && m < k)
-                continue;
-            const double difference = m >= 0 ? value[m] - value[k] : -value[k];
-            if (std::abs(difference) > symmetry_tolerance * largest)
-                throw Error(str("LinearSolver::prepare: A is not symmetric: A(", j, ", ", inner[k], ") − A(",
-                                inner[k], ", ", j, ") = ", difference, " (allowed: ", symmetry_tolerance,
-                                " × max |A_ij| = ", symmetry_tolerance * largest,
-                                "); the solvers of this interface need a symmetric positive definite A"));
+    const double allowed = symmetry_tolerance * largest;
+    for (const auto& [k, m] : pairs) {
+        const double difference = m >= 0 ? value[m] - value[k] : -value[k];
+        if (!(std::abs(difference) <= allowed)) {
+            // Where entry k sits, for the message: its column j (A is compressed, column-major).
+            const auto* outer = A.outerIndexPtr();
+            const Eigen::Index j = std::upper_bound(outer, outer + A.outerSize() + 1, k) - outer - 1;
+            const Eigen::Index i = A.innerIndexPtr()[k];
+            throw Error(str("LinearSolver::prepare: A is not symmetric: A(", i, ", ", j, ") − A(", j, ", ", i,
+                            ") = ", -difference, " (allowed: ", symmetry_tolerance, " × max |A_ij| = ", allowed,
+                            "); the solvers of this interface need a symmetric positive definite A"));
         }
+    }
 }
 
 bool same_pattern(const SparseMatrix& a, const SparseMatrix& b)
@@ -282,7 +282,7 @@ void LinearSolver::prepare(const Eigen::SparseMatrix<double>& A)
     Timer timer;
     try {
         if (!same)
-            mirror_ = mirror_entries(A_);
+            mirror_ = mirror_pairs(A_);
         check_symmetric(A_, mirror_, largest);
         do_prepare(A_, same);
     } catch (...) {

@@ -138,7 +138,7 @@ ReducedStepMatrix::ReducedStepMatrix(const SparseMatrix& M, const SparseMatrix& 
     for (std::size_t f = 0; f < dofs.indices().size(); ++f)
         renumbered[static_cast<std::size_t>(dofs.indices()[f])] = static_cast<int>(f);
     const auto slots = [&](const SparseMatrix& B) {
-        std::vector<Eigen::Index> slot(static_cast<std::size_t>(B.nonZeros()), -1);
+        std::vector<int> slot(static_cast<std::size_t>(B.nonZeros()), -1);  // Eigen's own index type
         for (Eigen::Index j = 0; j < n; ++j) {
             const int column = renumbered[static_cast<std::size_t>(j)];
             if (column < 0)
@@ -147,7 +147,7 @@ ReducedStepMatrix::ReducedStepMatrix(const SparseMatrix& M, const SparseMatrix& 
             const int* last = A_.innerIndexPtr() + A_.outerIndexPtr()[column + 1];
             for (Eigen::Index k = B.outerIndexPtr()[j]; k < B.outerIndexPtr()[j + 1]; ++k)
                 if (const int row = renumbered[static_cast<std::size_t>(B.innerIndexPtr()[k])]; row >= 0)
-                    slot[static_cast<std::size_t>(k)] = std::lower_bound(first, last, row) - A_.innerIndexPtr();
+                    slot[static_cast<std::size_t>(k)] = static_cast<int>(std::lower_bound(first, last, row) - A_.innerIndexPtr());
         }
         return slot;
     };
@@ -166,7 +166,7 @@ const SparseMatrix& ReducedStepMatrix::assemble(const SparseMatrix& M, const Spa
         throw Error("ReducedStepMatrix: M or K no longer has the pattern the step matrix was built for");
     double* values = A_.valuePtr();
     std::fill(values, values + A_.nonZeros(), 0.0);
-    const auto add = [values](const SparseMatrix& B, const std::vector<Eigen::Index>& slot, double weight) {
+    const auto add = [values](const SparseMatrix& B, const std::vector<int>& slot, double weight) {
         const double* b = B.valuePtr();
         for (std::size_t e = 0; e < slot.size(); ++e)
             if (slot[e] >= 0)

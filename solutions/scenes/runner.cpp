@@ -117,7 +117,9 @@ void SceneForces::set_level(Level level)
         if (level == Level::linear)
             model = std::make_unique<dynamics::LinearElasticity>(mesh_, material_);
         else if (level == Level::corotational)
-            model = std::make_unique<corot::CorotationalElasticity>(mesh_, material_);
+            model = std::make_unique<corot::CorotationalElasticity>(  // the faster force form
+                mesh_, material_, corot::RotationFit::polar, corot::PolarAlgorithm::newton,
+                corot::ForceForm::shape_gradients);
         else
             model = std::make_unique<hyper::HyperelasticElasticity>(
                 mesh_, hyper::make_material(hyperelastic_, material_.youngs_modulus, material_.poisson_ratio));

@@ -182,6 +182,33 @@ TEST_CASE("polar rotation by Newton's iteration: the SVD's rotation to round-off
     }
 }
 
+TEST_CASE("polar rotations four at a time: the bits of one at a time, for easy and hard F mixed", "[ch11]")
+{
+    // Small strains (the lanes' case), large ones (a scaled first step), inverted and flat F (the
+    // SVD), in groups of four where each kind sits next to the others, and a count that is not a
+    // multiple of four. With AVX2 the groups of easy F run in the lanes; either way every R must
+    // equal polar_rotation_newton's exactly (ctest also runs this with FEM_NO_AVX2=1).
+    std::vector<Eigen::Matrix3d> F;
+    for (unsigned seed = 0; seed < 203; ++seed) {
+        const double strain = seed % 5 == 0 ? 0.3 : seed % 7 == 0 ? 1e-6 : 1e-3;
+        Eigen::Matrix3d G = rotation(0.05 * seed, 500 + seed) *
+                            (Eigen::Matrix3d::Identity() + strain * Eigen::Matrix3d(fem::random_matrix(3, 3, 900 + seed)));
+        if (seed % 31 == 0)
+            G.col(2) = -G.col(2);  // inverted
+        if (seed % 37 == 0)
+            G.col(1) = 0.5 * G.col(0);  // flat
+        F.push_back(G);
+    }
+    std::vector<Eigen::Matrix3d> R(F.size());
+    polar_rotations_newton(F.data(), R.data(), F.size());
+    int differing = 0;
+    for (std::size_t k = 0; k < F.size(); ++k)
+        differing += R[k] != polar_rotation_newton(F[k]);
+    CHECK(differing == 0);
+    F[101](1, 1) = std::nan("");
+    CHECK_THROWS_WITH(polar_rotations_newton(F.data(), R.data(), F.size()), Contains("non-finite"));
+}
+
 TEST_CASE("edges, centroid or polar: equal for the tets they were made for, different for skewed ones", "[ex11.3]")
 {
     tet::TetVertices corner;  // edges from vertex 0 orthonormal: PᵀP = I
