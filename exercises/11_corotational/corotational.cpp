@@ -359,12 +359,14 @@ std::vector<Eigen::Matrix3d> CorotationalElasticity::vertex_rotations() const
             sums[static_cast<std::size_t>(mesh_.T(t, i))] += volumes_[t] * rotations_[static_cast<std::size_t>(t)];
             weights[mesh_.T(t, i)] += volumes_[t];
         }
-    // The weighted mean of rotations, det near 1 (Newton's iteration then needs no scaling).
+    // The weighted mean of rotations, det near 1 (Newton's iteration then needs no scaling), four
+    // vertices at a time; a vertex of no tet keeps the identity.
     for (std::size_t v = 0; v < sums.size(); ++v)
-        sums[v] = weights[static_cast<Eigen::Index>(v)] > 0.0
-                      ? polar_rotation_newton(sums[v] / weights[static_cast<Eigen::Index>(v)])
-                      : Eigen::Matrix3d::Identity();
-    return sums;
+        sums[v] = weights[static_cast<Eigen::Index>(v)] > 0.0 ? Eigen::Matrix3d(sums[v] / weights[static_cast<Eigen::Index>(v)])
+                                                              : Eigen::Matrix3d::Identity();
+    std::vector<Eigen::Matrix3d> rotations(sums.size());
+    polar_rotations_newton(sums.data(), rotations.data(), sums.size());
+    return rotations;
 }
 
 const std::vector<Eigen::Matrix3d>& CorotationalElasticity::rotations_at(const Eigen::VectorXd& u)
