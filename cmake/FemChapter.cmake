@@ -43,6 +43,17 @@ function(fem_discover_tests target label)
                        PROPERTIES LABELS "${label}")
 endfunction()
 
+# fem_test_without_avx2(number test_exe): ctest chNN_without_avx2 runs the chapter's unit tests once
+# more with FEM_NO_AVX2=1 (common/simd.hpp), the path of a processor without AVX2 and FMA, which an
+# AVX2 machine would otherwise never run. For chapters with hand-written AVX2 kernels (their
+# chapter.cmake calls it).
+function(fem_test_without_avx2 number test_exe)
+  if(FEM_BUILD_TESTS)
+    add_test(NAME ch${number}_without_avx2 COMMAND ${test_exe} --warn NoTests)
+    set_tests_properties(ch${number}_without_avx2 PROPERTIES ENVIRONMENT FEM_NO_AVX2=1 LABELS "ch${number}")
+  endif()
+endfunction()
+
 function(fem_add_chapter number name)
   cmake_parse_arguments(PARSE_ARGV 2 CH "" "" "DEPENDS")
   set(id ${number}_${name})

@@ -13,9 +13,5 @@ else()
   message(STATUS "Chapter 08: CHOLMOD not found; ch08 runs without the CHOLMOD reference")
 endif()
 
-# The unit tests once more on Eigen's products instead of the AVX2 kernels (FEM_NO_AVX2=1), the
-# path a processor without AVX2 and FMA takes, which this machine would otherwise never run.
-if(FEM_BUILD_TESTS)
-  add_test(NAME ch08_without_avx2 COMMAND ${test_exe} --warn NoTests)
-  set_tests_properties(ch08_without_avx2 PROPERTIES ENVIRONMENT FEM_NO_AVX2=1 LABELS "ch08")
-endif()
+# The unit tests once more with FEM_NO_AVX2=1: Eigen's products instead of the AVX2 kernels.
+fem_test_without_avx2(08 ${test_exe})
