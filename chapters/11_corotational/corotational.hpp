@@ -81,7 +81,7 @@ Eigen::Matrix3d polar_rotation_newton(const Eigen::Matrix3d& F);
 /// R[k] = polar_rotation_newton(F[k]) for k < count, four at a time in AVX2 registers where the
 /// processor has them (common/simd.hpp): every lane does the same operations in the same order as
 /// the function above, so the same bits; four that include one needing more (the SVD, a scaled
-/// step) go one at a time. fem::Error for a non-finite F.
+/// step) go one at a time. fem::Error naming the first non-finite F (before any R is written).
 /// docs/11_corotational.md#a-faster-polar-decomposition
 void polar_rotations_newton(const Eigen::Matrix3d* F, Eigen::Matrix3d* R, std::size_t count);
 

@@ -212,13 +212,14 @@ Eigen::Matrix3d polar_rotation_newton(const Eigen::Matrix3d& F)
 
 void polar_rotations_newton(const Eigen::Matrix3d* F, Eigen::Matrix3d* R, std::size_t count)
 {
+    for (std::size_t k = 0; k < count; ++k)
+        if (!F[k].allFinite())
+            throw Error(str("polar rotations: F[", k, "] of ", count, " has a non-finite entry (every entry must be finite)"));
     std::size_t first = 0;
 #ifdef FEM_AVX2_POLAR
     if (avx2_enabled())
         for (; first + 4 <= count; first += 4) {
-            const bool finite = F[first].allFinite() && F[first + 1].allFinite() && F[first + 2].allFinite() &&
-                                F[first + 3].allFinite();
-            if (finite && polar_rotations_newton_avx2(F + first, R + first))
+            if (polar_rotations_newton_avx2(F + first, R + first))
                 continue;
             for (std::size_t k = first; k < first + 4; ++k)
                 R[k] = polar_rotation_newton(F[k]);
@@ -304,6 +305,9 @@ std::vector<Eigen::Matrix3d> CorotationalElasticity::rotations(const Eigen::Vect
 {
     if (u.size() != 3 * mesh_.V.rows())
         throw Error(str("displacement has ", u.size(), " entries, expected 3n = ", 3 * mesh_.V.rows()));
+    for (Eigen::Index i = 0; i < u.size(); ++i)
+        if (!std::isfinite(u[i]))
+            throw Error(str("displacement entry ", i, " (vertex ", i / 3, ") is ", u[i], "; every entry must be finite"));
     const MatrixX3d x = mesh_.V + io::vertex_rows(u);
     std::vector<Eigen::Matrix3d> R(static_cast<std::size_t>(mesh_.T.rows()));
     if (gradients)
