@@ -182,7 +182,7 @@ TEST_CASE("polar rotation by Newton's iteration: the SVD's rotation to round-off
     }
 }
 
-TEST_CASE("polar rotations four at a time: the bits of one at a time, for easy and hard F mixed", "[ch11]")
+TEST_CASE("polar rotations four at a time: the bits of one at a time, for easy and hard F mixed", "[ex11.3]")
 {
     // Small strains (the lanes' case), large ones (a scaled first step), inverted and flat F (the
     // SVD), in groups of four where each kind sits next to the others, and a count that is not a
@@ -328,7 +328,7 @@ TEST_CASE("corotational body: no force under rigid motion, rotation covariance o
 }
 
 TEST_CASE("shape-gradient form: the forces and energy of the stiffness-matrix form, to round-off",
-          "[ch11]")
+          "[ex11.6]")
 {
     const elastic::Lame lame = elastic::lame_parameters(1e5, 0.3);
     for (unsigned seed = 0; seed < 20; ++seed) {
@@ -658,7 +658,7 @@ TEST_CASE("frozen-factor PCG: exact at rest, more iterations as the body turns, 
 }
 
 TEST_CASE("frozen-factor PCG: the balanced refresh refactors once the extra iterations have cost a factorization",
-          "[ch11]")
+          "[ex11.7]")
 {
     const TetMesh mesh = box_mesh(4, 2, 2, Eigen::Vector3d(0.4, 0.2, 0.2));
     CorotationalElasticity model(mesh, rubber);
