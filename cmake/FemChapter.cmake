@@ -46,9 +46,9 @@ endfunction()
 # fem_test_without_avx2(number test_exe): ctest chNN_without_avx2 runs the chapter's unit tests once
 # more with FEM_NO_AVX2=1 (common/simd.hpp), the path of a processor without AVX2 and FMA, which an
 # AVX2 machine would otherwise never run. For chapters with hand-written AVX2 kernels (their
-# chapter.cmake calls it).
+# chapter.cmake calls it). Nothing when the tests are not built (FEM_BUILD_TESTS off: test_exe empty).
 function(fem_test_without_avx2 number test_exe)
-  if(FEM_BUILD_TESTS)
+  if(FEM_BUILD_TESTS AND test_exe)
     add_test(NAME ch${number}_without_avx2 COMMAND ${test_exe} --warn NoTests)
     set_tests_properties(ch${number}_without_avx2 PROPERTIES ENVIRONMENT FEM_NO_AVX2=1 LABELS "ch${number}")
   endif()

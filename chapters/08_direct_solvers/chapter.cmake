@@ -14,4 +14,4 @@ else()
 endif()
 
 # The unit tests once more with FEM_NO_AVX2=1: Eigen's products instead of the AVX2 kernels.
-fem_test_without_avx2(08 ${test_exe})
+fem_test_without_avx2(08 "${test_exe}")
