@@ -328,6 +328,26 @@ struct ChartLayout {
     }
 };
 
+/// A horizontally centred text actor (set_font's font, size in points) whose position is its
+/// bottom centre; the caller adds it to a renderer and places it.
+vtkSmartPointer<vtkTextActor> text_actor(const std::string& text, int size, bool bold)
+{
+    auto actor = vtkSmartPointer<vtkTextActor>::New();
+    actor->SetInput(text.c_str());
+    set_font(actor->GetTextProperty(), size, bold);
+    actor->GetTextProperty()->SetJustificationToCentered();
+    actor->GetTextProperty()->SetVerticalJustificationToBottom();
+    return actor;
+}
+
+/// The height in pixels of a text actor's text (72 dpi, as the figures' windows).
+double text_height(vtkTextActor* actor)
+{
+    int box[4] = {0, 0, 0, 0};
+    vtkTextRenderer::GetInstance()->GetBoundingBox(actor->GetTextProperty(), actor->GetInput(), box, 72);
+    return box[3] - box[2] + 1;
+}
+
 /// The pixel size of the legend vtkChartLegend draws for these names (its own formula: the widest
 /// label, the symbol and padding across; a line of "Tgyf" height and padding per entry).
 std::pair<double, double> legend_size(vtkTextProperty* labels, const std::vector<std::string>& names)
@@ -613,15 +633,24 @@ bool save_chart(const LineChart& chart, const std::filesystem::path& stem, bool 
     renderer->AddActor(context);
     vtkNew<vtkChartXY> xy;
     context->GetScene()->AddItem(xy);
-    // The chart's own layout puts the x axis title at the window's bottom edge, where the
-    // descenders of DejaVu Sans are cut: the chart gets the window less a strip at the bottom.
+    // The chart's title and x axis title are text actors, not the chart's own: VTK 9.1's context
+    // device draws a top-aligned string (those two) shifted by its descent, so its descenders
+    // were cut and the top of its glyphs showed again under it. The chart gets the window less a
+    // strip at the top and one at the bottom, where the two actors go.
+    constexpr double margin = 8.0;
+    auto title = text_actor(chart.title, 18, false);
+    auto x_title = text_actor(chart.x_label, 16, true);
+    const double top_strip = chart.title.empty() ? 0.0 : text_height(title) + margin;  // the chart adds its own border
+    const double bottom_strip = chart.x_label.empty() ? margin : text_height(x_title) + 2 * margin;
     xy->SetAutoSize(false);
-    xy->SetSize(vtkRectf(0.0f, 12.0f, float(chart.width), float(chart.height - 12)));
-    xy->SetTitle(chart.title);
-    set_font(xy->GetTitleProperties(), 18);
+    xy->SetSize(vtkRectf(0.0f, float(bottom_strip), float(chart.width), float(chart.height - bottom_strip - top_strip)));
+    title->SetPosition(0.5 * chart.width, chart.height - margin);
+    title->GetTextProperty()->SetVerticalJustificationToTop();
+    renderer->AddActor2D(title);
+    renderer->AddActor2D(x_title);
     vtkAxis* x_axis = xy->GetAxis(vtkAxis::BOTTOM);
     vtkAxis* y_axis = xy->GetAxis(vtkAxis::LEFT);
-    x_axis->SetTitle(chart.x_label);
+    x_axis->SetTitle("");  // (drawn by x_title)
     y_axis->SetTitle(chart.y_label);
     x_axis->SetLogScale(chart.log_x);
     y_axis->SetLogScale(chart.log_y);
@@ -744,6 +773,7 @@ bool save_chart(const LineChart& chart, const std::filesystem::path& stem, bool 
     }
     const PixelBox box = layout.legend_box(corner, legend_width, legend_height);
     legend->SetPoint(vtkVector2f(float(box.left), float(box.bottom)));
+    x_title->SetPosition(0.5 * (layout.left + layout.right), margin);  // centred under the plot area
     window->Render();
     std::filesystem::path png_path = stem;
     png_path += ".png";

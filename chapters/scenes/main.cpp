@@ -66,6 +66,7 @@ int main(int argc, char** argv)
     cli.app.add_option("--screenshot", screenshot, "With --view: save the window at this step as view_<step>.png in --out")
         ->check(check::at_least<int>(0));
     std::vector<SceneSpec> scenes;
+    std::shared_ptr<const SkinObserver> skin;  // the run's (the first scene's), bound once
     // Every scene is read and checked before the output folder is touched.
     cli.check_options([&] {
         bool quick = false;
@@ -79,8 +80,11 @@ int main(int argc, char** argv)
             throw Error("--view: plays one run; --compare runs many without frames");
         for (const std::string& file : files) {
             scenes.push_back(read_scene(file, settings, quick));
-            if (const SceneSpec& scene = scenes.back(); scene.skin)
-                make_skin_observer(*scene.skin, scene.bodies[skin_body(scene)]);  // refused before anything runs
+            if (const SceneSpec& scene = scenes.back(); scene.skin) {
+                std::shared_ptr<const SkinObserver> bound = make_skin_observer(*scene.skin, scene.bodies[skin_body(scene)]);
+                if (scenes.size() == 1)
+                    skin = std::move(bound);  // refused before anything runs; kept for the run
+            }
         }
     });
     bool stopped = false;
@@ -102,6 +106,7 @@ int main(int argc, char** argv)
         RunOptions options;
         options.run = &run;
         options.progress = !no_progress;
+        options.skin = skin;
         std::unique_ptr<LiveView> live;
         if (view && fig::display_available()) {
             live = std::make_unique<LiveView>(scenes.front(), run.file(str("view_", screenshot, ".png")), screenshot);

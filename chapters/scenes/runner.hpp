@@ -147,6 +147,10 @@ struct RunOptions {
     bool keep_positions = false;       ///< keep every frame's positions (for the model comparison)
     bool progress = false;             ///< a progress bar on stderr (when it is a terminal)
     bool print_models = true;          ///< print which model each part of the run used
+    /// The scene's skin, bound already (fem_scene binds it before it makes the output folder, so a
+    /// bad skin is refused first). Null: run_scene binds the scene's skin itself when it writes
+    /// frames (a run that writes nothing has no use for it).
+    std::shared_ptr<const SkinObserver> skin;
 };
 
 /// Runs a scene: the steps of the header comment, writing (when options.run is set) the outputs the

@@ -480,9 +480,10 @@ std::string describe_segments(const std::vector<Segment>& segments, const std::s
 RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
 {
     // The skin (chapter 13) is bound before anything runs or is written: a bad one is refused early.
-    std::unique_ptr<SkinObserver> skin;
+    const RunContext* run = options.run;
     const std::size_t skinned = scene.skin ? skin_body(scene) : 0;
-    if (scene.skin)
+    std::shared_ptr<const SkinObserver> skin = options.skin;
+    if (scene.skin && !skin && run != nullptr && scene.output.pvd)
         skin = make_skin_observer(*scene.skin, scene.bodies[skinned]);
     std::vector<BodyRun> bodies;
     for (const BodySpec& spec : scene.bodies)
@@ -490,7 +491,6 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
 
     const int steps = dynamics::step_count(scene.duration, scene.time_step);
     const int frame_every = std::max(1, static_cast<int>(std::lround(1.0 / (scene.output.frame_rate * scene.time_step))));
-    const RunContext* run = options.run;
     const std::string stem = scene.file.stem().string();
     const bool png = run != nullptr && run->figures && scene.output.png;
     std::optional<io::MotionRecorder> recorder;

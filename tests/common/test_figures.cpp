@@ -17,10 +17,12 @@
 
 namespace {
 
-/// The number of distinct RGB colours in a PNG, and its size.
+/// The number of distinct RGB colours in a PNG, its size, and how many pixels within 4 pixels of
+/// its edges are not the white background.
 struct PngSummary {
     int width = 0, height = 0;
     std::size_t colours = 0;
+    std::size_t marked_edge_pixels = 0;
 };
 
 PngSummary read_png(const std::filesystem::path& path)
@@ -41,6 +43,10 @@ PngSummary read_png(const std::filesystem::path& path)
         for (int c = 0; c < 3; ++c)
             rgb = rgb * 256 + static_cast<long>(pixels->GetComponent(i, c));
         colours.insert(rgb);
+        const int x = int(i % dims[0]), y = int(i / dims[0]);
+        const bool at_edge = x < 4 || y < 4 || x >= dims[0] - 4 || y >= dims[1] - 4;
+        if (at_edge && rgb != 0xFFFFFF)
+            ++summary.marked_edge_pixels;
     }
     summary.colours = colours.size();
     return summary;
@@ -74,6 +80,7 @@ TEST_CASE("a log-log chart is saved as CSV always and as PNG when a display exis
         CHECK(png.width == chart.width);
         CHECK(png.height == chart.height);
         CHECK(png.colours > 20);  // lines, labels and legend, not a blank canvas
+        CHECK(png.marked_edge_pixels == 0);  // no text runs into the window's edge and is cut there
     }
     CHECK_FALSE(fem::fig::save_chart(chart, dir / "no_png", false));
     CHECK_FALSE(std::filesystem::exists(dir / "no_png.png"));
