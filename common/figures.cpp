@@ -236,6 +236,23 @@ void set_log_ticks(vtkAxis* axis, double low, double high)
     axis->SetCustomTickPositions(positions, labels);
 }
 
+/// Ticks at whole numbers over [low, high] (a linear axis whose data are all whole numbers, such as
+/// iteration counts, where VTK's own ticks would fall on halves): every 1, 2, 5, 10, 20, … of them,
+/// the smallest step that gives at most 12 ticks.
+void set_integer_ticks(vtkAxis* axis, double low, double high)
+{
+    double step = 1.0;
+    for (int k = 0; (high - low) / step > 12.0; ++k)
+        step = std::array{2.0, 5.0, 10.0}[k % 3] * std::pow(10.0, k / 3);
+    vtkNew<vtkDoubleArray> positions;
+    vtkNew<vtkStringArray> labels;
+    for (double tick = std::ceil(low / step) * step; tick <= high; tick += step) {
+        positions->InsertNextValue(tick);
+        labels->InsertNextValue(std::to_string(std::lround(tick)));
+    }
+    axis->SetCustomTickPositions(positions, labels);
+}
+
 /// A rectangle in pixels (origin bottom left, as VTK's context items use).
 struct PixelBox {
     double left, bottom, right, top;
@@ -277,6 +294,23 @@ struct ChartLayout {
     Scale sx, sy;
     double x_low = 0, x_high = 1, y_low = 0, y_high = 1;  // the axis ranges, in the axes' scales
     double left = 0, bottom = 0, right = 1, top = 1;      // the plot area in pixels
+
+    /// Whether every x (y) of the chart is a whole number, over a span of at most 50 (iteration
+    /// counts, say): a linear axis then gets whole-number ticks (set_integer_ticks).
+    bool whole_numbers_x() const { return whole_numbers(&Curve::x); }
+    bool whole_numbers_y() const { return whole_numbers(&Curve::y); }
+    bool whole_numbers(std::vector<double> Curve::*values) const
+    {
+        double low = std::numeric_limits<double>::infinity(), high = -low;
+        for (const Curve& c : curves)
+            for (double v : c.*values) {
+                if (v != std::round(v))
+                    return false;
+                low = std::min(low, v);
+                high = std::max(high, v);
+            }
+        return !curves.empty() && high - low <= 50.0;
+    }
 
     double pixel_x(double x) const { return left + (x - x_low) / (x_high - x_low) * (right - left); }
     double pixel_y(double y) const { return bottom + (y - y_low) / (y_high - y_low) * (top - bottom); }
@@ -723,8 +757,12 @@ bool save_chart(const LineChart& chart, const std::filesystem::path& stem, bool 
         y_axis->SetUnscaledRange(layout.sy.from(layout.y_low), layout.sy.from(layout.y_high));
         if (chart.log_x)
             set_log_ticks(x_axis, layout.x_low, layout.x_high);
+        else if (layout.whole_numbers_x())
+            set_integer_ticks(x_axis, layout.x_low, layout.x_high);
         if (chart.log_y)
             set_log_ticks(y_axis, layout.y_low, layout.y_high);
+        else if (layout.whole_numbers_y())
+            set_integer_ticks(y_axis, layout.y_low, layout.y_high);
         window->Render();  // lays the chart out: the plot area is known after it
         layout.left = xy->GetPoint1()[0];
         layout.bottom = xy->GetPoint1()[1];
