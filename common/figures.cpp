@@ -374,28 +374,24 @@ vtkSmartPointer<vtkTextActor> text_actor(const std::string& text, int size, bool
     return actor;
 }
 
-/// The height in pixels of a text actor's text (72 dpi, as the figures' windows).
-double text_height(vtkTextActor* actor)
+/// The width and height in pixels of a text drawn with these properties (72 dpi, as the figures'
+/// windows), as VTK's text renderer measures it.
+std::pair<double, double> text_size(vtkTextProperty* properties, const std::string& text)
 {
     int box[4] = {0, 0, 0, 0};
-    vtkTextRenderer::GetInstance()->GetBoundingBox(actor->GetTextProperty(), actor->GetInput(), box, 72);
-    return box[3] - box[2] + 1;
+    vtkTextRenderer::GetInstance()->GetBoundingBox(properties, text, box, 72);
+    return {box[1] - box[0] + 1, box[3] - box[2] + 1};
 }
 
 /// The pixel size of the legend vtkChartLegend draws for these names (its own formula: the widest
 /// label, the symbol and padding across; a line of "Tgyf" height and padding per entry).
 std::pair<double, double> legend_size(vtkTextProperty* labels, const std::vector<std::string>& names)
 {
-    constexpr int padding = 5, symbol_width = 25, dpi = 72;
-    vtkTextRenderer* renderer = vtkTextRenderer::GetInstance();
-    int box[4] = {0, 0, 0, 0};
-    renderer->GetBoundingBox(labels, "Tgyf", box, dpi);
-    const double line = box[3] - box[2] + 1;
+    constexpr int padding = 5, symbol_width = 25;
+    const double line = text_size(labels, "Tgyf").second;
     double widest = 0.0;
-    for (const std::string& name : names) {
-        renderer->GetBoundingBox(labels, name, box, dpi);
-        widest = std::max(widest, double(box[1] - box[0] + 1));
-    }
+    for (const std::string& name : names)
+        widest = std::max(widest, text_size(labels, name).first);
     return {widest + 2 * padding + symbol_width + 4, names.size() * (line + padding) + padding + 4};
 }
 
@@ -554,9 +550,7 @@ void add_renderers(vtkRenderWindow* window, vtkDataSet* data, bool cell_field, b
             set_font(name->GetTextProperty(), 17);
             name->SetPosition(x + 30.0, 18.0);
             keys.push_back(name);
-            int box[4] = {0, 0, 0, 0};
-            vtkTextRenderer::GetInstance()->GetBoundingBox(name->GetTextProperty(), c.name, box, 72);
-            x += 30.0 + (box[1] - box[0]) + 36.0;
+            x += 30.0 + text_size(name->GetTextProperty(), c.name).first + 35.0;
         }
     }
 
@@ -674,8 +668,10 @@ bool save_chart(const LineChart& chart, const std::filesystem::path& stem, bool 
     constexpr double margin = 8.0;
     auto title = text_actor(chart.title, 18, false);
     auto x_title = text_actor(chart.x_label, 16, true);
-    const double top_strip = chart.title.empty() ? 0.0 : text_height(title) + margin;  // the chart adds its own border
-    const double bottom_strip = chart.x_label.empty() ? margin : text_height(x_title) + 2 * margin;
+    const double title_height = text_size(title->GetTextProperty(), chart.title).second;
+    const double x_title_height = text_size(x_title->GetTextProperty(), chart.x_label).second;
+    const double top_strip = chart.title.empty() ? 0.0 : title_height + margin;  // the chart adds its own border
+    const double bottom_strip = chart.x_label.empty() ? margin : x_title_height + 2 * margin;
     xy->SetAutoSize(false);
     xy->SetSize(vtkRectf(0.0f, float(bottom_strip), float(chart.width), float(chart.height - bottom_strip - top_strip)));
     title->SetPosition(0.5 * chart.width, chart.height - margin);
