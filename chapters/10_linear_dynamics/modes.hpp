@@ -52,8 +52,10 @@ struct PowerIteration {
 
 /// ω_max by power iteration on M⁻¹K with a lumped (diagonal) M given as its diagonal `masses`:
 /// y = M⁻¹ K x, x = y / ‖y‖, ω² ≈ xᵀ K x / xᵀ M x, from a fixed start vector (all ones plus an
-/// alternating sign, so that the high modes are present). Converges like (ω₂/ω₁)^(2k) in the two
-/// largest ω: slowly on fine meshes, which is why highest_frequency uses Lanczos.
+/// alternating sign, so that the high modes are present). With λ = ω², λ_max the largest and λ′ the
+/// second largest, the iterate x converges like (λ′/λ_max)^k and the Rayleigh quotient twice as fast,
+/// like (λ′/λ_max)^(2k) = (ω′/ω_max)^(4k): slowly on fine meshes all the same, where λ′/λ_max → 1,
+/// which is why highest_frequency uses Lanczos.
 /// fem::Error unless sizes match, masses > 0, tolerance in (0, 1), max_iterations ≥ 1.
 /// docs/10_linear_dynamics.md#the-explicit-stability-limit
 PowerIteration power_iteration(const SparseMatrix& K, const Eigen::VectorXd& masses, double tolerance = 1e-8,
