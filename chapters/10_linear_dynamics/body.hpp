@@ -195,7 +195,10 @@ private:
 // --- The body --------------------------------------------------------------------------------
 
 /// What a scene assembles once: the mass matrix, the gravity load, the free dofs and the force
-/// model. Integrators read it; nothing in it changes during a run.
+/// model. Integrators read it. Two things may change between steps, set by a step hook
+/// (Simulation::set_before_step) for scenes whose boundary conditions move: the applied loads
+/// (f_ext = gravity load + applied loads) and the velocity of the pinned vertices over the next step.
+/// docs/10_linear_dynamics.md#the-step-hook
 class Body {
 public:
     /// validate(scene), then M (lumped or consistent, chapter 06), f_ext = gravity_load and the
@@ -213,9 +216,28 @@ public:
     /// The lumped masses repeated per dof (3n): m_v at 3v, 3v+1, 3v+2 (also for consistent M,
     /// whose rows sum to them).
     const Eigen::VectorXd& dof_masses() const { return dof_masses_; }
-    /// f_ext (3n): m_v g per vertex (pinned vertices included; their dofs never move, so their
-    /// entries do no work).
+    /// f_ext (3n): m_v g per vertex plus the applied loads (pinned vertices included: their entries
+    /// do work only when the pins move, and that work is the pins' reactions', see StepInfo).
     const Eigen::VectorXd& external_forces() const { return f_ext_; }
+    /// The gravity load m_v g per vertex (3n), constant.
+    const Eigen::VectorXd& gravity_load() const { return gravity_load_; }
+
+    /// Replaces the applied loads f_a (3n; empty: none): from now on f_ext = gravity_load() + f_a.
+    /// fem::Error for a size other than 3n or a non-finite entry (naming the dof).
+    void set_applied_loads(const Eigen::VectorXd& loads);
+    /// The applied loads f_a (3n; zero unless set).
+    const Eigen::VectorXd& applied_loads() const { return applied_; }
+
+    /// Sets how the pinned vertices move over the next step: their mean velocity
+    /// ṽ_p = (g(t + Δt) − u_p(t)) / Δt (3n; entries of free dofs must be 0; empty: pins at rest).
+    /// An integrator then ends the step with u_p⁺ = u_p + Δt ṽ_p exactly, and its free dofs feel
+    /// the pins' motion through the coupling of the step matrix. fem::Error for a size other than
+    /// 3n, a non-finite entry or a non-zero entry on a free dof. docs/10_linear_dynamics.md#moving-pins
+    void set_pin_velocity(const Eigen::VectorXd& velocity);
+    /// ṽ_p (3n, zero on free dofs; all zero unless set).
+    const Eigen::VectorXd& pin_velocity() const { return pin_velocity_; }
+    /// True when some pinned dof has ṽ_p ≠ 0.
+    bool pins_move() const { return pins_move_; }
 
     /// x = x₀ + u as #V×3 rows.
     MatrixX3d positions(const Eigen::VectorXd& u) const;
@@ -226,7 +248,9 @@ private:
     FreeDofs dofs_;
     SparseMatrix M_;
     Eigen::VectorXd dof_masses_;
-    Eigen::VectorXd f_ext_;
+    Eigen::VectorXd gravity_load_, applied_, f_ext_;
+    Eigen::VectorXd pin_velocity_;
+    bool pins_move_ = false;
 };
 
 /// The energies of a state (u, v) of a body [J]:

@@ -25,9 +25,15 @@
 // Beside them, the explicit (symplectic) Euler step v⁺ = v + Δt M⁻¹ [f(u) + f_ext − D v],
 // u⁺ = u + Δt v⁺, stable only for Δt < 2/ω_max (modes.hpp).
 //
-// Simulation owns the loop: time, energies, what damping and the integrator dissipate, divergence
-// detection (an fem::Error naming the step and the energy growth, never a NaN frame) and the
-// observers that write frames.
+// Pinned vertices that move (docs/10_linear_dynamics.md#moving-pins): the body's pin velocity ṽ_p
+// (Body::set_pin_velocity) fixes v_θ = ṽ_p on the pinned dofs, so u_p⁺ = u_p + Δt ṽ_p, and the
+// free dofs feel it through the coupling A_fp of the step matrix: A_ff x_f = b_f − A_fp x_p.
+// The reactions r_p that move the pins do the work Δt ṽ_pᵀ r_p on the body (StepInfo::boundary_work).
+//
+// Simulation owns the loop: time, energies, what damping and the integrator dissipate, the energy
+// the scene puts in (a hook before each step may move the pins, change the loads and switch the
+// force model, and the loop books what that does), divergence detection (an fem::Error naming the
+// step and the growth of H − W_in, never a NaN frame) and the observers that write frames.
 
 #include "10_linear_dynamics/body.hpp"
 
@@ -166,6 +172,10 @@ struct ImplicitOptions {
 /// What one step did, for the loop's bookkeeping.
 struct StepInfo {
     double damping_work = 0.0;   ///< energy removed by D in this step: Δt v_θᵀ D v_θ ≥ 0 [J]
+    /// The work the pinned vertices' reactions did on the body in this step [J]: Δt ṽ_pᵀ r_p, with
+    /// r = M (v⁺ − v)/Δt − f_θ − f_ext + D v_θ the residual of the step's momentum equation, zero on
+    /// the free dofs (0 when the pins rest). docs/10_linear_dynamics.md#moving-pins
+    double boundary_work = 0.0;
     int solver_iterations = 0;   ///< iterations of an iterative solver (0 for a direct one)
     int newton_iterations = 0;   ///< Newton iterations of a nonlinear step (chapter 12; 0 here)
     bool prepared = false;       ///< the step (re)factored its matrix
@@ -235,21 +245,25 @@ std::vector<std::string> integrator_names();
 
 // --- The time loop -----------------------------------------------------------------------------
 
-/// One line of a run's history.
+/// One line of a run's history. The books balance: H(t) = H(0) + work_in − damping_dissipated −
+/// integrator_dissipated. docs/10_linear_dynamics.md#energy
 struct StepRecord {
     int step = 0;
     double time = 0.0;
     Energies energies;
+    double work_in = 0.0;                ///< Σ so far of the energy the scene put in [J]: the hook's
+                                         ///< changes (loads, force model) and the pins' boundary work
     double damping_dissipated = 0.0;     ///< Σ damping_work so far [J]
-    double integrator_dissipated = 0.0;  ///< H(0) − H(t) − damping_dissipated: what the integrator
-                                         ///< itself removed (> 0) or added (< 0) [J]
+    double integrator_dissipated = 0.0;  ///< H(0) + work_in − H(t) − damping_dissipated: what the
+                                         ///< integrator itself removed (> 0) or added (< 0) [J]
     int solver_iterations = 0;           ///< of this step
     int newton_iterations = 0;           ///< of this step (a nonlinear integrator's)
+    double seconds = 0.0;                ///< wall time of this step's hook and integrator [s]
 };
 
-/// The divergence rule: a run fails when its total energy H has risen above H(0) by more than this
-/// fraction of the largest energy magnitude T + U + |W| seen so far. A stable integrator on a body
-/// without energy sources never raises H by more than a round-off or O(Δt²) share of it; an
+/// The divergence rule: a run fails when H − W_in (its total energy less what the scene put in) has
+/// risen above H(0) by more than this fraction of the largest energy magnitude T + U + |W| seen so
+/// far. A stable integrator never raises it by more than a round-off or O(Δt²) share of that; an
 /// unstable one multiplies H every step and crosses the line within a few steps of becoming visible.
 inline constexpr double divergence_energy_fraction = 0.5;
 
@@ -259,13 +273,25 @@ public:
     /// Called at step 0 and after every step with the new state and its record.
     using Observer = std::function<void(const State&, const StepRecord&)>;
 
+    /// The step hook: called before every step with the body, the state at t and the step's end
+    /// time t + Δt. It may set the body's pin velocity and applied loads (Body::set_pin_velocity,
+    /// set_applied_loads) and change the force model (a model that switches between others, as the
+    /// scenes runner's). It returns true when it changed the loads or the model, i.e. H at the same
+    /// (u, v): the loop then evaluates the model at u again and books H_after − H_before as work in.
+    /// Moving the pins changes nothing at t; their work is booked by the step (StepInfo::boundary_work).
+    /// docs/10_linear_dynamics.md#the-step-hook
+    using BeforeStep = std::function<bool(Body& body, const State& state, double step_end)>;
+
     /// fem::Error if Δt ≤ 0 or the state does not fit the body.
     Simulation(Body& body, Integrator& integrator, State initial, double time_step);
 
+    /// Sets the step hook (empty: none, the default): the scene's moving pins, loads and model.
+    void set_before_step(BeforeStep hook) { before_step_ = std::move(hook); }
+
     /// Runs `steps` steps (≥ 0), calling observer (if any) at step 0 of the first run and after every
     /// step. fem::Error when a step fails or the run diverges: a non-finite u, v or energy, or the
-    /// divergence rule above; the message names the step, the time and the energy growth, and the
-    /// observer never sees that state (no NaN frame is ever written).
+    /// divergence rule above; the message names the step, the time, the integrator and the energy
+    /// growth, and the observer never sees that state (no NaN frame is ever written).
     void run(int steps, const Observer& observer = {});
 
     const State& state() const { return state_; }
@@ -277,10 +303,19 @@ private:
     Integrator& integrator_;
     State state_;
     double time_step_;
+    BeforeStep before_step_;
     double initial_total_ = 0.0;
     double largest_magnitude_ = 0.0;
     StepRecord last_;
     bool started_ = false;
 };
+
+/// The energy a step hook puts in (the teaching piece of Simulation::run): H = energies(body,
+/// state).total() before, then hook(body, state, step_end); when it returns true (it changed the loads
+/// or the force model), the model is evaluated at u again (state.forces and state.elastic_energy)
+/// and the work in is H_after − H_before; when it returns false, 0. A change of the load by δf at u
+/// puts in −δfᵀu (the load potential's jump); a switch of the model, U_new(u) − U_old(u).
+/// docs/10_linear_dynamics.md#the-step-hook
+double apply_step_hook(const Simulation::BeforeStep& hook, Body& body, State& state, double step_end);
 
 }  // namespace fem::dynamics

@@ -184,7 +184,52 @@ Body::Body(const Scene& scene, std::unique_ptr<ForceModel> model)
     dof_masses_.resize(3 * masses.size());
     for (Eigen::Index v = 0; v < masses.size(); ++v)
         dof_masses_.segment<3>(3 * v).setConstant(masses[v]);
-    f_ext_ = assembly::gravity_load(scene.mesh, m.density, scene.gravity);
+    gravity_load_ = assembly::gravity_load(scene.mesh, m.density, scene.gravity);
+    f_ext_ = gravity_load_;
+    applied_ = Eigen::VectorXd::Zero(f_ext_.size());
+    pin_velocity_ = Eigen::VectorXd::Zero(f_ext_.size());
+}
+
+namespace {
+
+/// fem::Error unless x has n entries, all finite (what: the quantity, for the message).
+void require_finite_dofs(const Eigen::VectorXd& x, Eigen::Index n, const char* what)
+{
+    if (x.size() != n)
+        throw Error(str(what, " has ", x.size(), " entries, expected 3n = ", n));
+    for (Eigen::Index i = 0; i < n; ++i)
+        if (!std::isfinite(x[i]))
+            throw Error(str(what, " has the non-finite value ", x[i], " at dof ", i, " (vertex ", i / 3, ")"));
+}
+
+}  // namespace
+
+void Body::set_applied_loads(const Eigen::VectorXd& loads)
+{
+    if (loads.size() == 0) {
+        applied_.setZero();
+    } else {
+        require_finite_dofs(loads, dofs_.full_size(), "the applied loads");
+        applied_ = loads;
+    }
+    f_ext_ = gravity_load_ + applied_;
+}
+
+void Body::set_pin_velocity(const Eigen::VectorXd& velocity)
+{
+    if (velocity.size() == 0) {
+        pin_velocity_.setZero();
+        pins_move_ = false;
+        return;
+    }
+    require_finite_dofs(velocity, dofs_.full_size(), "the pin velocity");
+    const Eigen::VectorXd& free = dofs_.free_mask();
+    for (Eigen::Index i = 0; i < velocity.size(); ++i)
+        if (free[i] != 0.0 && velocity[i] != 0.0)
+            throw Error(str("the pin velocity is ", velocity[i], " at dof ", i, " of vertex ", i / 3,
+                            ", which is not pinned; only pinned dofs have a prescribed velocity"));
+    pin_velocity_ = velocity;
+    pins_move_ = velocity.cwiseAbs().maxCoeff() > 0.0;
 }
 
 MatrixX3d Body::positions(const Eigen::VectorXd& u) const

@@ -1,9 +1,11 @@
 #include "10_linear_dynamics/time_integration.hpp"
 
 #include "common/error.hpp"
+#include "common/timer.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace fem::dynamics {
 namespace {
@@ -30,6 +32,35 @@ Eigen::VectorXd damping_times(const Body& body, const Eigen::VectorXd& x, const 
     if (d.beta != 0.0)
         Dx += d.beta * Kx;
     return Dx;
+}
+
+/// The velocity the pinned dofs end a θ-step with: v⁺_p = (ṽ_p − (1 − θ) v_p)/θ, so that
+/// v_θ = θ v⁺ + (1 − θ) v is the body's pin velocity ṽ_p there (3n, zero on the free dofs).
+Eigen::VectorXd pinned_velocity_next(const Body& body, const Eigen::VectorXd& v, double theta)
+{
+    const Eigen::VectorXd pinned = Eigen::VectorXd::Ones(v.size()) - body.dofs().free_mask();
+    return ((body.pin_velocity() - (1.0 - theta) * v) / theta).cwiseProduct(pinned);
+}
+
+/// Overwrites the pinned entries of v_next with those of pinned_next (3n each).
+void set_pinned(const Body& body, const Eigen::VectorXd& pinned_next, Eigen::VectorXd& v_next)
+{
+    const Eigen::VectorXd& free = body.dofs().free_mask();
+    for (Eigen::Index i = 0; i < v_next.size(); ++i)
+        if (free[i] == 0.0)
+            v_next[i] = pinned_next[i];
+}
+
+/// The work of the pins' reactions over a step, ṽ_pᵀ R_p, where R = M (v⁺ − v) − Δt (f_θ + f_ext − D v_θ)
+/// is Δt times the residual r of the step's momentum equation (zero on the free dofs up to the
+/// solver's tolerance). momentum_change = M (v⁺ − v), net_force = f_θ + f_ext − D v_θ (3n each).
+double boundary_work(const Body& body, const Eigen::VectorXd& momentum_change, const Eigen::VectorXd& net_force,
+                     double time_step)
+{
+    if (!body.pins_move())
+        return 0.0;
+    const Eigen::VectorXd R = momentum_change - time_step * net_force;
+    return body.pin_velocity().cwiseProduct(Eigen::VectorXd::Ones(R.size()) - body.dofs().free_mask()).dot(R);
 }
 
 }  // namespace
@@ -63,13 +94,9 @@ State initial_state(Body& body, const Eigen::VectorXd& u0, const Eigen::VectorXd
     for (const auto& [x, name] : {std::pair{&state.u, "initial displacement u0"}, std::pair{&state.v, "initial velocity v0"}}) {
         if (x->size() != n)
             throw Error(str(name, " has ", x->size(), " entries, expected 3n = ", n));
-        for (Eigen::Index i = 0; i < n; ++i) {
+        for (Eigen::Index i = 0; i < n; ++i)
             if (!std::isfinite((*x)[i]))
                 throw Error(str(name, " has the non-finite value ", (*x)[i], " at dof ", i));
-            if (body.dofs().free_mask()[i] == 0.0 && (*x)[i] != 0.0)
-                throw Error(str(name, " is ", (*x)[i], " at dof ", i, " of pinned vertex ", i / 3,
-                                "; pinned vertices stay at rest"));
-        }
     }
     state.elastic_energy = body.model().evaluate(state.u, state.forces);
     return state;
@@ -268,8 +295,10 @@ StepInfo ThetaMethod::step(Body& body, double time_step, State& state)
     // HINT: velocity_change form: r = velocity_change_right_hand_side(M, v, K v, f, f_ext, D, Δt, θ),
     // HINT: solve A Δv = r, v⁺ = v + Δv. velocity form: b = step_right_hand_side(M, v, f, f_ext, Δt),
     // HINT: minus (1 − θ)Δt (D v + θΔt K v) when θ < 1 (damping_times gives D v); solve A v⁺ = b.
+    // HINT: Moving pins: the pinned part x_p of the unknown is known (v⁺_p from pinned_velocity_next,
+    // HINT: less v_p in the Δv form): take A x_p = a M x_p + k K x_p off the right-hand side.
     // HINT: Solve on the free dofs (eliminate: gather, solve, scatter; keep: zero the pinned rows
-    // HINT: of the right-hand side, solve all 3n). Then v_θ = θ v⁺ + (1 − θ) v, u⁺ = u + Δt v_θ.
+    // HINT: of the right-hand side, solve all 3n), set v⁺_p. Then v_θ = θ v⁺ + (1 − θ) v, u⁺ = u + Δt v_θ.
     const bool change = options_.form == StepForm::velocity_change;
     Eigen::VectorXd Kv;
     if (change || theta_ < 1.0)
@@ -282,6 +311,15 @@ StepInfo ThetaMethod::step(Body& body, double time_step, State& state)
         b = step_right_hand_side(M, state.v, state.forces, body.external_forces(), time_step);
         if (theta_ < 1.0)
             b -= ((1.0 - theta_) * time_step) * (damping_times(body, state.v, Kv) + (theta_ * time_step) * Kv);
+    }
+    const Eigen::VectorXd pinned_next = pinned_velocity_next(body, state.v, theta_);
+    const Eigen::VectorXd pinned_part = change ? Eigen::VectorXd(pinned_next - state.v.cwiseProduct(
+                                                     Eigen::VectorXd::Ones(b.size()) - dofs.free_mask()))
+                                               : pinned_next;
+    if (pinned_part.cwiseAbs().maxCoeff() > 0.0) {
+        const double h = theta_ * time_step;
+        const Damping& d = body.scene().damping;
+        b -= (1.0 + h * d.alpha) * (M * pinned_part) + (h * d.beta + h * h) * (K * pinned_part);
     }
     // solution_ still holds the previous answer: the warm start of an iterative solver.
     v_next = Eigen::VectorXd::Zero(state.v.size());
@@ -300,15 +338,23 @@ StepInfo ThetaMethod::step(Body& body, double time_step, State& state)
     }
     if (change)
         v_next += state.v;
+    set_pinned(body, pinned_next, v_next);
     v_theta = theta_ * v_next + (1.0 - theta_) * state.v;
     u_next = state.u + time_step * v_theta;
     // END EXERCISE
 
     info.solver_iterations = solver_->stats().iterations;
     const Damping& d = body.scene().damping;
+    Eigen::VectorXd damping_force = Eigen::VectorXd::Zero(v_theta.size());
     if (d.alpha != 0.0 || d.beta != 0.0) {
         const Eigen::VectorXd Kv = d.beta != 0.0 ? Eigen::VectorXd(K * v_theta) : Eigen::VectorXd();
-        info.damping_work = time_step * v_theta.dot(damping_times(body, v_theta, Kv));
+        damping_force = damping_times(body, v_theta, Kv);
+        info.damping_work = time_step * v_theta.dot(damping_force);
+    }
+    if (body.pins_move()) {  // f_θ = f(u) − θΔt K v_θ: the step's linearised force at u_θ
+        const Eigen::VectorXd net =
+            state.forces - (theta_ * time_step) * (K * v_theta) + body.external_forces() - damping_force;
+        info.boundary_work = boundary_work(body, M * (v_next - state.v), net, time_step);
     }
     commit_step(model, time_step, std::move(u_next), std::move(v_next), state);
     return info;
@@ -340,19 +386,25 @@ StepInfo SymplecticEuler::step(Body& body, double time_step, State& state)
     // BEGIN EXERCISE 10.5 symplectic_euler_step #explicit-euler
     // HINT: a = f + f_ext − D v on the free dofs; lumped: M⁻¹ a is a division by dof_masses();
     // HINT: consistent: solve M_ff x = a_f with mass_solver_. Then v⁺ = v + Δt M⁻¹ a (pinned dofs
-    // HINT: stay 0) and u⁺ = u + Δt v⁺ (the NEW velocity: that is what makes it symplectic).
-    const Eigen::VectorXd net = dofs.gather(state.forces + body.external_forces() - damping_force);
+    // HINT: take their ṽ_p, the body's pin velocity) and u⁺ = u + Δt v⁺ (the NEW velocity: that is
+    // HINT: what makes it symplectic). A consistent M couples the pins' acceleration into the free rows.
+    const Eigen::VectorXd pin_change = body.pin_velocity() - state.v.cwiseProduct(Eigen::VectorXd::Ones(state.v.size()) - dofs.free_mask());
+    Eigen::VectorXd net = dofs.gather(state.forces + body.external_forces() - damping_force);
+    if (!lumped && pin_change.cwiseAbs().maxCoeff() > 0.0)
+        net -= dofs.gather(body.mass_matrix() * pin_change) / time_step;
     Eigen::VectorXd acceleration;
     if (lumped)
         acceleration = net.cwiseQuotient(dofs.gather(body.dof_masses()));
     else
         acceleration = mass_solver_->solve(net);
-    v_next = state.v;
+    v_next = body.pin_velocity();
     dofs.scatter(dofs.gather(state.v) + time_step * acceleration, v_next);
     u_next = state.u + time_step * v_next;
     // END EXERCISE
 
     info.damping_work = time_step * v_next.dot(damping_force);
+    info.boundary_work = boundary_work(body, body.mass_matrix() * (v_next - state.v),
+                                       state.forces + body.external_forces() - damping_force, time_step);
     commit_step(model, time_step, std::move(u_next), std::move(v_next), state);
     return info;
 }
@@ -376,6 +428,24 @@ std::vector<std::string> integrator_names()
     return {"backward-euler", "implicit-midpoint", "symplectic-euler"};
 }
 
+// --- The time loop -------------------------------------------------------------------------------
+
+double apply_step_hook(const Simulation::BeforeStep& hook, Body& body, State& state, double step_end)
+{
+    double work = 0.0;
+    // BEGIN EXERCISE 10.9 apply_step_hook #the-step-hook
+    // HINT: H before the hook (energies(body, state).total()); call the hook. If it says it changed the
+    // HINT: loads or the model, evaluate the model at u again (forces and U into the state): the work
+    // HINT: it put in is H after minus H before. If it changed nothing, it put in nothing.
+    const double before = energies(body, state).total();
+    if (hook(body, std::as_const(state), step_end)) {
+        state.elastic_energy = body.model().evaluate(state.u, state.forces);
+        work = energies(body, state).total() - before;
+    }
+    // END EXERCISE
+    return work;
+}
+
 // --- Simulation ----------------------------------------------------------------------------------
 
 Simulation::Simulation(Body& body, Integrator& integrator, State initial, double time_step)
@@ -390,7 +460,10 @@ void Simulation::run(int steps, const Observer& observer)
     if (steps < 0)
         throw Error(str("the number of steps must be >= 0, got ", steps));
     if (!started_) {
-        last_ = StepRecord{state_.step, state_.time, energies(body_, state_), 0.0, 0.0, 0};
+        last_ = StepRecord{};
+        last_.step = state_.step;
+        last_.time = state_.time;
+        last_.energies = energies(body_, state_);
         initial_total_ = last_.energies.total();
         largest_magnitude_ = last_.energies.magnitude();
         started_ = true;
@@ -398,8 +471,14 @@ void Simulation::run(int steps, const Observer& observer)
             observer(state_, last_);
     }
     for (int k = 0; k < steps; ++k) {
-        const StepInfo info = integrator_.step(body_, time_step_, state_);
+        Timer clock;
         StepRecord record;
+        record.work_in = last_.work_in;
+        if (before_step_)
+            record.work_in += apply_step_hook(before_step_, body_, state_, state_.time + time_step_);
+        const StepInfo info = integrator_.step(body_, time_step_, state_);
+        record.work_in += info.boundary_work;
+        record.seconds = clock.seconds();
         record.step = state_.step;
         record.time = state_.time;
         record.energies = energies(body_, state_);
@@ -409,19 +488,22 @@ void Simulation::run(int steps, const Observer& observer)
         const double total = record.energies.total();
         const auto where = [&] {
             return str("step ", record.step, " (t = ", record.time, " s, dt = ", time_step_, " s, ",
-                       integrator_.name(), ")");
+                       integrator_.name(), ", ", body_.model().name(), " model)");
         };
-        if (!std::isfinite(total) || !state_.u.allFinite() || !state_.v.allFinite())
+        if (!std::isfinite(total) || !std::isfinite(record.work_in) || !state_.u.allFinite() || !state_.v.allFinite())
             throw Error(str("the run diverged at ", where(), ": the state is no longer finite (energy ", total,
                             " J); use a smaller dt or an implicit integrator"));
         largest_magnitude_ = std::max(largest_magnitude_, record.energies.magnitude());
-        const double rise = total - initial_total_;
+        const double rise = total - record.work_in - initial_total_;
         if (rise > divergence_energy_fraction * largest_magnitude_)
-            throw Error(str("the run diverged at ", where(), ": the total energy rose from ", initial_total_,
-                            " J to ", total, " J, by ", rise / std::max(largest_magnitude_, 1e-300),
+            throw Error(str("the run diverged at ", where(), ": H - W_in (the total energy less the ", record.work_in,
+                            " J the scene put in) rose from ", initial_total_, " J to ", total - record.work_in,
+                            " J, by ", rise / std::max(largest_magnitude_, 1e-300),
                             " of the largest energy in play (the limit is ", divergence_energy_fraction,
-                            "); an explicit step above its stability limit does this: use a smaller dt"));
-        record.integrator_dissipated = initial_total_ - total - record.damping_dissipated;
+                            "); an explicit step above its stability limit 2/omega_max does this (use a smaller "
+                            "dt or an implicit integrator), and so does a force model pushed past what it can "
+                            "hold (an implicit step: use a smaller dt or a nonlinear model)"));
+        record.integrator_dissipated = initial_total_ + record.work_in - total - record.damping_dissipated;
         last_ = record;
         if (observer)
             observer(state_, last_);
