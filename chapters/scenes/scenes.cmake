@@ -4,7 +4,8 @@
 # against its stored numbers (tests/scenes/expected/<scene>).
 find_package(tomlplusplus 3 REQUIRED)  # Debian's libtomlplusplus-dev (tools/setup.sh)
 
-add_library(fem_scenes STATIC ${FEM_ROOT}/solutions/scenes/scene_file.cpp ${FEM_ROOT}/solutions/scenes/runner.cpp)
+file(GLOB scene_sources CONFIGURE_DEPENDS ${FEM_ROOT}/solutions/scenes/*.cpp)
+add_library(fem_scenes STATIC ${scene_sources})
 target_include_directories(fem_scenes PUBLIC ${FEM_ROOT}/chapters)
 target_link_libraries(fem_scenes PUBLIC fem_ch13_reference fem_ch12_reference fem_ch11_reference fem_ch10_reference
                       PRIVATE tomlplusplus::tomlplusplus fem_flags)
