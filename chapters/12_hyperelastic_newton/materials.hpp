@@ -81,10 +81,11 @@ public:
     Matrix9d piola_derivative(const Eigen::Matrix3d& H) const override;
 };
 
-/// Stable neo-Hookean (Smith, de Goes, Kim 2018, in the form without the log term):
+/// Stable neo-Hookean, the course's log-free variant of Smith, de Goes, Kim 2018 (not the paper's
+/// energy, which is PaperStableNeoHookean):
 /// ψ = (μ/2)(tr(FᵀF) − 3) − μ(J − 1) + (λ̂/2)(J − 1)², λ̂ = λ + μ (which makes it agree with linear
-/// elasticity for small strains). With the cofactor C = ∂J/∂F (C = J F⁻ᵀ when F is invertible,
-/// defined for every F): P = μF + (λ̂(J − 1) − μ) C;
+/// elasticity for small strains, and P(I) = 0). With the cofactor C = ∂J/∂F (C = J F⁻ᵀ when F is
+/// invertible, defined for every F): P = μF + (λ̂(J − 1) − μ) C;
 /// ∂P_ab/∂F_cd = μ δ_ac δ_bd + λ̂ C_ab C_cd + (λ̂(J − 1) − μ) ε_ack ε_bdl F_kl.
 /// Defined for every F, inverted ones included: an inverted tet is pushed back.
 /// docs/12_hyperelastic_newton.md#stable-neo-hookean
@@ -98,12 +99,35 @@ public:
     Matrix9d piola_derivative(const Eigen::Matrix3d& H) const override;
 };
 
-/// The material called `name` ("stvk", "neo-hookean", "stable-neo-hookean") with the Lamé
-/// parameters of Y and ν (chapter 05). fem::Error for another name (the message lists these) or a
-/// bad Y, ν. docs/12_hyperelastic_newton.md#energy-densities
+/// Stable neo-Hookean as Smith, de Goes and Kim 2018 write it (their final energy, with the log
+/// term that makes it rest-stable and their Lamé reparametrisation), minus its value at rest:
+/// ψ = (μ'/2)(I_C − 3) − (μ'/2) ln((I_C + 1)/4) + (λ'/2)((J − α)² − (1 − α)²),  I_C = tr(FᵀF),
+/// α = 1 + 3μ'/(4λ') (which makes P(I) = 0), μ' = 4μ/3, λ' = λ + 5μ/6 (which make it agree with
+/// linear elasticity of λ, μ for small strains). With C = ∂J/∂F as above:
+/// P = μ'(1 − 1/(I_C + 1)) F + λ'(J − α) C;
+/// ∂P_ab/∂F_cd = μ'(1 − 1/(I_C + 1)) δ_ac δ_bd + 2μ'/(I_C + 1)² F_ab F_cd + λ' C_ab C_cd
+///               + λ'(J − α) ε_ack ε_bdl F_kl.
+/// Defined for every F (I_C + 1 ≥ 1). It differs from the course's variant by its log term, which
+/// keeps the energy growing for a tet collapsed to a point (I_C → 0), and by λ' < λ̂.
+/// docs/12_hyperelastic_newton.md#stable-neo-hookean
+class PaperStableNeoHookean final : public Material {
+public:
+    using Material::Material;
+    std::string name() const override { return "stable-neo-hookean-paper"; }
+    bool defined_when_inverted() const override { return true; }
+    double energy_density(const Eigen::Matrix3d& H) const override;
+    Eigen::Matrix3d first_piola(const Eigen::Matrix3d& H) const override;
+    Matrix9d piola_derivative(const Eigen::Matrix3d& H) const override;
+};
+
+/// The material called `name` (one of material_names()) with the Lamé parameters of Y and ν
+/// (chapter 05), from the registry in materials.cpp: one line per material. fem::Error for another
+/// name (the message lists the known ones) or a bad Y, ν.
+/// docs/12_hyperelastic_newton.md#adding-a-material
 std::unique_ptr<Material> make_material(std::string_view name, double youngs_modulus, double poisson_ratio);
 
-/// The names make_material accepts.
+/// The names make_material accepts, in the registry's order: "stvk", "neo-hookean",
+/// "stable-neo-hookean" (the course's variant), "stable-neo-hookean-paper".
 std::vector<std::string> material_names();
 
 /// The cofactor matrix C = ∂(det F)/∂F (3×3): its rows are cross products of F's rows, so it is

@@ -4,9 +4,12 @@
 // docs/12_hyperelastic_newton.md#backward-euler-as-minimisation
 //
 // The step from (qᵗ, q̇ᵗ) finds the velocity v that minimises
-//     E(v) = ½ (v − q̇ᵗ)ᵀ M (v − q̇ᵗ) + U(qᵗ + Δt v) − Δt vᵀ f_ext,
-// and sets q⁺ = qᵗ + Δt v, q̇⁺ = v. Its gradient ∇E = M (v − q̇ᵗ) − Δt (f(qᵗ + Δt v) + f_ext) is zero
-// exactly at the backward Euler step; its Hessian is M + Δt² K(qᵗ + Δt v). The notes write the
+//     E(v) = ½ (v − q̇ᵗ)ᵀ M (v − q̇ᵗ) + U(qᵗ + Δt v) − Δt vᵀ f_ext + (Δt/2) vᵀ D v,
+// and sets q⁺ = qᵗ + Δt v, q̇⁺ = v. Its gradient ∇E = M (v − q̇ᵗ) − Δt (f(qᵗ + Δt v) + f_ext − D v) is
+// zero exactly at the backward Euler step; its Hessian is M + Δt D + Δt² K(qᵗ + Δt v). D = α M + β K_t
+// is Rayleigh damping with K_t the (positive semi-definite) tangent at the step's start, fixed over
+// the step (StepDamping). Pinned dofs move with the body's pin velocity ṽ_p (v_p = ṽ_p, not unknowns).
+// The notes write the
 // kinetic term with qᵗ instead of q̇ᵗ, drop the Δt in the update, and loop while ‖∇E‖ is *below*
 // the tolerance; all three are corrected here (docs: where the notes slip).
 
@@ -69,21 +72,52 @@ inline constexpr double objective_round_off = 1e-13;
 /// after a few hundred steps) is at rest in any units, and the iteration has converged.
 inline const double smallest_measurable_norm = std::sqrt(std::numeric_limits<double>::min());
 
-/// E(v) of the header comment for the full velocity v (3n), with model's energy at qᵗ + Δt v
-/// (+∞ where the model is undefined); magnitude (if given) receives |½ΔvᵀMΔv| + |U| + |Δt vᵀf_ext|,
-/// the scale of E's round-off. fem::Error on sizes or Δt ≤ 0.
-double backward_euler_objective(dynamics::Body& body, const dynamics::State& state, double time_step,
-                                const Eigen::VectorXd& v, double* magnitude = nullptr);
+/// Rayleigh damping over one backward Euler step: D = α M + β K_t (3n×3n), with α, β the scene's and
+/// K_t = ForceModel::definite_stiffness(qᵗ) the positive semi-definite tangent at the step's start,
+/// fixed over the step. D is symmetric positive semi-definite, so E's term (Δt/2) vᵀ D v is convex
+/// and the energy it removes, Δt vᵀ D v, is never negative: damping cannot add energy, which the
+/// exact K(qᵗ) of an indefinite material could. For a linear body K_t = K, chapter 10's D.
+/// docs/12_hyperelastic_newton.md#rayleigh-damping
+class StepDamping {
+public:
+    /// No damping: D = 0 (for an undamped body).
+    StepDamping() = default;
+    /// D of body.scene().damping at the start displacement u_start (3n): keeps a copy of
+    /// definite_stiffness(u_start) when β ≠ 0 (one assembly per step), nothing more when β = 0.
+    StepDamping(dynamics::Body& body, const Eigen::VectorXd& u_start);
 
-/// ∇E(v) = M (v − q̇ᵗ) − Δt (f(qᵗ + Δt v) + f_ext) (3n; pinned entries included). fem::Error on sizes,
-/// Δt ≤ 0, or where the model is undefined.
+    const dynamics::Damping& coefficients() const { return coefficients_; }
+    /// D v = α M v + β K_t v (3n). fem::Error unless v has M's size.
+    Eigen::VectorXd times(const Eigen::VectorXd& v) const;
+    /// K_t (3n×3n; empty when β = 0).
+    const dynamics::SparseMatrix& start_stiffness() const { return K_start_; }
+
+private:
+    dynamics::Damping coefficients_;
+    const dynamics::SparseMatrix* M_ = nullptr;
+    dynamics::SparseMatrix K_start_;
+};
+
+/// E(v) of the header comment for the full velocity v (3n), with model's energy at qᵗ + Δt v
+/// (+∞ where the model is undefined) and damping's D; magnitude (if given) receives
+/// |½ΔvᵀMΔv| + |U| + |Δt vᵀf_ext| + (Δt/2) vᵀDv, the scale of E's round-off. fem::Error on sizes,
+/// Δt ≤ 0, or a damping whose α, β are not the body's (a damped body needs StepDamping(body, qᵗ)).
+double backward_euler_objective(dynamics::Body& body, const dynamics::State& state, double time_step,
+                                const Eigen::VectorXd& v, double* magnitude = nullptr,
+                                const StepDamping& damping = {});
+
+/// ∇E(v) = M (v − q̇ᵗ) − Δt (f(qᵗ + Δt v) + f_ext − D v) (3n; pinned entries included: there it is
+/// Δt times the reaction the pins exert). fem::Error on sizes, Δt ≤ 0, a damping whose α, β are not
+/// the body's, or where the model is undefined.
 Eigen::VectorXd backward_euler_gradient(dynamics::Body& body, const dynamics::State& state, double time_step,
-                                        const Eigen::VectorXd& v);
+                                        const Eigen::VectorXd& v, const StepDamping& damping = {});
 
 /// The scale the gradient is measured against: ‖M q̇ᵗ‖ + Δt ‖f_ext‖ + Δt ‖f(qᵗ)‖ over the free dofs
-/// (momentum: the inertia and the loads of the step). A step that starts at rest under no load has
-/// scale 0 and a zero gradient: it is converged at once.
-double momentum_scale(const dynamics::Body& body, const dynamics::State& state, double time_step);
+/// (momentum: the inertia and the loads of the step), plus ‖M ṽ_p‖ + Δt ‖f(qᵗ + Δt ṽ_p)‖ over the
+/// free dofs when the pins move (what their step pushes into the body; one model evaluation). A
+/// step that starts at rest under no load with the pins at rest has scale 0 and a zero gradient: it
+/// is converged at once.
+double momentum_scale(dynamics::Body& body, const dynamics::State& state, double time_step);
 
 /// A minimisation problem for newton_minimize, on the free unknowns x (free dofs of a body).
 struct NewtonProblem {
@@ -120,7 +154,8 @@ NewtonResult newton_minimize(const NewtonProblem& problem, Eigen::VectorXd x0, c
 Eigen::VectorXd solve_static(dynamics::Body& body, const NewtonOptions& options = {});
 
 /// Backward Euler by Newton's method with a backtracking (Armijo) line search, for any force model
-/// (chapter 10's linear one converges in one iteration). docs/12_hyperelastic_newton.md#newton-with-line-search
+/// (chapter 10's linear one converges in one iteration), with the scene's Rayleigh damping
+/// (StepDamping) and the body's moving pins. docs/12_hyperelastic_newton.md#newton-with-line-search
 class NewtonBackwardEuler final : public dynamics::Integrator {
 public:
     /// fem::Error for a tolerance outside (0, 1), a cap < 1, c outside (0, ½), shrink outside (0, 1),
@@ -129,8 +164,10 @@ public:
 
     std::string name() const override { return "Newton backward Euler"; }
     int order() const override { return 1; }
-    /// One step: Newton iterations from v = q̇ᵗ (or v = 0 when E(q̇ᵗ) = +∞) until
-    /// ‖∇E‖ ≤ tol · momentum_scale. fem::Error (state
+    /// One step: Newton iterations from v = q̇ᵗ (or v = 0 when E(q̇ᵗ) = +∞) on the free dofs until
+    /// ‖∇E‖ ≤ tol · momentum_scale, the pinned dofs held at v = ṽ_p (Body::pin_velocity), so
+    /// q⁺_p = qᵗ_p + Δt ṽ_p. StepInfo::damping_work = Δt v⁺ᵀ D v⁺ (≥ 0) [J]; when the pins move,
+    /// StepInfo::boundary_work = Δt ṽ_pᵀ r_p = ṽ_pᵀ ∇E(v⁺) (the reactions r_p = ∇E_p(v⁺)/Δt) [J]. fem::Error (state
     /// unchanged) when the cap is reached, the line search fails, or d is no descent direction (an
     /// indefinite Hessian: use a projection).
     dynamics::StepInfo step(dynamics::Body& body, double time_step, dynamics::State& state) override;

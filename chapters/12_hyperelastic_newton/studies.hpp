@@ -2,6 +2,7 @@
 // The studies of ch12_hyperelastic_newton, one file each (study_*.cpp), called in order by main.cpp.
 // Not part of the chapter's library: only the executable uses them.
 
+#include "12_hyperelastic_newton/force_models.hpp"
 #include "12_hyperelastic_newton/hyperelastic.hpp"
 #include "12_hyperelastic_newton/newton.hpp"
 
@@ -24,13 +25,6 @@ struct Settings {
     std::vector<int> cost_cells{20, 40, 100};      ///< cells along the beams of the cost study
     double seconds = 0.2;                          ///< measuring time per timed kernel [s]
 };
-
-/// The models compared: "linear" (chapter 10), "corotational" (chapter 11), "stvk", "neo-hookean",
-/// "stable-neo-hookean".
-const std::vector<std::string>& model_names();
-
-/// The force model called `name` for a scene's mesh and material.
-std::unique_ptr<dynamics::ForceModel> force_model(const std::string& name, const dynamics::Scene& scene);
 
 void materials_study(const RunContext& run, const Settings& settings);
 void newton_study(const RunContext& run, const Settings& settings);

@@ -28,7 +28,7 @@ void cost_study(const RunContext& run, const Settings& settings)
                  {"step matrix [s]", Format::scientific, 2}, {"factor and solve [s]", Format::scientific, 2}});
     for (int cells : settings.cost_cells) {
         dynamics::Scene scene = dynamics::cantilever_scene(dynamics::Material{1e6, 0.45, 1100.0}, cells, 1.0);
-        dynamics::Body body(scene, force_model("neo-hookean", scene));
+        dynamics::Body body(scene, make_force_model("neo-hookean", scene.mesh, scene.material));
         NewtonBackwardEuler newton;
         dynamics::State state = dynamics::initial_state(body);
         for (int k = 0; k < 3; ++k)
@@ -64,7 +64,7 @@ void cost_study(const RunContext& run, const Settings& settings)
     {
         const dynamics::Scene scene =
             dynamics::cantilever_scene(dynamics::Material{1e6, 0.45, 1100.0}, settings.cost_cells.back(), 1.0);
-        dynamics::Body body(scene, force_model("neo-hookean", scene));
+        dynamics::Body body(scene, make_force_model("neo-hookean", scene.mesh, scene.material));
         NewtonBackwardEuler newton;
         dynamics::State state = dynamics::initial_state(body);
         newton.step(body, scene.time_step, state);
@@ -98,7 +98,7 @@ void cost_study(const RunContext& run, const Settings& settings)
     dynamics::Scene vega = dynamics::cantilever_scene(dynamics::Material{1e6, 0.45, 1100.0}, 2, 1.0);
     vega.mesh = box_mesh(60, 12, 12, Eigen::Vector3d(0.2, 0.04, 0.04));  // 61 × 13 × 13 = 10 309 vertices
     vega.pinned = assembly::vertices_on_plane(vega.mesh, 0, 0.0);
-    dynamics::Body body(vega, force_model("neo-hookean", vega));
+    dynamics::Body body(vega, make_force_model("neo-hookean", vega.mesh, vega.material));
     Table goal("A 10,000-vertex neo-Hookean backward Euler step, converged (relative tolerance 1e-6), one core",
                {{"vertices", Format::integer}, {"free dofs", Format::integer}, {"Newton solver", Format::text},
                 {"Newton iterations per step", Format::fixed, 1}, {"CG iterations per step", Format::fixed, 1},

@@ -83,7 +83,7 @@ void newton_study(const RunContext& run, const Settings& settings)
     history.y_label = "|grad E| / momentum scale";
     history.log_y = true;
     {
-        dynamics::Body body(swing, force_model("stable-neo-hookean", swing));
+        dynamics::Body body(swing, make_force_model("stable-neo-hookean", swing.mesh, swing.material));
         NewtonOptions options;
         options.relative_tolerance = 1e-10;  // far below the default, above the round-off floor (~1e-12)
         NewtonBackwardEuler newton(options);
@@ -135,7 +135,7 @@ void newton_study(const RunContext& run, const Settings& settings)
                      {{"relative tolerance", Format::scientific, 0}, {"Newton iterations per step", Format::fixed, 2},
                       {"max tip difference to tolerance 1e-10 [m]", Format::scientific, 2}, {"time per step [s]", Format::scientific, 2}});
     const auto tip_path = [&](double tolerance, double& iterations, double& seconds) {
-        dynamics::Body body(swing, force_model("stable-neo-hookean", swing));
+        dynamics::Body body(swing, make_force_model("stable-neo-hookean", swing.mesh, swing.material));
         NewtonOptions options;
         options.relative_tolerance = tolerance;
         NewtonBackwardEuler newton(options);
@@ -198,7 +198,7 @@ void newton_study(const RunContext& run, const Settings& settings)
         dynamics::Material material = settings.soft;
         material.poisson_ratio = poisson;
         const dynamics::Scene beam = dynamics::cantilever_scene(material, run.quick ? 10 : settings.swing_cells, 0.5);
-        dynamics::Body body(beam, force_model("stable-neo-hookean", beam));
+        dynamics::Body body(beam, make_force_model("stable-neo-hookean", beam.mesh, beam.material));
         NewtonBackwardEuler newton;
         dynamics::Simulation simulation(body, newton, dynamics::initial_state(body), beam.time_step);
         const int tip = dynamics::far_corner(beam.mesh);

@@ -32,7 +32,7 @@ SwingRun swing(const dynamics::Scene& base, const std::string& model, double tim
 {
     dynamics::Scene scene = base;
     scene.time_step = time_step;
-    dynamics::Body body(scene, force_model(model, scene));
+    dynamics::Body body(scene, make_force_model(model, scene.mesh, scene.material));
     NewtonOptions options;
     options.relative_tolerance = tolerance;
     NewtonBackwardEuler newton(options);
@@ -89,7 +89,7 @@ void swing_study(const RunContext& run, const Settings& settings)
                  {"Newton iterations per step", Format::fixed, 2}, {"most Newton iterations", Format::integer},
                  {"max |V/V0 - 1|", Format::scientific, 2}, {"time per step [s]", Format::scientific, 2}});
     std::vector<SwingRun> runs;
-    for (const std::string& model : model_names())
+    for (const std::string& model : force_model_names())
         for (const double rate : steps_per_second) {
             runs.push_back(swing(scene, model, 1.0 / rate, 1e-6));
             const SwingRun& r = runs.back();
@@ -104,7 +104,7 @@ void swing_study(const RunContext& run, const Settings& settings)
     pareto.x_label = "wall time of the swing [s]";
     pareto.y_label = "max tip error [m]";
     pareto.log_x = pareto.log_y = true;
-    for (const std::string& model : model_names()) {
+    for (const std::string& model : force_model_names()) {
         fig::Series series{model, {}, {}};
         for (const SwingRun& r : runs)
             if (r.model == model) {

@@ -27,8 +27,9 @@ struct Settings {
     double seconds = 0.2;                          ///< measuring time per timed kernel [s]
 };
 
-/// The force models the simulations accept: "corotational" (chapter 11, backward Euler) and
-/// "stable-neo-hookean" (chapter 12, backward Euler by Newton).
+/// The force models the simulations offer: "corotational" (chapter 11, backward Euler) and
+/// "stable-neo-hookean" (chapter 12, backward Euler by Newton), both built by chapter 12's
+/// make_force_model and make_integrator_for.
 const std::vector<std::string>& model_names();
 
 /// data/bunny.obj in its own units (about 9.7 tall, y up).
@@ -37,8 +38,8 @@ TriMesh bunny_surface();
 TetMesh bunny_tets();
 
 /// A body of the rubber bunny on mesh (already in metres), standing on the ground of the bunny
-/// surface (its lowest 5 %), with the force model settings.model, and the integrator that model
-/// needs. The body keeps the returned integrator's model alive.
+/// surface (its lowest 5 %), with the force model settings.model and the integrator that model
+/// needs (hyper::make_force_model, hyper::make_integrator_for: fem::Error for an unknown name). The body keeps the returned integrator's model alive.
 struct Run {
     std::unique_ptr<dynamics::Body> body;
     std::unique_ptr<dynamics::Integrator> integrator;

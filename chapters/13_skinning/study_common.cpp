@@ -1,11 +1,8 @@
 // What the studies of ch13_skinning share: the bunny's meshes and the pushed bunny's run.
 #include "13_skinning/studies.hpp"
 
-#include "11_corotational/corotational.hpp"
-#include "12_hyperelastic_newton/hyperelastic.hpp"
-#include "12_hyperelastic_newton/newton.hpp"
+#include "12_hyperelastic_newton/force_models.hpp"
 
-#include "common/error.hpp"
 #include "common/files.hpp"
 #include "common/mesh_io.hpp"
 
@@ -32,17 +29,8 @@ Run bunny_run(const TetMesh& mesh, const TriMesh& surface, const Settings& setti
     const double low = surface.V.col(1).minCoeff(), high = surface.V.col(1).maxCoeff();
     const dynamics::Scene scene = dynamics::standing_scene(mesh, settings.rubber, low + 0.05 * (high - low), settings.duration);
     Run run;
-    if (settings.model == "corotational") {
-        run.body = std::make_unique<dynamics::Body>(scene, std::make_unique<corot::CorotationalElasticity>(scene.mesh, scene.material));
-        run.integrator = std::make_unique<dynamics::ThetaMethod>(1.0);
-    } else if (settings.model == "stable-neo-hookean") {
-        run.body = std::make_unique<dynamics::Body>(
-            scene, std::make_unique<hyper::HyperelasticElasticity>(
-                       scene.mesh, hyper::make_material(settings.model, scene.material.youngs_modulus, scene.material.poisson_ratio)));
-        run.integrator = std::make_unique<hyper::NewtonBackwardEuler>();
-    } else {
-        throw Error(str("unknown force model '", settings.model, "' (corotational, stable-neo-hookean)"));
-    }
+    run.body = std::make_unique<dynamics::Body>(scene, hyper::make_force_model(settings.model, scene.mesh, scene.material));
+    run.integrator = hyper::make_integrator_for(settings.model);
     run.push = dynamics::sideways_push(scene, low, high, 0.5);
     return run;
 }

@@ -185,33 +185,35 @@ Matrix9d NeoHookean::piola_derivative(const Eigen::Matrix3d& H) const
     return dP;
 }
 
-// --- stable neo-Hookean -------------------------------------------------------------------------
+// --- stable neo-Hookean: the course's form and the paper's -----------------------------------------
 
-double StableNeoHookean::energy_density(const Eigen::Matrix3d& H) const
+namespace {
+
+/// The part both stable neo-Hookean forms share, ψ = (μ/2)(tr(FᵀF) − 3) − μ(J − 1) + (λ̂/2)(J − 1)²,
+/// written in H: (μ/2)(tr(FᵀF) − 3) − μ(J − 1) = (μ/2)‖H‖² − μ(½(tr²H − tr H²) + det H), tr H
+/// cancelled exactly.
+double stable_energy(double mu, double lambda_hat, const Eigen::Matrix3d& H)
 {
-    require_finite(H, name());
-    const double lambda = lame().lambda + lame().mu, change = volume_change(H);
-    // (μ/2)(tr(FᵀF) − 3) − μ(J − 1) = (μ/2)‖H‖² − μ(½(tr²H − tr H²) + det H): tr H cancelled exactly.
-    return 0.5 * lame().mu * H.squaredNorm() - lame().mu * higher_volume_change(H) + 0.5 * lambda * change * change;
+    const double change = volume_change(H);
+    return 0.5 * mu * H.squaredNorm() - mu * higher_volume_change(H) + 0.5 * lambda_hat * change * change;
 }
 
-Eigen::Matrix3d StableNeoHookean::first_piola(const Eigen::Matrix3d& H) const
+/// Its P = μF + (λ̂(J − 1) − μ)C = μ(H − (C − I)) + λ̂(J − 1)C.
+Eigen::Matrix3d stable_piola(double mu, double lambda_hat, const Eigen::Matrix3d& H)
 {
-    require_finite(H, name());
-    const double lambda = lame().lambda + lame().mu, change = volume_change(H);
+    const double change = volume_change(H);
     const Eigen::Matrix3d C_change = cofactor_change(H);
-    // μF + (λ̂(J − 1) − μ)C = μ(H − (C − I)) + λ̂(J − 1)C.
-    return lame().mu * (H - C_change) + lambda * change * (Eigen::Matrix3d::Identity() + C_change);
+    return mu * (H - C_change) + lambda_hat * change * (Eigen::Matrix3d::Identity() + C_change);
 }
 
-Matrix9d StableNeoHookean::piola_derivative(const Eigen::Matrix3d& H) const
+/// Its ∂P/∂F = μ I + λ̂ vec(C) vec(C)ᵀ + (λ̂(J − 1) − μ) ∂²J/∂F².
+Matrix9d stable_derivative(double mu, double lambda_hat, const Eigen::Matrix3d& H)
 {
-    require_finite(H, name());
-    const double mu = lame().mu, lambda = lame().lambda + mu, change = volume_change(H);
+    const double change = volume_change(H);
     const Eigen::Matrix3d F = Eigen::Matrix3d::Identity() + H;
     const Vector9d C = flatten(Eigen::Matrix3d::Identity() + cofactor_change(H));
-    Matrix9d dP = mu * Matrix9d::Identity() + lambda * C * C.transpose();
-    const double weight = lambda * change - mu;
+    Matrix9d dP = mu * Matrix9d::Identity() + lambda_hat * C * C.transpose();
+    const double weight = lambda_hat * change - mu;
     // EXERCISE 12.3 (stable_neo_hookean_derivative): see docs/12_hyperelastic_newton.md#stable-neo-hookean
     // HINT: add (λ̂(J − 1) − μ) ∂²J/∂F² to dP, entry (3a + b, 3c + d), where
     // HINT: ∂²J/∂F_ab∂F_cd = Σ_kl ε_ack ε_bdl F_kl (levi_civita(i, j, k) is ε_ijk).
@@ -219,23 +221,113 @@ Matrix9d StableNeoHookean::piola_derivative(const Eigen::Matrix3d& H) const
     return dP;
 }
 
-// --- factory and projection ---------------------------------------------------------------------
+/// The paper's λ' = λ + 5μ/6 (with μ' = 4μ/3 it agrees with linear elasticity for small strains).
+double paper_lambda(const elastic::Lame& lame)
+{
+    return lame.lambda + 5.0 * lame.mu / 6.0;
+}
+
+/// x = I_C − 3 = tr(FᵀF) − 3 = 2 tr H + ‖H‖², exact in H.
+double stretch_invariant_change(const Eigen::Matrix3d& H)
+{
+    return 2.0 * H.trace() + H.squaredNorm();
+}
+
+}  // namespace
+
+double StableNeoHookean::energy_density(const Eigen::Matrix3d& H) const
+{
+    require_finite(H, name());
+    return stable_energy(lame().mu, lame().lambda + lame().mu, H);
+}
+
+Eigen::Matrix3d StableNeoHookean::first_piola(const Eigen::Matrix3d& H) const
+{
+    require_finite(H, name());
+    return stable_piola(lame().mu, lame().lambda + lame().mu, H);
+}
+
+Matrix9d StableNeoHookean::piola_derivative(const Eigen::Matrix3d& H) const
+{
+    require_finite(H, name());
+    return stable_derivative(lame().mu, lame().lambda + lame().mu, H);
+}
+
+// The paper's energy μ'/2 (I_C − 3) − μ'/2 ln(I_C + 1) + λ'/2 (J − α)², α = 1 + 3μ'/(4λ'), with
+// μ' = 4μ/3 = 4/3 · (the shared part's μ): it is the shared part with λ̂ = λ' plus
+// (μ'/2)(x/4 − ln(1 + x/4)), x = I_C − 3, minus its value at rest.
+
+double PaperStableNeoHookean::energy_density(const Eigen::Matrix3d& H) const
+{
+    require_finite(H, name());
+    const double mu_prime = 4.0 * lame().mu / 3.0;
+    return stable_energy(lame().mu, paper_lambda(lame()), H) +
+           0.5 * mu_prime * x_minus_log1p(0.25 * stretch_invariant_change(H));
+}
+
+Eigen::Matrix3d PaperStableNeoHookean::first_piola(const Eigen::Matrix3d& H) const
+{
+    require_finite(H, name());
+    const double mu_prime = 4.0 * lame().mu / 3.0, x = stretch_invariant_change(H);
+    // ∂/∂F of (μ'/2)(x/4 − ln(1 + x/4)) = μ' x / (4(4 + x)) F.
+    return stable_piola(lame().mu, paper_lambda(lame()), H) +
+           (mu_prime * x / (4.0 * (4.0 + x))) * (Eigen::Matrix3d::Identity() + H);
+}
+
+Matrix9d PaperStableNeoHookean::piola_derivative(const Eigen::Matrix3d& H) const
+{
+    require_finite(H, name());
+    const double mu_prime = 4.0 * lame().mu / 3.0, x = stretch_invariant_change(H);
+    const Vector9d F = flatten(Eigen::Matrix3d::Identity() + H);
+    // ∂/∂F of μ' x/(4(4 + x)) F: that factor on the diagonal, plus 2μ'/(4 + x)² vec(F) vec(F)ᵀ.
+    return stable_derivative(lame().mu, paper_lambda(lame()), H) +
+           (mu_prime * x / (4.0 * (4.0 + x))) * Matrix9d::Identity() +
+           (2.0 * mu_prime / ((4.0 + x) * (4.0 + x))) * F * F.transpose();
+}
+
+// --- the registry, and the projection --------------------------------------------------------------
+
+namespace {
+
+template <class M>
+std::unique_ptr<Material> make(const elastic::Lame& lame)
+{
+    return std::make_unique<M>(lame);
+}
+
+/// Every material make_material knows, by name: adding a material is one line here.
+/// docs/12_hyperelastic_newton.md#adding-a-material
+struct Registered {
+    std::string_view name;
+    std::unique_ptr<Material> (*make)(const elastic::Lame&);
+};
+constexpr Registered registry[] = {
+    {"stvk", make<StVenantKirchhoff>},
+    {"neo-hookean", make<NeoHookean>},
+    {"stable-neo-hookean", make<StableNeoHookean>},
+    {"stable-neo-hookean-paper", make<PaperStableNeoHookean>},
+};
+
+}  // namespace
 
 std::vector<std::string> material_names()
 {
-    return {"stvk", "neo-hookean", "stable-neo-hookean"};
+    std::vector<std::string> names;
+    for (const Registered& entry : registry)
+        names.emplace_back(entry.name);
+    return names;
 }
 
 std::unique_ptr<Material> make_material(std::string_view name, double youngs_modulus, double poisson_ratio)
 {
     const elastic::Lame lame = elastic::lame_parameters(youngs_modulus, poisson_ratio);
-    if (name == "stvk")
-        return std::make_unique<StVenantKirchhoff>(lame);
-    if (name == "neo-hookean")
-        return std::make_unique<NeoHookean>(lame);
-    if (name == "stable-neo-hookean")
-        return std::make_unique<StableNeoHookean>(lame);
-    throw Error(str("unknown material '", name, "' (stvk, neo-hookean, stable-neo-hookean)"));
+    for (const Registered& entry : registry)
+        if (entry.name == name)
+            return entry.make(lame);
+    std::string names;
+    for (const Registered& entry : registry)
+        names += str(names.empty() ? "" : ", ", entry.name);
+    throw Error(str("unknown material '", name, "'; choose one of: ", names));
 }
 
 template <int N>

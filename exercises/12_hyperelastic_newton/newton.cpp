@@ -19,42 +19,81 @@ void require_sizes(const dynamics::Body& body, const dynamics::State& state, dou
                         state.u.size(), " and ", state.v.size()));
 }
 
+/// fem::Error unless damping's α, β are the body's: a damped body's objective needs its StepDamping.
+void require_damping(const dynamics::Body& body, const StepDamping& damping)
+{
+    const dynamics::Damping& scene = body.scene().damping;
+    if (damping.coefficients().alpha != scene.alpha || damping.coefficients().beta != scene.beta)
+        throw Error(str("backward Euler objective: the body's Rayleigh damping is alpha = ", scene.alpha, ", beta = ",
+                        scene.beta, " but the step's StepDamping has alpha = ", damping.coefficients().alpha,
+                        ", beta = ", damping.coefficients().beta, "; pass StepDamping(body, state.u)"));
+}
+
 }  // namespace
 
+StepDamping::StepDamping(dynamics::Body& body, const Eigen::VectorXd& u_start)
+    : coefficients_(body.scene().damping), M_(&body.mass_matrix())
+{
+    if (coefficients_.beta != 0.0)
+        K_start_ = body.model().definite_stiffness(u_start);  // a copy: the model refills its own
+}
+
+Eigen::VectorXd StepDamping::times(const Eigen::VectorXd& v) const
+{
+    if (M_ == nullptr)
+        return Eigen::VectorXd::Zero(v.size());
+    if (v.size() != M_->rows())
+        throw Error(str("StepDamping: v must have 3n = ", M_->rows(), " entries, got ", v.size()));
+    Eigen::VectorXd Dv = coefficients_.alpha * (*M_ * v);
+    if (coefficients_.beta != 0.0)
+        Dv += coefficients_.beta * (K_start_ * v);
+    return Dv;
+}
+
 double backward_euler_objective(dynamics::Body& body, const dynamics::State& state, double time_step,
-                                const Eigen::VectorXd& v, double* magnitude)
+                                const Eigen::VectorXd& v, double* magnitude, const StepDamping& damping)
 {
     require_sizes(body, state, time_step, v);
+    require_damping(body, damping);
     const double elastic = body.model().energy(state.u + time_step * v);
     if (!std::isfinite(elastic))
         return std::numeric_limits<double>::infinity();
-    double kinetic = 0.0, work = 0.0;
+    double kinetic = 0.0, work = 0.0, dissipation = 0.0;
     // EXERCISE 12.7 (objective): see docs/12_hyperelastic_newton.md#backward-euler-as-minimisation
     // HINT: kinetic = ½ (v − q̇ᵗ)ᵀ M (v − q̇ᵗ) (state.v is q̇ᵗ; the notes' qᵗ here is a slip);
-    // HINT: work = Δt vᵀ f_ext. E = kinetic + U(qᵗ + Δt v) − work.
+    // HINT: work = Δt vᵀ f_ext; dissipation = (Δt/2) vᵀ D v (damping.times(v) is D v).
+    // HINT: E = kinetic + U(qᵗ + Δt v) − work + dissipation.
     throw fem::NotImplemented("12.7", "objective", "docs/12_hyperelastic_newton.md#backward-euler-as-minimisation");
     if (magnitude != nullptr)
-        *magnitude = std::abs(kinetic) + std::abs(elastic) + std::abs(work);
-    return kinetic + elastic - work;
+        *magnitude = std::abs(kinetic) + std::abs(elastic) + std::abs(work) + std::abs(dissipation);
+    return kinetic + elastic - work + dissipation;
 }
 
 Eigen::VectorXd backward_euler_gradient(dynamics::Body& body, const dynamics::State& state, double time_step,
-                                        const Eigen::VectorXd& v)
+                                        const Eigen::VectorXd& v, const StepDamping& damping)
 {
     require_sizes(body, state, time_step, v);
+    require_damping(body, damping);
     Eigen::VectorXd forces, gradient;
     body.model().evaluate(state.u + time_step * v, forces);
     // EXERCISE 12.8 (gradient): see docs/12_hyperelastic_newton.md#backward-euler-as-minimisation
-    // HINT: ∇E = M (v − q̇ᵗ) − Δt (f(qᵗ + Δt v) + f_ext), with forces = f(qᵗ + Δt v) above.
+    // HINT: ∇E = M (v − q̇ᵗ) − Δt (f(qᵗ + Δt v) + f_ext − D v), with forces = f(qᵗ + Δt v) above
+    // HINT: and D v = damping.times(v).
     throw fem::NotImplemented("12.8", "gradient", "docs/12_hyperelastic_newton.md#backward-euler-as-minimisation");
     return gradient;
 }
 
-double momentum_scale(const dynamics::Body& body, const dynamics::State& state, double time_step)
+double momentum_scale(dynamics::Body& body, const dynamics::State& state, double time_step)
 {
     const dynamics::FreeDofs& dofs = body.dofs();
-    return dofs.gather(body.mass_matrix() * state.v).norm() + time_step * dofs.gather(body.external_forces()).norm() +
-           time_step * dofs.gather(state.forces).norm();
+    double scale = dofs.gather(body.mass_matrix() * state.v).norm() +
+                   time_step * dofs.gather(body.external_forces()).norm() + time_step * dofs.gather(state.forces).norm();
+    if (body.pins_move()) {  // what the pins' step pushes into the free dofs
+        Eigen::VectorXd forces;
+        body.model().evaluate(state.u + time_step * body.pin_velocity(), forces);
+        scale += dofs.gather(body.mass_matrix() * body.pin_velocity()).norm() + time_step * dofs.gather(forces).norm();
+    }
+    return scale;
 }
 
 NewtonBackwardEuler::NewtonBackwardEuler(NewtonOptions options)
@@ -197,31 +236,37 @@ Eigen::VectorXd solve_static(dynamics::Body& body, const NewtonOptions& options)
 dynamics::StepInfo NewtonBackwardEuler::step(dynamics::Body& body, double time_step, dynamics::State& state)
 {
     require_positive(time_step, "time step dt [s]");
-    const dynamics::Damping& damping = body.scene().damping;
-    if (damping.alpha != 0.0 || damping.beta != 0.0)
-        throw Error("Newton backward Euler: Rayleigh damping is not part of its objective yet; set alpha = beta = 0");
     const dynamics::FreeDofs& dofs = body.dofs();
+    const StepDamping damping(body, state.u);  // D = αM + βK_t, K_t at the step's start
+    // The full velocity: the unknowns x on the free dofs, the pins' ṽ_p (zero on free dofs) on theirs.
     const auto full = [&](const Eigen::VectorXd& x) {
-        Eigen::VectorXd v = Eigen::VectorXd::Zero(dofs.full_size());
+        Eigen::VectorXd v = body.pin_velocity();
         dofs.scatter(x, v);
         return v;
     };
     NewtonProblem problem;
     problem.objective = [&](const Eigen::VectorXd& x, double* magnitude) {
-        return backward_euler_objective(body, state, time_step, full(x), magnitude);
+        return backward_euler_objective(body, state, time_step, full(x), magnitude, damping);
     };
     problem.gradient = [&](const Eigen::VectorXd& x) {
-        return Eigen::VectorXd(dofs.gather(backward_euler_gradient(body, state, time_step, full(x))));
+        return Eigen::VectorXd(dofs.gather(backward_euler_gradient(body, state, time_step, full(x), damping)));
     };
+    // H = M + Δt D + Δt² K = (1 + Δt α) M + Δt² (K + (β/Δt) K_t), in the fixed pattern.
+    const dynamics::Damping& coefficients = damping.coefficients();
+    dynamics::SparseMatrix damped_K;
     problem.hessian = [&](const Eigen::VectorXd& x, bool definite) -> const dynamics::SparseMatrix& {
         const Eigen::VectorXd u = state.u + time_step * full(x);
-        const dynamics::SparseMatrix& K = definite ? body.model().definite_stiffness(u) : body.model().stiffness(u);
+        const dynamics::SparseMatrix* K = definite ? &body.model().definite_stiffness(u) : &body.model().stiffness(u);
+        if (coefficients.beta != 0.0) {
+            damped_K = *K + (coefficients.beta / time_step) * damping.start_stiffness();
+            K = &damped_K;
+        }
         const dynamics::SparseMatrix& M = body.mass_matrix();
-        if (!reduced_ || reduced_body_ != &body || !reduced_->fits(M, K)) {
-            reduced_.emplace(M, K, dofs);
+        if (!reduced_ || reduced_body_ != &body || !reduced_->fits(M, *K)) {
+            reduced_.emplace(M, *K, dofs);
             reduced_body_ = &body;
         }
-        return reduced_->assemble(M, K, dynamics::Damping{}, time_step, 1.0);
+        return reduced_->assemble(M, *K, 1.0 + time_step * coefficients.alpha, time_step * time_step);
     };
     problem.scale = momentum_scale(body, state, time_step);
     problem.what = str("step ", state.step + 1, " (t = ", state.time + time_step, " s)");
@@ -236,6 +281,10 @@ dynamics::StepInfo NewtonBackwardEuler::step(dynamics::Body& body, double time_s
     info.solver_iterations = last_.solver_iterations;
     info.prepared = last_.iterations > 0;
     const Eigen::VectorXd v = full(last_.x);
+    info.damping_work = time_step * v.dot(damping.times(v));
+    // The pins' reactions r_p = ∇E_p(v⁺)/Δt do Δt ṽ_pᵀ r_p = ṽ_pᵀ ∇E(v⁺) (ṽ is zero on free dofs).
+    if (body.pins_move())
+        info.boundary_work = body.pin_velocity().dot(backward_euler_gradient(body, state, time_step, v, damping));
     dynamics::commit_step(body.model(), time_step, state.u + time_step * v, v, state);
     return info;
 }

@@ -1,0 +1,74 @@
+#include "12_hyperelastic_newton/force_models.hpp"
+
+#include "12_hyperelastic_newton/hyperelastic.hpp"
+#include "12_hyperelastic_newton/materials.hpp"
+#include "12_hyperelastic_newton/newton.hpp"
+
+#include "11_corotational/corotational.hpp"
+
+#include "common/error.hpp"
+
+#include <algorithm>
+
+namespace fem::hyper {
+namespace {
+
+/// The error for a model name that is not one of force_model_names(), listing them.
+Error unknown_model(std::string_view name)
+{
+    std::string names;
+    for (const std::string& known : force_model_names())
+        names += str(names.empty() ? "" : ", ", known);
+    return Error(str("unknown force model '", name, "'; choose one of: ", names));
+}
+
+}  // namespace
+
+std::vector<std::string> force_model_names()
+{
+    std::vector<std::string> names{"linear", "corotational"};
+    for (std::string& material : material_names())
+        names.push_back(std::move(material));
+    return names;
+}
+
+bool is_hyperelastic(std::string_view name)
+{
+    const std::vector<std::string> materials = material_names();
+    return std::find(materials.begin(), materials.end(), name) != materials.end();
+}
+
+std::unique_ptr<dynamics::ForceModel> make_force_model(std::string_view name, const TetMesh& mesh,
+                                                       const dynamics::Material& material)
+{
+    if (name == "linear")
+        return std::make_unique<dynamics::LinearElasticity>(mesh, material);
+    if (name == "corotational")
+        return std::make_unique<corot::CorotationalElasticity>(mesh, material, corot::RotationFit::polar,
+                                                               corot::PolarAlgorithm::newton,
+                                                               corot::ForceForm::shape_gradients);
+    if (is_hyperelastic(name))
+        return std::make_unique<HyperelasticElasticity>(
+            mesh, make_material(name, material.youngs_modulus, material.poisson_ratio));
+    throw unknown_model(name);
+}
+
+std::unique_ptr<dynamics::Integrator> make_integrator_for(std::string_view model, const StepSettings& settings)
+{
+    if (is_hyperelastic(model)) {
+        if (settings.integrator != "backward-euler")
+            throw Error(str("integrator '", settings.integrator, "' for the hyperelastic model '", model,
+                            "': chapter 12's Newton steps backward Euler only; use backward-euler"));
+        NewtonOptions options;
+        options.relative_tolerance = settings.newton_tolerance;
+        options.solver = settings.solver;
+        return std::make_unique<NewtonBackwardEuler>(options);
+    }
+    if (model != "linear" && model != "corotational")
+        throw unknown_model(model);
+    dynamics::ImplicitOptions options;
+    options.solver = settings.solver;
+    return dynamics::make_integrator(settings.integrator, options);
+}
+
+}  // namespace fem::hyper
