@@ -9,8 +9,11 @@
 #include <cmath>
 #include <csignal>
 #include <cstdlib>
+#include <exception>
 #include <fstream>
 #include <iostream>
+#include <iterator>
+#include <new>
 #include <optional>
 
 namespace fem {
@@ -110,7 +113,10 @@ ChapterCli::ChapterCli(const std::string& executable, const std::string& chapter
     : app(description, executable), out_text_("out/" + chapter)
 {
     app.add_option("--out", out_text_, "Folder for the VTK files, CSV tables and PNG figures")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(CLI::Validator(
+            [](std::string& text) { return text.empty() ? std::string("must name a folder, got an empty text") : std::string(); },
+            ""));
     app.add_flag("--quick", context_.quick, "A small, fast run (what ctest runs)");
     app.add_flag("--no-figures", no_figures_, "Skip the PNG figures");
     // A bad command line reads like every other bad input: "error: ..." (naming the option), and
@@ -125,33 +131,117 @@ namespace {
 /// The list of the files a run wrote, kept in its output folder for the next run.
 constexpr const char* run_manifest = ".fem-run-files";
 
-/// The names the previous run in `out` wrote (none when there was none).
+/// The names the previous run in `out` wrote (none when there was none). Every line must be a plain
+/// entry name of out (no folder part, not the list itself, not a staging folder): a list that holds
+/// anything else was not written by a run, and is ignored with a warning (nothing is removed).
 std::vector<std::string> previous_run_files(const std::filesystem::path& out)
 {
     std::vector<std::string> names;
     std::ifstream file(out / run_manifest);
-    for (std::string name; std::getline(file, name);)
+    int line = 0;
+    for (std::string name; std::getline(file, name);) {
+        ++line;
+        const bool plain = !name.empty() && name != "." && name != ".." && name != run_manifest &&
+                           name.find('/') == std::string::npos && !name.starts_with(".staging-");
+        if (!plain) {
+            std::cerr << "warning: " << (out / run_manifest).string() << ":" << line << ": '" << name.substr(0, 200)
+                      << "' is not a file name of this folder; the list is ignored (no earlier result is removed)\n";
+            return {};
+        }
         names.push_back(name);
+    }
     return names;
+}
+
+/// path made absolute, with symbolic links and "..", "." resolved as far as it exists.
+std::filesystem::path resolved(const std::filesystem::path& path)
+{
+    std::error_code ec;
+    const std::filesystem::path absolute = std::filesystem::absolute(path, ec);
+    const std::filesystem::path canonical = std::filesystem::weakly_canonical(absolute, ec);
+    return (ec ? absolute : canonical).lexically_normal();
+}
+
+/// True when inner is outer or lies inside it (both resolved).
+bool within(const std::filesystem::path& inner, const std::filesystem::path& outer)
+{
+    const auto o = std::mismatch(outer.begin(), outer.end(), inner.begin(), inner.end()).first;
+    return o == outer.end() || (o->empty() && std::next(o) == outer.end());  // or a trailing separator
+}
+
+/// The message of a failure caught at the top of a run: an fem::Error's or an unfinished exercise's
+/// own; a lack of memory said so; anything else is a bug of the course.
+std::string failure_message(const std::exception_ptr& failure)
+{
+    constexpr const char* report = " (a bug of the course: please report it with the command line)";
+    try {
+        std::rethrow_exception(failure);
+    } catch (const Error& e) {
+        return e.what();
+    } catch (const NotImplemented& e) {
+        return e.what();
+    } catch (const std::bad_alloc&) {
+        return "out of memory (std::bad_alloc): the run needs more memory than the system gives it";
+    } catch (const std::exception& e) {
+        return str("internal error: ", e.what(), report);
+    } catch (...) {
+        return str("internal error: an exception of an unknown type", report);
+    }
 }
 
 }  // namespace
 
 void ChapterCli::check_options(std::function<void()> check) { check_ = std::move(check); }
 
+void ChapterCli::protect_inputs(const std::vector<std::filesystem::path>& inputs)
+{
+    inputs_.insert(inputs_.end(), inputs.begin(), inputs.end());
+}
+
+void ChapterCli::writes_entry(const std::string& name) { written_entries_.push_back(name); }
+
+void ChapterCli::check_command_line()
+{
+    if (check_)
+        check_();
+    const std::filesystem::path out = resolved(out_text_);
+    for (const std::filesystem::path& input : inputs_) {
+        const std::filesystem::path in = resolved(input);
+        if (within(in, out) || within(out, in))
+            throw Error(str("--out: '", out_text_, "' ", within(out, in) ? "is or lies inside" : "holds",
+                            " the input '", input.string(), "'; the run's files would replace or remove it: ",
+                            "choose a folder apart from the inputs"));
+    }
+    std::error_code ec;
+    if (written_entries_.empty() || !std::filesystem::is_directory(out, ec))
+        return;
+    const std::vector<std::string> previous = previous_run_files(out);
+    for (const std::string& name : written_entries_)
+        if (std::filesystem::exists(std::filesystem::symlink_status(out / name, ec)) &&
+            std::find(previous.begin(), previous.end(), name) == previous.end())
+            throw Error(str("--out: '", (std::filesystem::path(out_text_) / name).string(),
+                            "' exists and was not written by an earlier run (", run_manifest,
+                            " does not list it); this run would replace it: move it or choose another --out"));
+}
+
 int ChapterCli::run(int argc, char** argv, const std::function<void(const RunContext&)>& body)
 {
+    // Every exception ends here, as one line: none reaches std::terminate.
     try {
-        app.parse(argc, argv);
-    } catch (const CLI::ParseError& e) {
-        // --help prints the options and exits with 0; anything else is a bad command line.
-        return app.exit(e) == 0 ? 0 : 1;
-    }
-    try {
-        if (check_)
-            check_();
-    } catch (const Error& e) {
-        std::cerr << "error: " << e.what() << "\nrun with --help to see the options\n";
+        try {
+            app.parse(argc, argv);
+        } catch (const CLI::ParseError& e) {
+            // --help prints the options and exits with 0; anything else is a bad command line.
+            return app.exit(e) == 0 ? 0 : 1;
+        }
+        try {
+            check_command_line();
+        } catch (const Error& e) {
+            std::cerr << "error: " << e.what() << "\nrun with --help to see the options\n";
+            return 1;
+        }
+    } catch (...) {
+        std::cerr << "error: " << failure_message(std::current_exception()) << '\n';
         return 1;
     }
     const std::filesystem::path out = out_text_;
@@ -182,12 +272,8 @@ int ChapterCli::run(int argc, char** argv, const std::function<void(const RunCon
         staged->publish(previous_run_files(out));
         std::cout << "\nwrote " << std::filesystem::absolute(out).lexically_normal().string() << '\n';
         return 0;
-    } catch (const Error& e) {
-        message = e.what();
-    } catch (const NotImplemented& e) {
-        message = e.what();
-    } catch (const std::exception& e) {
-        message = str("unexpected failure: ", e.what());
+    } catch (...) {
+        message = failure_message(std::current_exception());
     }
     // The staging folder is gone: name the files where they would have appeared.
     const std::string staging = context_.out_dir.string();

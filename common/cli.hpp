@@ -1,6 +1,7 @@
 #pragma once
 // The command line every chapter executable shares (CLI11), and the guard around its main():
-// options --out DIR, --quick, --no-figures, --help; fem::Error becomes "error: ..." and exit 1.
+// options --out DIR, --quick, --no-figures, --help; any exception becomes one line "error: ..." and
+// exit 1 (one that is not an fem::Error is a bug: "error: internal error: ... please report it").
 // Every option is checked before anything is computed or written: its values by a check of
 // fem::check (given to CLI11's ->check()), what depends on several options by
 // ChapterCli::check_options.
@@ -79,18 +80,37 @@ public:
     /// and an fem::Error it throws is a bad command line (exit 1, nothing written).
     void check_options(std::function<void()> check);
 
+    /// Names the files the run reads (a scene, its meshes, its skin); the check of check_options() may
+    /// call it. run() refuses, before anything is written, an --out that is one of them, lies inside
+    /// one, or holds one at any depth: publishing the run's files could replace or delete it.
+    void protect_inputs(const std::vector<std::filesystem::path>& inputs);
+
+    /// Names an entry (a file or folder name) the run writes directly into --out, which replaces
+    /// an entry of that name there; the check of check_options() may call it. run() refuses, before
+    /// anything is written, an --out that already holds such an entry that the previous run into it
+    /// did not write (its .fem-run-files does not list it): it is someone else's.
+    void writes_entry(const std::string& name);
+
     /// Parses argv (running every option's check), runs the check of check_options(), and calls
     /// body, which writes into a staging folder (fem::StagedFiles) inside --out. Only when body
     /// returns do its files appear in --out, together, replacing the previous run's (whose files
     /// this run did not write again are removed; other files are left alone). A run that fails
-    /// leaves --out as it was. Returns the process exit code:
-    /// 0 on success (and after --help); 1 after printing "error: <message>" for fem::Error, an
-    /// unfinished exercise, a bad command line (an unknown option, a value that does not parse)
-    /// or any other failure.
+    /// leaves --out as it was. The list of the files written (.fem-run-files in --out) names the
+    /// files the next run may remove; a list that names anything but plain entries of --out is
+    /// ignored with a warning. Returns the process exit code: 0 on success (and after --help); 1
+    /// after printing one line "error: <message>" for fem::Error, an unfinished exercise, a bad
+    /// command line (an unknown option, a value that does not parse, an empty --out, an --out
+    /// that overlaps an input) or any other exception ("internal error: ... please report it"):
+    /// nothing escapes to std::terminate.
     int run(int argc, char** argv, const std::function<void(const RunContext&)>& body);
 
 private:
+    /// The options' checks, the inputs' and the output folder's: fem::Error for a bad command line.
+    void check_command_line();
+
     std::function<void()> check_;
+    std::vector<std::filesystem::path> inputs_;
+    std::vector<std::string> written_entries_;
     RunContext context_;
     std::string out_text_;
     bool no_figures_ = false;

@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <string>
 #include <system_error>
@@ -62,23 +63,23 @@ void write_file(const std::filesystem::path& path, std::string_view bytes)
     });
 }
 
-namespace {
-
-constexpr std::string_view staging_prefix = ".staging-";
-
-/// Removes the staging folders in folder left by processes that no longer run.
-void remove_abandoned_staging(const std::filesystem::path& folder)
+void remove_abandoned(const std::filesystem::path& folder, std::string_view prefix)
 {
     std::error_code ec;
     for (const auto& entry : std::filesystem::directory_iterator(folder, ec)) {
         const std::string name = entry.path().filename().string();
-        if (!name.starts_with(staging_prefix))
+        if (!name.starts_with(prefix))
             continue;
-        const long pid = std::strtol(name.c_str() + staging_prefix.size(), nullptr, 10);
+        const long pid = std::strtol(name.c_str() + prefix.size(), nullptr, 10);
+        std::error_code ignored;
         if (pid > 0 && ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH)
-            std::filesystem::remove_all(entry.path(), ec);
+            std::filesystem::remove_all(entry.path(), ignored);
     }
 }
+
+namespace {
+
+constexpr std::string_view staging_prefix = ".staging-";
 
 /// A plain entry name: no folder separator, not "." or "..", not empty.
 bool plain_name(const std::string& name)
@@ -95,7 +96,7 @@ StagedFiles::StagedFiles(std::filesystem::path folder) : folder_(folder.empty() 
          missing = missing.parent_path())
         created_ = missing;
     ensure_directory(folder_);
-    remove_abandoned_staging(folder_);
+    remove_abandoned(folder_, staging_prefix);
     staging_ = folder_ / str(staging_prefix, ::getpid(), "-", counter++);
     std::error_code ec;
     if (!std::filesystem::create_directory(staging_, ec))

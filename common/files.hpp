@@ -48,6 +48,11 @@ private:
     bool published_ = false;
 };
 
+/// Removes the entries of folder whose names are prefix followed by the id of a process that no
+/// longer runs ("<prefix><pid>-..."): what a killed run left behind (a staging folder, a temporary
+/// folder). Entries of running processes are left alone; failures to remove are ignored.
+void remove_abandoned(const std::filesystem::path& folder, std::string_view prefix);
+
 /// Creates a folder (and its parents) if missing; fem::Error if it cannot.
 void ensure_directory(const std::filesystem::path& directory);
 

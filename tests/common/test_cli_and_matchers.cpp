@@ -2,17 +2,21 @@
 // the entry-by-entry matrix matcher of test_support.hpp (it names the entry that differs).
 #include "common/cli.hpp"
 #include "common/error.hpp"
+#include "common/files.hpp"
 #include "common/test_support.hpp"
 
 #include <catch2/catch.hpp>
 
 #include <Eigen/SparseCore>
 
+#include <algorithm>
 #include <filesystem>
 #include <functional>
 #include <iostream>
 #include <limits>
+#include <new>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -29,10 +33,15 @@ struct CliRun {
     bool body_ran = false;
 };
 
-/// check_options: the chapter's check of options together (none when empty).
-CliRun run_cli(std::vector<std::string> args, const std::function<void()>& check_options = {})
+/// check_options: the chapter's check of options together (none when empty); setup: what the
+/// chapter tells the command line before it runs (its inputs, its entries); body: the run's work.
+CliRun run_cli(std::vector<std::string> args, const std::function<void()>& check_options = {},
+               const std::function<void(fem::ChapterCli&)>& setup = {},
+               const std::function<void(const fem::RunContext&)>& body = {})
 {
     fem::ChapterCli cli("ch00_test", "00_test", "A test of the shared command line");
+    if (setup)
+        setup(cli);
     double c = 1.0;
     int n = 3;
     cli.app.add_option("--c", c, "A chapter option")->capture_default_str();
@@ -50,6 +59,8 @@ CliRun run_cli(std::vector<std::string> args, const std::function<void()>& check
     run.code = cli.run(static_cast<int>(argv.size()), argv.data(), [&](const fem::RunContext& context) {
         run.body_ran = true;
         CHECK_FALSE(context.figures);  // every call below that gets here passes --no-figures
+        if (body)
+            body(context);
     });
     std::cout.rdbuf(old_out);
     std::cerr.rdbuf(old_err);
@@ -157,6 +168,84 @@ TEST_CASE("the flag --no-figures turns the figures off", "[cli]")
     const CliRun run = run_cli({"--no-figures", "--out", out_dir});
     CHECK(run.code == 0);
     CHECK(run.body_ran);
+}
+
+TEST_CASE("--out \"\" is refused before anything is written (issue 23, row 7)", "[cli]")
+{
+    const std::filesystem::path here = std::filesystem::current_path();
+    const bool had_manifest = std::filesystem::exists(here / ".fem-run-files");
+    const CliRun run = run_cli({"--no-figures", "--out", ""});
+    CHECK(run.code == 1);
+    CHECK_FALSE(run.body_ran);
+    CHECK_THAT(run.err, Contains("error: --out: must name a folder, got an empty text"));
+    CHECK(std::filesystem::exists(here / ".fem-run-files") == had_manifest);  // nothing published here
+}
+
+TEST_CASE("any exception is one line 'error: …' and exit 1; one that is not an fem::Error is an internal error to report", "[cli]")
+{
+    const std::string out_dir = fem::test::fresh_output_dir("cli_internal_error").string();
+    // In the options' check (it was std::terminate there) and in the run itself.
+    const CliRun in_check = run_cli({"--no-figures", "--out", out_dir + "/out"},
+                                    [] { throw std::out_of_range("stoul"); });
+    const CliRun in_body = run_cli({"--no-figures", "--out", out_dir + "/out"}, {}, {},
+                                   [](const fem::RunContext&) { throw std::out_of_range("stoul"); });
+    for (const CliRun& run : {in_check, in_body}) {
+        CHECK(run.code == 1);
+        CHECK_THAT(run.err, Contains("error: internal error: stoul") && Contains("please report it"));
+        CHECK(std::count(run.err.begin(), run.err.end(), '\n') == 1);  // one line
+    }
+    CHECK_FALSE(in_check.body_ran);
+    CHECK_FALSE(std::filesystem::exists(out_dir + "/out"));
+    const CliRun memory = run_cli({"--no-figures", "--out", out_dir + "/out"}, {}, {},
+                                  [](const fem::RunContext&) { throw std::bad_alloc(); });
+    CHECK(memory.code == 1);
+    CHECK_THAT(memory.err, Contains("error: out of memory"));
+}
+
+TEST_CASE("an --out that is, lies inside or holds an input is refused before anything runs (issue 23, rows 3 and 10)", "[cli]")
+{
+    const std::filesystem::path dir = fem::test::fresh_output_dir("cli_inputs");
+    const std::filesystem::path scene = dir / "proj" / "mybar.toml";
+    fem::write_file(scene, "title = 'mine'\n");
+    const auto inputs = [&](fem::ChapterCli& cli) { cli.protect_inputs({scene}); };
+    for (const std::filesystem::path& out : {dir / "proj", dir, scene, dir / "proj" / "." / "mybar.toml" / "x"}) {
+        INFO(out);
+        const CliRun run = run_cli({"--no-figures", "--out", out.string()}, {}, inputs);
+        CHECK(run.code == 1);
+        CHECK_FALSE(run.body_ran);
+        CHECK_THAT(run.err, Contains("error: --out: '" + out.string() + "'") && Contains("the input '" + scene.string()));
+    }
+    CHECK(std::filesystem::exists(scene));
+    CHECK(run_cli({"--no-figures", "--out", (dir / "elsewhere").string()}, {}, inputs).code == 0);
+}
+
+TEST_CASE("an entry the run writes does not replace one of the same name that no earlier run wrote (issue 23, row 3)", "[cli]")
+{
+    const std::filesystem::path out = fem::test::fresh_output_dir("cli_entries");
+    fem::write_file(out / "mybar" / "mesh.node", "the user's mesh");
+    const auto frames = [](fem::ChapterCli& cli) { cli.writes_entry("mybar"); };
+    const auto write_frames = [](const fem::RunContext& run) { fem::write_file(run.file("mybar") / "f.vtu", "frame"); };
+    const CliRun refused = run_cli({"--no-figures", "--out", out.string()}, {}, frames, write_frames);
+    CHECK(refused.code == 1);
+    CHECK_FALSE(refused.body_ran);
+    CHECK_THAT(refused.err, Contains("mybar' exists and was not written by an earlier run"));
+    CHECK(std::filesystem::exists(out / "mybar" / "mesh.node"));
+    // A folder an earlier run wrote (listed in .fem-run-files) is the run's to replace.
+    std::filesystem::remove_all(out / "mybar");
+    CHECK(run_cli({"--no-figures", "--out", out.string()}, {}, frames, write_frames).code == 0);
+    CHECK(run_cli({"--no-figures", "--out", out.string()}, {}, frames, write_frames).code == 0);
+    CHECK(std::filesystem::exists(out / "mybar" / "f.vtu"));
+}
+
+TEST_CASE("a .fem-run-files that names anything but plain entries of --out is ignored with a warning (issue 23, row 10)", "[cli]")
+{
+    const std::filesystem::path out = fem::test::fresh_output_dir("cli_forged_list");
+    fem::write_file(out / "keep.csv", "not this run's");
+    fem::write_file(out / ".fem-run-files", "keep.csv\n../victim\n");
+    const CliRun run = run_cli({"--no-figures", "--out", out.string()});
+    CHECK(run.code == 0);
+    CHECK_THAT(run.err, Contains("warning: ") && Contains(".fem-run-files:2: '../victim' is not a file name of this folder"));
+    CHECK(std::filesystem::exists(out / "keep.csv"));  // the list was not followed
 }
 
 TEST_CASE("EntriesNear passes within its tolerance and names the first entry that differs", "[matchers]")

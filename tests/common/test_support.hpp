@@ -10,7 +10,9 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <functional>
+#include <map>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -25,6 +27,27 @@ inline std::filesystem::path fresh_output_dir(const std::string& name)
     std::filesystem::remove_all(dir);
     fem::ensure_directory(dir);
     return dir;
+}
+
+/// A table of bad inputs and their errors (tests/common/bad_files/errors.txt,
+/// tests/scenes/bad_scenes/errors.txt): one line "file  text", where text is what the file's error
+/// must contain; a file may have several lines, one per text; '#' starts a comment line.
+inline std::map<std::string, std::vector<std::string>> error_table(const std::filesystem::path& table)
+{
+    std::ifstream in(table);
+    REQUIRE(in);
+    std::map<std::string, std::vector<std::string>> expected;
+    for (std::string line; std::getline(in, line);) {
+        if (line.empty() || line.front() == '#')
+            continue;
+        std::istringstream fields(line);
+        std::string name, text;
+        fields >> name >> std::ws;
+        std::getline(fields, text);
+        REQUIRE_FALSE(text.empty());
+        expected[name].push_back(text);
+    }
+    return expected;
 }
 
 /// The finite-difference sweep (HOBAK's habit): the relative errors ‖(g(h) − g(−h))/(2h) − exact‖ /
