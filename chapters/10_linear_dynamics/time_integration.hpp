@@ -64,7 +64,8 @@ struct State {
 };
 
 /// The state (u0, v0) at time 0 (empty vectors: zero), with the force model evaluated at u0.
-/// fem::Error unless u0 and v0 have 3n finite entries and are zero on the pinned dofs.
+/// fem::Error unless u0 and v0 have 3n finite entries. A pinned vertex may start displaced or moving
+/// (a prescribed motion's state at time 0); it then moves only as the body's pin velocity says.
 State initial_state(Body& body, const Eigen::VectorXd& u0 = {}, const Eigen::VectorXd& v0 = {});
 
 /// Commits a step an integrator has computed: the force model evaluated once at u⁺ (forces and

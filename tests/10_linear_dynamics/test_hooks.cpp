@@ -7,6 +7,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <Eigen/Geometry>
+
 #include <cmath>
 #include <string>
 
@@ -84,14 +86,21 @@ TEST_CASE("pins translating at constant speed carry a damped body rigidly: no st
                 const double t = simulation.state().time;
                 const double u_error = (simulation.state().u - t * velocity).cwiseAbs().maxCoeff();
                 const double v_error = (simulation.state().v - velocity).cwiseAbs().maxCoeff();
-                const double kinetic = kinetic_energy(body.mass_matrix(), velocity);
                 const double bound = fem::test::trajectory_roundoff(body, scene.time_step, theta, steps);
+                // The energies' round-off: K v and K u of a rigid motion vanish only to ε |K||v| and
+                // ε |K||u|; over the run the damping work Δt β vᵀKv and the pins' work Δt ṽᵀ(K u + …)
+                // add up to at most steps Δt ε |v|ᵀ|K||v| (β + t). A lagging body (a missing coupling)
+                // strains by ~c Δt / L and costs orders of magnitude more.
+                const SparseMatrix& K = body.model().stiffness(simulation.state().u);
+                const double energy_bound = steps * scene.time_step * 2.220446049250313e-16 *
+                                            velocity.cwiseAbs().dot(K.cwiseAbs() * velocity.cwiseAbs()) *
+                                            (scene.damping.beta + t);
                 CAPTURE(theta, form == StepForm::velocity, route == PinnedRoute::keep, sci(u_error), sci(v_error),
-                        sci(damping), sci(boundary), sci(bound));
+                        sci(damping), sci(boundary), sci(bound), sci(energy_bound));
                 CHECK(u_error <= bound * t * c.norm());
                 CHECK(v_error <= bound * c.norm());
-                CHECK(std::abs(damping) <= bound * kinetic);
-                CHECK(std::abs(boundary) <= bound * kinetic);
+                CHECK(std::abs(damping) <= energy_bound);
+                CHECK(std::abs(boundary) <= energy_bound);
             }
 }
 
@@ -179,7 +188,8 @@ TEST_CASE("apply_step_hook books a load change as -df u and evaluates the model 
     const double work = apply_step_hook(add_load, body, state, state.time + scene.time_step);
     CAPTURE(sci(work), sci(expected));
     CHECK(std::abs(work - expected) <= 1e-12 * std::abs(expected));
-    CHECK((body.external_forces() - body.gravity_load() - df).cwiseAbs().maxCoeff() == 0.0);
+    CHECK((body.external_forces() - body.gravity_load() - df).cwiseAbs().maxCoeff() <=
+          1e-15 * body.gravity_load().cwiseAbs().maxCoeff());
 
     // A hook that changes nothing puts in nothing, and leaves the forces alone.
     const Eigen::VectorXd forces = state.forces;
@@ -226,7 +236,7 @@ TEST_CASE("the divergence rule counts the hook's work: an explicit step past its
     Scene scene = cantilever_scene();
     Body body(scene);
     const auto [K, M] = fem::test::free_matrices(body);
-    const double limit = explicit_stability_limit(K, M);
+    const double limit = explicit_stability_limit(highest_frequency(K, M));
     SymplecticEuler explicit_euler;
     Eigen::VectorXd start = Eigen::VectorXd::Zero(body.dofs().full_size());
     start[3 * fem::test::tip_vertex(scene) + 2] = 1e-4;
