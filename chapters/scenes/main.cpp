@@ -11,13 +11,16 @@
 // Writes (under out/scenes/<scene>): <scene>.pvd with <scene>/<scene>_NNNN.vtu frames, PNG frames
 // <scene>_NNNN.png and <scene>.mp4 (ffmpeg), steps.csv with the charts energies, step_time and
 // newton_iterations; with --compare, models.csv. docs/scenes.md
+#include "scenes/compare.hpp"
 #include "scenes/runner.hpp"
 
 #include "09_conjugate_gradient/linear_solver.hpp"
 
 #include "common/cli.hpp"
 #include "common/error.hpp"
+#include "common/interrupt.hpp"
 
+#include <csignal>
 #include <iostream>
 #include <memory>
 
@@ -98,11 +101,11 @@ int main(int argc, char** argv)
                 std::cout << "  " << body.name << ": " << body.mesh.V.rows() << " vertices, " << body.mesh.T.rows()
                           << " tets, " << body.pinned.size() << " pinned, model " << body.model << '\n';
             if (compare)
-                compare_models(scene, run);
+                compare_models(scene, &run);
         }
         if (compare)
             return;
-        catch_interrupt();
+        catch_stop_signals();
         RunOptions options;
         options.run = &run;
         options.progress = !no_progress;
@@ -129,6 +132,7 @@ int main(int argc, char** argv)
                   << result.frame_count << " frames, " << result.newton_iterations << " Newton iterations\n";
         stopped = result.interrupted;
     });
-    // Interrupted: the files so far were published (a valid .pvd); the exit code says it stopped.
-    return code == 0 && stopped ? 130 : code;
+    // Stopped: the files so far were published (a valid .pvd); the exit code says by what (128 +
+    // the signal, as a shell expects; the live view's q counts as Ctrl-C).
+    return code == 0 && stopped ? 128 + (stop_signal() != 0 ? stop_signal() : SIGINT) : code;
 }

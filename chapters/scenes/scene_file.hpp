@@ -105,11 +105,14 @@ struct BodySpec {
 };
 
 /// When model "auto" moves up from linear to corotational to hyperelastic (and back down), measured
-/// per step on every tet's deformation gradient F. docs/scenes.md#model-auto
+/// per step on every tet's deformation gradient F (model_auto.hpp). docs/scenes.md#model-auto
 struct AutoThresholds {
-    double rotation = 0.1745329251994330;  ///< largest element rotation [rad] linear allows (10°)
+    double rotation = 0.0872664625997165;  ///< an unstrained rotation up to this angle [rad] stays linear
+                                           ///< (5°: a ghost strain 1 − cos 5° = 0.38 %)
+    double ghost_ratio = 0.1;              ///< linear also holds while a tet's ghost strain is at most this
+                                           ///< fraction of its real (Green) strain
     double strain = 0.05;                  ///< largest principal Green strain corotational allows
-    double volume_ratio = 0.5;             ///< smallest det F corotational allows (near inversion)
+    double volume_ratio = 0.9;             ///< corotational allows det F in [volume_ratio, 2 − volume_ratio]
     double hysteresis = 0.5;               ///< move down only below this fraction of a threshold
     std::string hyperelastic = "stable-neo-hookean";  ///< the model above corotational
 };

@@ -1,0 +1,108 @@
+// How a scene's frames are drawn, and the live view. docs/scenes.md#the-live-view
+#include "scenes/live_view.hpp"
+
+#include "common/error.hpp"
+#include "common/interrupt.hpp"
+
+#include <array>
+#include <chrono>
+#include <iostream>
+#include <thread>
+
+namespace fem::scenes {
+
+fig::RenderOptions frame_view(const SceneSpec& scene)
+{
+    const OutputSpec& out = scene.output;
+    fig::RenderOptions view;
+    view.title = scene.title;
+    view.field = out.colour;
+    view.view_direction = {out.view_direction.x(), out.view_direction.y(), out.view_direction.z()};
+    view.view_up = {out.view_up.x(), out.view_up.y(), out.view_up.z()};
+    view.width = out.width;
+    view.height = out.height;
+    view.frame_bounds = out.frame_box;
+    view.range = out.colour_range;
+    return view;
+}
+
+std::string frame_title(const SceneSpec& scene, double time)
+{
+    // As io::MotionRecorder::render_png_frames titles a frame.
+    const double warp = scene.output.warp;
+    const std::string scale = warp == 1.0 ? std::string() : str(" (displacement x ", warp, ")");
+    return str(scene.title, scale, ", t = ", time, " s");
+}
+
+// --- LiveView -------------------------------------------------------------------------------------
+
+LiveView::LiveView(const SceneSpec& scene, std::filesystem::path screenshot, int screenshot_step)
+    : scene_(scene), window_(frame_view(scene), str("fem_scene: ", scene.title)), screenshot_(std::move(screenshot)),
+      screenshot_step_(screenshot_step)
+{
+    fields_ = {scene.output.colour};
+    for (const std::string& field : scene.output.fields)
+        if (field != scene.output.colour)
+            fields_.push_back(field);
+    if (scene.output.colour != io::displacement_field)
+        fields_.push_back(io::displacement_field);
+}
+
+void LiveView::frame(const io::MeshData& frame, int step, double time)
+{
+    const io::MeshData shown = io::warped(frame, scene_.output.warp);
+    const auto draw = [&] {
+        fig::RenderOptions view = frame_view(scene_);
+        view.field = fields_[field_];
+        if (field_ != 0)
+            view.range.reset();  // the fixed range belongs to the scene's colour field
+        view.title = frame_title(scene_, time);
+        if (!view.frame_bounds) {  // no box fixed: the rest shape, grown by half its size each way
+            std::array<double, 6> box{};
+            for (int axis = 0; axis < 3; ++axis) {
+                const double low = frame.points.col(axis).minCoeff(), high = frame.points.col(axis).maxCoeff();
+                const double margin = 0.5 * (frame.points.colwise().maxCoeff() - frame.points.colwise().minCoeff()).norm();
+                box[2 * axis] = low - margin;
+                box[2 * axis + 1] = high + margin;
+            }
+            view.frame_bounds = box;
+        }
+        window_.show(shown, view);
+    };
+    draw();
+    if (step == screenshot_step_)
+        window_.save_png(screenshot_);
+    // Real time: the next frame comes no sooner than one frame interval after this one.
+    while (!paused_ && clock_.seconds() < 1.0 / scene_.output.frame_rate)
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    clock_.restart();
+    bool advance = false, announced = false;
+    do {
+        for (char key : window_.poll_keys()) {
+            if (key == ' ') {
+                paused_ = !paused_;
+                if (!paused_)
+                    std::cout << "resumed" << std::endl;
+            } else if (key == '>' && paused_)
+                advance = true;
+            else if (key == 'r')
+                throw Restart{};
+            else if (key == 'q')
+                request_stop();
+            else if (key == 'c') {
+                field_ = (field_ + 1) % fields_.size();
+                draw();
+            }
+        }
+        if (paused_ && !advance && !announced) {
+            // Said once per frame it waits on, when this frame's files are written and it is shown:
+            // a script driving the window waits for the line (tests/scenes/test_runner.cpp).
+            std::cout << "paused at step " << step << " (t = " << time << " s)" << std::endl;
+            announced = true;
+        }
+        if (paused_ && !advance)
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    } while (paused_ && !advance && !stop_requested());
+}
+
+}  // namespace fem::scenes

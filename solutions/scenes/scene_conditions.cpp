@@ -1,0 +1,102 @@
+// What a scene changes between steps: loads, moving pins, auto's model. docs/scenes.md#the-runner
+#include "scenes/scene_conditions.hpp"
+
+#include "13_skinning/skinning.hpp"
+
+#include "common/error.hpp"
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace fem::scenes {
+
+Eigen::VectorXd applied_loads(const BodySpec& body, const MatrixX3i& boundary, double t)
+{
+    Eigen::VectorXd f = Eigen::VectorXd::Zero(3 * body.mesh.V.rows());
+    for (const Load& load : body.loads) {
+        const double scale = t > load.until ? 0.0 : load.ramp > 0.0 ? std::min(1.0, t / load.ramp) : 1.0;
+        if (scale == 0.0)
+            continue;
+        const std::vector<int>& vertices = load.select.vertices;
+        if (load.kind == Load::Kind::point) {
+            const Eigen::Vector3d share = scale * load.value / static_cast<double>(vertices.size());
+            for (int v : vertices)
+                f.segment<3>(3 * v) += share;
+            continue;
+        }
+        std::vector<char> selected(static_cast<std::size_t>(body.mesh.V.rows()), 0);
+        for (int v : vertices)
+            selected[static_cast<std::size_t>(v)] = 1;
+        for (Eigen::Index i = 0; i < boundary.rows(); ++i) {
+            const int a = boundary(i, 0), b = boundary(i, 1), c = boundary(i, 2);
+            if (!selected[a] || !selected[b] || !selected[c])
+                continue;
+            const Eigen::Vector3d A = body.mesh.V.row(a), B = body.mesh.V.row(b), C = body.mesh.V.row(c);
+            const double area = 0.5 * (B - A).cross(C - A).norm();
+            for (int v : {a, b, c})
+                f.segment<3>(3 * v) += (scale * area / 3.0) * load.value;
+        }
+    }
+    return f;
+}
+
+SceneConditions::SceneConditions(const BodySpec& body, const SceneSpec& scene, SceneForces* forces, bool automatic)
+    : body_(&body), scene_(&scene), forces_(forces), automatic_(automatic && forces != nullptr)
+{
+    for (const Pin& pin : body.pins)
+        pins_move_ = pins_move_ || pin.motion.kind != Motion::Kind::fixed;
+    for (const Load& load : body.loads)
+        loads_change_ = loads_change_ || load.ramp > 0.0 || std::isfinite(load.until);
+    if (!body.loads.empty())
+        boundary_ = skin::boundary_faces(body.mesh).faces;
+    // A surface load must cover at least one boundary triangle: one that covers none applies nothing.
+    for (const Load& load : body.loads) {
+        if (load.kind != Load::Kind::surface)
+            continue;
+        BodySpec alone = body;
+        alone.loads = {load};
+        alone.loads.front().ramp = 0.0;
+        alone.loads.front().until = std::numeric_limits<double>::infinity();
+        if (applied_loads(alone, boundary_, 0.0).cwiseAbs().maxCoeff() == 0.0 && load.value.norm() > 0.0)
+            throw Error(str(load.select.where, ": this surface load's vertices span no boundary triangle of body '",
+                            body.name, "' (all three corners of a boundary triangle must be selected), so it would "
+                            "apply nothing; select a whole face of the surface"));
+    }
+    initial_loads_ = applied_loads(body, boundary_, 0.0);
+}
+
+bool SceneConditions::operator()(dynamics::Body& body, const dynamics::State& state, double step_end)
+{
+    bool changed = false;
+    if (loads_change_) {
+        body.set_applied_loads(applied_loads(*body_, boundary_, step_end));
+        changed = true;
+    }
+    if (pins_move_) {
+        const double dt = step_end - state.time;
+        Eigen::VectorXd velocity = Eigen::VectorXd::Zero(state.u.size());
+        for (const Pin& pin : body_->pins) {
+            if (pin.motion.kind == Motion::Kind::fixed)
+                continue;
+            for (int v : pin.select.vertices) {
+                const Eigen::Vector3d g = prescribed_displacement(pin.motion, body_->mesh.V.row(v).transpose(), step_end);
+                velocity.segment<3>(3 * v) = (g - state.u.segment<3>(3 * v)) / dt;
+            }
+        }
+        body.set_pin_velocity(velocity);
+    }
+    if (automatic_) {
+        const Level next = choose_level(deformation_measures(body_->mesh, body.positions(state.u), scene_->thresholds),
+                                        forces_->level(), scene_->thresholds);
+        if (next != forces_->level()) {
+            forces_->set_level(next);
+            changed = true;
+        }
+    }
+    return changed;
+}
+
+}  // namespace fem::scenes
