@@ -88,8 +88,9 @@ LocateMethod parse_method(const std::string& name);
 /// Every method returns the same tet: the LOWEST-NUMBERED tet with min φᵢ ≥ −tolerance, or -1. A
 /// point on a shared face, edge or vertex lies in several tets; this rule picks one of them
 /// independently of the search (the grid and the tree test all their candidates and keep the lowest
-/// number). Each tet's box is padded by tolerance × its longest edge, so that a point the tolerance
-/// admits is never missed by the box tests. docs/13_skinning.md#point-location
+/// number). Each tet's box is padded by 3 × tolerance × its longest edge: the points the tolerance
+/// admits form the tet scaled by 1 + 4 × tolerance about its centroid, which reaches that far beyond
+/// a corner, so the box tests never miss one. docs/13_skinning.md#point-location
 class PointLocator {
 public:
     virtual ~PointLocator() = default;

@@ -33,11 +33,15 @@ bool contains(const Eigen::Vector4d& phi, double tolerance)
     return phi.minCoeff() >= -tolerance;
 }
 
-/// The box of tet t grown by tolerance × its longest edge on every side.
+/// The box of tet t grown by 3 × tolerance × its longest edge ℓ on every side. The points the
+/// tolerance admits, {φᵢ ≥ −tolerance}, form the tet scaled by 1 + 4·tolerance about its centroid c
+/// (φᵢ(c + s(X − c)) = ¼ + s(φᵢ(X) − ¼)), which reaches 4·tolerance·|Xᵢ − c| beyond corner i, and
+/// |Xᵢ − c| = |Σⱼ (Xᵢ − Xⱼ)| / 4 ≤ ¾ ℓ: up to 3·tolerance·ℓ (a needle tet comes close), three
+/// times the reach beyond a face.
 Eigen::Matrix<double, 2, 3> padded_box(const BarycentricFrames& frames, int t, double tolerance)
 {
     Eigen::Matrix<double, 2, 3> box = frames.box(t);
-    const double pad = tolerance * frames.longest_edge(t);
+    const double pad = 3.0 * tolerance * frames.longest_edge(t);
     box.row(0).array() -= pad;
     box.row(1).array() += pad;
     return box;

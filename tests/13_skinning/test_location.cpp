@@ -16,6 +16,8 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
+#include <memory>
 #include <vector>
 
 using namespace fem;
@@ -169,6 +171,95 @@ TEST_CASE("points just outside, by the tree: none beyond the tolerance, the face
 {
     const BarycentricFrames frames(bunny_tets());
     check_just_outside(frames, AabbTree(frames, 1e-3), 1e-3);
+}
+
+namespace {
+
+/// One tet with the given corners.
+TetMesh one_tet(const Eigen::Matrix<double, 4, 3>& corners)
+{
+    TetMesh mesh;
+    mesh.V = corners;
+    mesh.T.resize(1, 4);
+    mesh.T << 0, 1, 2, 3;
+    return mesh;
+}
+
+/// The admitted set {φᵢ ≥ −τ} of a tet is the tet scaled by 1 + 4τ about its centroid c: the point
+/// Xᵢ + 4τ·reach·(Xᵢ − c) beyond corner i has φᵢ = 1 + 3τ·reach and the other three −τ·reach, so it
+/// is admitted for reach ≤ 1 and not beyond. Returns these points for every corner of every k-th tet.
+std::vector<Eigen::Vector3d> beyond_corners(const TetMesh& mesh, double tolerance, double reach, int every)
+{
+    std::vector<Eigen::Vector3d> points;
+    for (Eigen::Index t = 0; t < mesh.T.rows(); t += every) {
+        const tet::TetVertices X = tet::tet_vertices(mesh, mesh.V, static_cast<int>(t));
+        const Eigen::RowVector3d c = X.colwise().mean();
+        for (int i = 0; i < 4; ++i)
+            points.push_back((X.row(i) + 4.0 * tolerance * reach * (X.row(i) - c)).transpose());
+    }
+    return points;
+}
+
+/// How far p lies outside tet t's (unpadded) box, in units of τ × its longest edge: the padding
+/// the box tests need for p.
+double padding_needed(const BarycentricFrames& frames, int t, const Eigen::Vector3d& p, double tolerance)
+{
+    const Eigen::Matrix<double, 2, 3> box = frames.box(t);
+    const double outside = std::max({0.0, (box.row(0).transpose() - p).maxCoeff(), (p - box.row(1).transpose()).maxCoeff()});
+    return outside / (tolerance * frames.longest_edge(t));
+}
+
+/// Points just inside the admitted set beyond the corners of single tets (a right-angled corner tet,
+/// a needle, a sliver-like flat one) and of every 13th tet of the bunny: the locator finds the tet
+/// brute force finds; just outside it, none is found in the single tets. A box padded by τ × the
+/// longest edge (instead of 3τ) misses them: the needle's points need 2.9τ.
+void check_beyond_corners(LocateMethod method)
+{
+    const double tolerance = 0.1;
+    const double inside = 1.0 - 1e-9, outside = 1.0 + 1e-6;
+    Eigen::Matrix<double, 4, 3> corner, needle, flat;
+    corner << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
+    needle << 1, 0, 0, 0, 0, 0, 0, 0, 0.1, 0, 0.1, 0;
+    flat << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0.4, 0.4, 0.05;
+    for (const Eigen::Matrix<double, 4, 3>* tet : {&corner, &needle, &flat}) {
+        const BarycentricFrames frames(one_tet(*tet));
+        const std::unique_ptr<PointLocator> locator = make_locator(method, frames, tolerance);
+        const std::vector<Eigen::Vector3d> admitted = beyond_corners(frames.mesh(), tolerance, inside, 1);
+        double needed = 0.0;
+        for (const Eigen::Vector3d& p : admitted) {
+            REQUIRE(locate_brute_force(frames, p, tolerance).tet == 0);  // the geometry above, independently
+            needed = std::max(needed, padding_needed(frames, 0, p, tolerance));
+        }
+        INFO("tet corners\n" << *tet << "\nthe points need a box padded by " << needed
+             << " x tolerance x longest edge; a locator that misses them pads its boxes by less (the admitted "
+                "set is the tet scaled by 1 + 4 tolerance about its centroid: up to 3 tolerance x longest edge "
+                "beyond a corner, docs/13_skinning.md#point-location)");
+        CHECK(needed > 1.0);  // these points are the ones a padding of τ × the longest edge misses
+        check_against_brute_force(frames, *locator, admitted, tolerance);
+        for (const Eigen::Vector3d& p : beyond_corners(frames.mesh(), tolerance, outside, 1)) {
+            CHECK(locate_brute_force(frames, p, tolerance).tet == -1);
+            CHECK(locator->locate(p).tet == -1);
+        }
+        if (tet == &needle)
+            CHECK(needed > 2.9);
+    }
+    const BarycentricFrames bunny_frames(bunny_tets());
+    check_against_brute_force(bunny_frames, *make_locator(method, bunny_frames, tolerance),
+                              beyond_corners(bunny_frames.mesh(), tolerance, inside, 13), tolerance);
+}
+
+}  // namespace
+
+TEST_CASE("points just inside the tolerance beyond a corner, by the grid: the brute force's tet (boxes padded by 3 tolerance x longest edge)",
+          "[ex13.2]")
+{
+    check_beyond_corners(LocateMethod::grid);
+}
+
+TEST_CASE("points just inside the tolerance beyond a corner, by the tree: the brute force's tet (boxes padded by 3 tolerance x longest edge)",
+          "[ex13.3]")
+{
+    check_beyond_corners(LocateMethod::tree);
 }
 
 TEST_CASE("the coarse lattice encloses the bunny: every vertex inside, brute force and chapter 04 agree", "[ex13.1]")
