@@ -254,7 +254,7 @@ TEST_CASE("fem_scene refuses bad scene files with one error line and writes noth
 TEST_CASE("the live view shows the PNG frame of the same step, pixel for pixel", "[scenes]")
 {
     if (std::getenv("DISPLAY") == nullptr) {
-        WARN("no X display: run the tests under xvfb-run -a to check the live view");
+        WARN("SKIPPED: no X display: run the tests under xvfb-run -a to check the live view");
         return;
     }
     const std::filesystem::path base = output / "view";
@@ -289,7 +289,7 @@ TEST_CASE("the live view without a display: one line says so and the run goes on
 TEST_CASE("the video: ffmpeg makes it from the PNG frames, or one line says it is missing", "[scenes]")
 {
     if (std::getenv("DISPLAY") == nullptr) {
-        WARN("no X display, so no PNG frames to make a video of: run the tests under xvfb-run -a");
+        WARN("SKIPPED: no X display, so no PNG frames to make a video of: run the tests under xvfb-run -a");
         return;
     }
     const std::string scene = (gallery / "cantilever.toml").string();
@@ -416,7 +416,7 @@ TEST_CASE("the live view's keys: space pauses, the right arrow steps, space resu
 {
     Display* display = std::getenv("DISPLAY") ? XOpenDisplay(nullptr) : nullptr;
     if (display == nullptr) {
-        WARN("no X display: run the tests under xvfb-run -a to check the live view's keys");
+        WARN("SKIPPED: no X display: run the tests under xvfb-run -a to check the live view's keys");
         return;
     }
     const std::filesystem::path out = output / "keys";
