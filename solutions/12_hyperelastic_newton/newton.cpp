@@ -38,11 +38,11 @@ StepDamping::StepDamping(dynamics::Body& body, const Eigen::VectorXd& u_start)
 
 Eigen::VectorXd StepDamping::times(const Eigen::VectorXd& v) const
 {
-    if (M_ == nullptr)
-        return Eigen::VectorXd::Zero(v.size());
-    if (v.size() != M_->rows())
+    if (M_ != nullptr && v.size() != M_->rows())
         throw Error(str("StepDamping: v must have 3n = ", M_->rows(), " entries, got ", v.size()));
-    Eigen::VectorXd Dv = coefficients_.alpha * (*M_ * v);
+    Eigen::VectorXd Dv = Eigen::VectorXd::Zero(v.size());
+    if (coefficients_.alpha != 0.0)
+        Dv += coefficients_.alpha * (*M_ * v);
     if (coefficients_.beta != 0.0)
         Dv += coefficients_.beta * (K_start_ * v);
     return Dv;
