@@ -175,7 +175,8 @@ void StagedFiles::publish(const std::vector<std::string>& obsolete)
 std::filesystem::path data_path(std::string_view file_name)
 {
     const std::filesystem::path path = std::filesystem::path(FEM_DATA_DIR) / file_name;
-    if (!std::filesystem::exists(path))
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec))  // ec: a name too long is an Error like a missing one
         throw Error(str("data file '", path.string(), "' does not exist"));
     return path;
 }

@@ -160,16 +160,21 @@ TetMesh tetrahedralize(const TriMesh& surface, const std::string& switches, cons
         return io::read_tet_mesh(node);
     if (exited && WEXITSTATUS(run.status) == 127)
         throw Error(str(what, ": the tetgen program is not installed (tools/setup.sh installs it)"));
-    const std::string reason = tetgen_reason(run.output);
-    const bool signalled = WIFSIGNALED(run.status);
-    if (signalled && WTERMSIG(run.status) == SIGXCPU)
+    std::string reason = tetgen_reason(run.output);
+    if (WIFSIGNALED(run.status) && WTERMSIG(run.status) == SIGXCPU)
         throw Error(str(what, ": TetGen exceeded its limit of ", limits.seconds, " s of processor time with switches '",
                         switches, "'; ", advice));
-    if (reason.find("emory") != std::string::npos || reason.find("bad_alloc") != std::string::npos || signalled)
-        throw Error(str(what, ": TetGen ", signalled ? str("ended with signal ", WTERMSIG(run.status)) : reason,
-                        " with switches '", switches, "' (its memory limit is ", limits.memory >> 20, " MB); ", advice));
+    // Out of memory, TetGen 1.5 throws its error code (an int) past its main: "terminate called
+    // after throwing an instance of 'int'", the same words as for a few of its other failures.
+    if (reason.find("emory") != std::string::npos || reason.find("bad_alloc") != std::string::npos ||
+        reason.find("instance of 'int'") != std::string::npos)
+        throw Error(str(what, ": TetGen gave up with switches '", switches, "' (", reason,
+                        "): out of memory within its limit of ", limits.memory >> 20,
+                        " MB, or a surface it cannot mesh; ", advice));
+    if (reason.empty())
+        reason = WIFSIGNALED(run.status) ? str("it ended with signal ", WTERMSIG(run.status)) : "no output";
     throw Error(str(what, ": TetGen could not tetrahedralise the surface (does it enclose a volume, closed and ",
-                    "free of self-intersections?): ", reason.empty() ? "no output" : reason));
+                    "free of self-intersections?): ", reason));
 }
 
 }  // namespace fem

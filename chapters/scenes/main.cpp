@@ -83,6 +83,9 @@ int main(int argc, char** argv)
             throw Error("--view: plays one run; --compare runs many without frames");
         for (const std::string& file : files) {
             scenes.push_back(read_scene(file, settings, quick));
+            cli.protect_inputs(input_files(scenes.back()));  // --out must not overlap what is read
+            if (!compare)  // the frames folder <scene>/ must not replace a folder of someone else's
+                cli.writes_entry(scenes.back().file.stem().string());
             if (const SceneSpec& scene = scenes.back(); scene.skin) {
                 std::shared_ptr<const SkinObserver> bound = make_skin_observer(*scene.skin, scene.bodies[skin_body(scene)]);
                 if (scenes.size() == 1)

@@ -15,6 +15,7 @@
 #include "10_linear_dynamics/body.hpp"
 
 #include "common/mesh.hpp"
+#include "common/tetgen.hpp"
 
 #include <Eigen/Core>
 
@@ -160,15 +161,49 @@ struct SceneSpec {
     std::optional<SkinSpec> skin;
 };
 
+/// The deepest nesting a scene file (or a --set value) may have: tables of headers and dotted
+/// keys, arrays and inline tables together. Deeper text is refused before it is parsed.
+constexpr int max_nesting = 32;
+
+/// The largest scene file read [bytes].
+constexpr long long max_scene_bytes = 16ll << 20;
+
+/// What reading a scene may do and use; the defaults are those of a run.
+struct ReadLimits {
+    bool tetgen = true;             ///< tetrahedralise a surface mesh file with TetGen (else an error)
+    TetgenLimits tetgen_limits;     ///< TetGen's time and memory
+    /// The memory a run of the scene may need [bytes] (see memory_estimate); 0: the memory the
+    /// machine has available now (and the process's address-space limit, if lower).
+    std::size_t memory = 0;
+};
+
 /// Reads and checks a scene file: first the [quick] table's overrides when quick is set, then
 /// each "key=value" of overrides (the --set options; value in TOML syntax, or else a string),
 /// then every field. Builds every body's mesh (TetGen for a surface file) and selects its pinned
 /// vertices. fem::Error naming the file, line and column, the field and what is allowed, for a
-/// missing or unreadable file, a syntax error, an unknown field, a wrong type or value, a mesh
-/// without tets, a selection that selects nothing, or a surface TetGen cannot tetrahedralise.
-/// docs/scenes.md#the-scene-file
+/// missing or unreadable file, a file over max_scene_bytes or nested deeper than max_nesting, a
+/// syntax error, an unknown field, a wrong type or value, a mesh without tets, a selection that
+/// selects nothing, a surface TetGen cannot tetrahedralise (within limits), or a scene that needs
+/// more memory than limits allow (naming the field to change). docs/scenes.md#the-scene-file
 SceneSpec read_scene(const std::filesystem::path& path, const std::vector<std::string>& overrides = {},
-                     bool quick = false);
+                     bool quick = false, const ReadLimits& limits = {});
+
+/// What a run of one body needs: its unknowns, the entries of its Cholesky factor, and the memory
+/// of the mesh, the matrices, the per-tet data of every model and the factor together.
+struct MemoryEstimate {
+    long long dofs = 0;           ///< 3 per vertex
+    double factor_nonzeros = 0;   ///< entries of the Cholesky factor (a nested-dissection fill estimate)
+    double bytes = 0;             ///< the whole run [bytes]
+};
+
+/// The memory a run of a body of this many vertices and tets needs (an estimate that errs high):
+/// read_scene refuses a scene whose bodies together need more than ReadLimits::memory, before it
+/// builds a box mesh and after it reads a file mesh. docs/scenes.md#limits
+MemoryEstimate memory_estimate(long long vertices, long long tets);
+
+/// The files a scene reads: the scene file, its bodies' mesh files (a TetGen pair's .node and
+/// .ele) and its skin. fem_scene refuses an --out that overlaps one (common/cli.hpp).
+std::vector<std::filesystem::path> input_files(const SceneSpec& scene);
 
 /// Chapter 10's Scene of one body of a scene: its mesh, material, pinned vertices, damping and mass,
 /// the scene's gravity, Δt and duration.
@@ -183,10 +218,5 @@ Eigen::Vector3d prescribed_displacement(const Motion& motion, const Eigen::Vecto
 /// The triangles on the boundary of a tet mesh (faces of one tet only), outward by the tet's
 /// orientation (#F×3).
 MatrixX3i boundary_faces(const TetMesh& mesh);
-
-/// Tetrahedralises a closed triangle surface with Debian's tetgen program and the given switches
-/// ("pq1.5aY": a piecewise linear complex, quality 1.5, the surface kept). fem::Error with TetGen's
-/// reason when it fails (an open or self-intersecting surface) or is not installed.
-TetMesh tetrahedralize(const TriMesh& surface, const std::string& switches, const std::string& what);
 
 }  // namespace fem::scenes

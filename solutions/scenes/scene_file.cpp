@@ -9,6 +9,7 @@
 #include "common/error.hpp"
 #include "common/files.hpp"
 #include "common/mesh_io.hpp"
+#include "common/tetgen.hpp"
 
 #include <toml++/toml.h>
 
@@ -17,12 +18,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <fstream>
 #include <map>
 #include <set>
+#include <sys/resource.h>
 #include <sstream>
-#include <unistd.h>
 
 namespace fem::scenes {
 
@@ -35,6 +35,11 @@ const std::vector<std::string>& model_names()
 
 namespace {
 
+// The memory estimate's constants (memory_estimate).
+constexpr double fill_per_vertex_block = 1.0;  ///< factor blocks per vertex^(4/3)
+constexpr double bytes_per_tet = 3000.0;       ///< the mesh, per-tet matrices and frames
+constexpr double bytes_per_vertex = 4000.0;    ///< positions, velocities, the matrices' rows
+
 std::string joined(const std::vector<std::string>& names)
 {
     std::string out;
@@ -43,11 +48,112 @@ std::string joined(const std::vector<std::string>& names)
     return out;
 }
 
+/// text itself, or when longer than 200 characters its start and end with the count between (a
+/// name or key of megabytes is not echoed whole).
+std::string clipped(const std::string& text)
+{
+    constexpr std::size_t most = 200;
+    if (text.size() <= most)
+        return text;
+    return str(text.substr(0, 100), "[... ", text.size() - 180, " characters ...]", text.substr(text.size() - 80));
+}
+
+/// Refuses TOML text nested deeper than max_nesting levels (tables of headers and dotted keys,
+/// arrays and inline tables together) before toml++ parses it: its parser and the tables it builds
+/// recurse once per level, and tens of thousands of levels overflow the stack. what names the text
+/// (the file, or the --set option), followed by :line:column when with_position.
+void check_nesting(std::string_view text, const std::string& what, bool with_position)
+{
+    int line = 1, column = 0;
+    int header = 0;                 // levels of the current [table] header
+    std::vector<int> opened;        // '[' or '{' of the open arrays and inline tables
+    std::vector<int> key_levels;    // the dotted-key levels at each of them
+    int key = 0;                    // dots of the key being read
+    bool key_position = true, in_header = false, start_of_line = true;
+    for (std::size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        ++column;
+        if (c == '\n') {
+            ++line;
+            column = 0;
+            if (opened.empty()) {
+                key_position = true;
+                key = 0;
+                start_of_line = true;
+            }
+            continue;
+        }
+        if (c == '#') {  // a comment, to the end of the line
+            while (i + 1 < text.size() && text[i + 1] != '\n')
+                ++i;
+            continue;
+        }
+        if (c == '"' || c == '\'') {  // a string: skipped, escapes and multi-line ones included
+            const bool triple = text.substr(i, 3) == std::string(3, c);
+            const std::string_view close = triple ? std::string_view(&text[i], 3) : std::string_view(&text[i], 1);
+            std::size_t j = i + close.size();
+            while (j < text.size() && text.substr(j, close.size()) != close) {
+                if (c == '"' && text[j] == '\\')
+                    ++j;
+                if (j < text.size() && text[j] == '\n') {
+                    ++line;
+                    column = 0;
+                }
+                ++j;
+            }
+            i = std::min(text.size(), j + close.size()) - 1;
+            start_of_line = false;
+            continue;
+        }
+        if (c == ' ' || c == '\t' || c == '\r')
+            continue;
+        if (start_of_line && opened.empty() && c == '[') {  // a header [a.b] or [[a.b]]
+            in_header = true;
+            header = 1;
+            start_of_line = false;
+            continue;
+        }
+        start_of_line = false;
+        if (in_header) {
+            if (c == '.')
+                ++header;
+            else if (c == ']' && (i + 1 >= text.size() || text[i + 1] != ']'))
+                in_header = false;
+        } else if (key_position && c == '.') {
+            ++key;
+        } else if (c == '=') {
+            key_position = false;
+        } else if (c == '[' || c == '{') {
+            opened.push_back(c);
+            key_levels.push_back(key);
+            key_position = c == '{';
+            key = 0;
+        } else if ((c == ']' || c == '}') && !opened.empty()) {
+            opened.pop_back();
+            key = key_levels.back();
+            key_levels.pop_back();
+            key_position = false;
+        } else if (c == ',' && !opened.empty()) {
+            key_position = opened.back() == '{';
+            key = 0;
+        }
+        int levels = header + key + static_cast<int>(opened.size());
+        for (int k : key_levels)
+            levels += k;
+        if (levels > max_nesting)
+            throw Error(str(what, with_position ? str(":", line, ":", column) : std::string(), ": nested deeper than ",
+                            max_nesting, " levels (tables, dotted keys, arrays and inline tables together); a scene ",
+                            "needs fewer than 10"));
+    }
+}
+
 /// Where the fields being read come from: the scene file, and the overrides that replaced some of
 /// them (the field path as given, e.g. "body.material.model", and the option that set it).
 struct Source {
     std::string file;
     std::vector<std::pair<std::string, std::string>> overrides;
+    ReadLimits limits;
+    mutable double estimated_bytes = 0.0;  ///< the memory estimates of the bodies read so far, summed
 
     /// The option that set a field (e.g. "--set body.0.material.poisson_ratio=0.5"), matched on the
     /// path without array indices; empty when none did.
@@ -99,7 +205,7 @@ public:
 
     [[noreturn]] void fail(const toml::node& node, const std::string& key, const std::string& message) const
     {
-        throw Error(str(where(node, key), ": ", field(key), ": ", message));
+        throw Error(str(where(node, key), ": ", clipped(field(key)), ": ", message));
     }
     [[noreturn]] void missing(const std::string& key, const std::string& message) const
     {
@@ -251,7 +357,7 @@ public:
     {
         std::ostringstream out;
         if (node.is_string())
-            out << "'" << *node.value<std::string>() << "'";
+            out << "'" << clipped(*node.value<std::string>()) << "'";
         else if (node.is_boolean())
             out << (*node.value<bool>() ? "true" : "false");
         else if (node.is_number())
@@ -372,16 +478,65 @@ std::vector<std::string> with(std::vector<std::string> keys, const std::vector<s
     return keys;
 }
 
+/// Whether path exists as a regular file; false, not an exception, for a name the system refuses
+/// (too long). A folder, a device or a pipe is no mesh (reading a pipe could wait for ever).
+bool file_exists(const std::filesystem::path& path)
+{
+    std::error_code ec;
+    return std::filesystem::is_regular_file(path, ec);
+}
+
+/// The file a scene names: an absolute path as given, else beside the scene file, else in data/.
 std::filesystem::path resolve(const std::filesystem::path& scene_file, const std::string& name)
 {
     const std::filesystem::path given(name);
     if (given.is_absolute())
         return given;
     const std::filesystem::path beside = scene_file.parent_path() / given;
-    if (std::filesystem::exists(beside))
+    if (file_exists(beside))
         return beside;
-    const std::filesystem::path data = data_path(name);
-    return std::filesystem::exists(data) ? data : beside;
+    try {
+        return data_path(name);
+    } catch (const Error&) {
+        return beside;  // in neither place: the error names the first tried
+    }
+}
+
+/// The memory this process may still use [bytes]: the system's available memory (MemAvailable of
+/// /proc/meminfo), or the address-space limit (ulimit -v) when it is lower.
+double available_memory()
+{
+    double available = std::numeric_limits<double>::infinity();
+    std::ifstream meminfo("/proc/meminfo");
+    for (std::string key; meminfo >> key;) {
+        double kilobytes = 0.0;
+        meminfo >> kilobytes;
+        if (key == "MemAvailable:")
+            available = kilobytes * 1024.0;
+        meminfo.ignore(std::numeric_limits<std::streamsize>::max(), '\n');
+    }
+    rlimit limit{};
+    if (::getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY)
+        available = std::min(available, static_cast<double>(limit.rlim_cur));
+    return available;
+}
+
+/// Refuses a body whose run would need more memory than the scene may use (see memory_estimate),
+/// the bodies read before it included: the error is at field, the field to change.
+void check_memory(const Fields& fields, const toml::node& node, const std::string& key, long long vertices,
+                  long long tets, const std::string& change)
+{
+    const MemoryEstimate need = memory_estimate(vertices, tets);
+    const Source& source = fields.source();
+    const double budget = source.limits.memory > 0 ? static_cast<double>(source.limits.memory) : available_memory();
+    if (source.estimated_bytes + need.bytes > budget)
+        fields.fail(node, key, str("a run of this mesh needs about ", std::ceil(need.bytes / 1e6), " MB (", tets, " tets, ",
+                                   need.dofs, " unknowns, about ", need.factor_nonzeros, " factor entries)",
+                                   source.estimated_bytes > 0 ? str(" besides ", std::ceil(source.estimated_bytes / 1e6),
+                                                                    " MB for the bodies before it")
+                                                              : std::string(),
+                                   ", more than the ", std::floor(budget / 1e6), " MB available: ", change));
+    source.estimated_bytes += need.bytes;
 }
 
 TetMesh build_mesh(const Fields& fields, const std::filesystem::path& scene_file, MeshSpec& spec)
@@ -406,6 +561,9 @@ TetMesh build_mesh(const Fields& fields, const std::filesystem::path& scene_file
         for (const std::string key : {"tetgen", "lattice"})
             if (fields.has(key))
                 fields.fail(*fields.get(key), key, "belongs to a surface file");
+        const Eigen::Vector3<long long> cells = spec.cells.cast<long long>();
+        check_memory(fields, fields.has("cells") ? *fields.get("cells") : *fields.get("generator"), "cells",
+                     (cells.array() + 1).prod(), 6 * cells.prod(), "use fewer cells");
         mesh = box_mesh(spec.cells.x(), spec.cells.y(), spec.cells.z(), spec.size);
     } else {
         for (const std::string key : {"size", "cells"})
@@ -414,8 +572,8 @@ TetMesh build_mesh(const Fields& fields, const std::filesystem::path& scene_file
         const std::string name = fields.text("file", "");
         spec.file = resolve(scene_file, name);
         const toml::node& node = *fields.get("file");
-        if (!std::filesystem::exists(spec.file))
-            fields.fail(node, "file", str("no such file: ", spec.file.string()));
+        if (!file_exists(spec.file))
+            fields.fail(node, "file", str("no such file: ", clipped(spec.file.string()), " (looked beside the scene file, then in the data folder)"));
         const std::string extension = spec.file.extension().string();
         try {
             if (extension == ".obj" || extension == ".stl" || extension == ".ply") {
@@ -427,7 +585,10 @@ TetMesh build_mesh(const Fields& fields, const std::filesystem::path& scene_file
                     mesh = skin::enclosing_lattice(io::read_tri_mesh(spec.file), spec.lattice);
                 } else {
                     spec.tetgen = fields.text("tetgen", spec.tetgen);
-                    mesh = tetrahedralize(io::read_tri_mesh(spec.file), spec.tetgen, spec.file.string());
+                    if (!fields.source().limits.tetgen)
+                        fields.fail(node, "file", "a surface to tetrahedralise, and TetGen is not allowed here");
+                    mesh = tetrahedralize(io::read_tri_mesh(spec.file), spec.tetgen, spec.file.string(),
+                                          fields.source().limits.tetgen_limits);
                 }
             } else if (extension == ".node" || extension == ".ele" || extension == ".vtu") {
                 for (const std::string key : {"tetgen", "lattice"})
@@ -445,6 +606,9 @@ TetMesh build_mesh(const Fields& fields, const std::filesystem::path& scene_file
             fields.fail(node, "file", text);
         }
         mesh.V *= spec.scale;
+        if (mesh.T.rows() > 0)
+            check_memory(fields, node, "file", mesh.V.rows(), mesh.T.rows(),
+                         fields.has("lattice") ? "use a smaller lattice" : "use a coarser mesh (or larger TetGen volumes)");
     }
     if (mesh.T.rows() == 0)
         fields.fail(*fields.get(file ? "file" : "generator"), file ? "file" : "generator", "the mesh has no tets");
@@ -575,9 +739,9 @@ void assign(toml::table& table, const std::vector<std::string>& parts, std::size
     } else if (child->is_array_of_tables()) {
         toml::array& items = *child->as_array();
         if (all_digits(parts[at + 1])) {
-            const std::size_t index = std::stoul(parts[at + 1]);
+            const std::size_t index = parts[at + 1].size() > 9 ? items.size() : std::stoul(parts[at + 1]);
             if (index >= items.size())
-                throw Error(str(option, ": ", key, " has ", items.size(), " entries, no ", index));
+                throw Error(str(option, ": ", key, " has ", items.size(), " entries, no ", clipped(parts[at + 1])));
             if (at + 2 == parts.size())
                 throw Error(str(option, ": name a field of ", key, "[", index, "]"));
             assign(*items.get(index)->as_table(), parts, at + 2, value, option);
@@ -600,7 +764,10 @@ void apply_override(toml::table& root, const std::string& setting, const std::st
     const std::vector<std::string> parts = split_path(key);
     for (const std::string& part : parts)
         if (part.empty())
-            throw Error(str(option, ": the key '", key, "' has an empty part"));
+            throw Error(str(option, ": the key '", clipped(key), "' has an empty part"));
+    if (parts.size() > static_cast<std::size_t>(max_nesting))
+        throw Error(str(option, ": the key has ", parts.size(), " parts; at most ", max_nesting, " are allowed"));
+    check_nesting("value = " + text, option, false);
     // The value in TOML syntax (a number, true, [1, 2, 3], "text"); anything else is a string.
     toml::table parsed;
     try {
@@ -635,19 +802,36 @@ void flatten(const toml::table& table, const std::string& prefix, std::vector<st
 
 }  // namespace
 
-SceneSpec read_scene(const std::filesystem::path& path, const std::vector<std::string>& overrides, bool quick)
+SceneSpec read_scene(const std::filesystem::path& path, const std::vector<std::string>& overrides, bool quick,
+                     const ReadLimits& limits)
 {
     const std::string file = path.string();
-    if (!std::filesystem::is_regular_file(path))
-        throw Error(str("scene file '", file, "': ", std::filesystem::exists(path) ? "not a regular file" : "no such file"));
+    std::error_code ec;
+    const std::filesystem::file_status status = std::filesystem::status(path, ec);
+    if (!std::filesystem::is_regular_file(status))
+        throw Error(str("scene file '", clipped(file), "': ",
+                        ec && ec != std::errc::no_such_file_or_directory ? ec.message()
+                        : std::filesystem::exists(status)                 ? "not a regular file"
+                                                                          : "no such file"));
+    std::ifstream in(path, std::ios::binary);
+    in.seekg(0, std::ios::end);
+    const std::streamoff size = in.tellg();
+    if (!in || size > max_scene_bytes)
+        throw Error(str("scene file '", clipped(file), "': ", !in ? "cannot be read" : str("holds ", size, " bytes; at most "),
+                        !in ? "" : str(max_scene_bytes, " are allowed (a scene is a few kilobytes)")));
+    std::string text(static_cast<std::size_t>(size), '\0');
+    in.seekg(0);
+    if (!in.read(text.data(), size))
+        throw Error(str("scene file '", clipped(file), "': cannot be read"));
+    check_nesting(text, file, true);
     toml::table root;
     try {
-        root = toml::parse_file(file);
+        root = toml::parse(text, file);
     } catch (const toml::parse_error& e) {
         throw Error(str(file, ":", e.source().begin.line, ":", e.source().begin.column, ": TOML syntax error: ",
                         e.description()));
     }
-    Source source{file, {}};
+    Source source{file, {}, limits};
     if (quick) {
         if (const toml::node* node = root.get("quick")) {
             if (!node->is_table())
@@ -664,7 +848,7 @@ SceneSpec read_scene(const std::filesystem::path& path, const std::vector<std::s
         }
     }
     for (const std::string& setting : overrides) {
-        apply_override(root, setting, "--set " + setting);
+        apply_override(root, setting, str(clipped(file), ": --set ", clipped(setting)));
         source.overrides.emplace_back(setting.substr(0, setting.find('=')), "--set " + setting);
     }
 
@@ -750,6 +934,8 @@ SceneSpec read_scene(const std::filesystem::path& path, const std::vector<std::s
         out.height = o.integer("height", out.height, 64, 4096);
         if (out.colour != "displacement" && std::find(out.fields.begin(), out.fields.end(), out.colour) == out.fields.end())
             o.fail(*output_table, "colour", str("'", out.colour, "' must be one of the fields written (output.fields)"));
+        if (!out.png && !o.has("video"))
+            out.video = "none";  // the default video is made from the PNG frames: none without them
         if (out.video != "none" && !out.png)
             o.fail(*o.get("video"), "video", "is made from the PNG frames: set png = true or video = \"none\"");
     }
@@ -775,8 +961,8 @@ SceneSpec read_scene(const std::filesystem::path& path, const std::vector<std::s
         if (!s.has("file"))
             s.missing("file", "the fine surface (.obj, .stl, .ply) the tets carry");
         skin.file = resolve(path, s.text("file", ""));
-        if (!std::filesystem::exists(skin.file))
-            s.fail(*s.get("file"), "file", str("no such file: ", skin.file.string()));
+        if (!file_exists(skin.file))
+            s.fail(*s.get("file"), "file", str("no such file: ", clipped(skin.file.string()), " (looked beside the scene file, then in the data folder)"));
         skin.body = s.text("body", scene.bodies.front().name);
         if (!names.count(skin.body))
             s.fail(*s.get("body"), "body", str("no body is called '", skin.body, "'"));
@@ -799,6 +985,35 @@ SceneSpec read_scene(const std::filesystem::path& path, const std::vector<std::s
         }
     }
     return scene;
+}
+
+MemoryEstimate memory_estimate(long long vertices, long long tets)
+{
+    MemoryEstimate e;
+    e.dofs = 3 * vertices;
+    // A fill-reducing ordering of a 3D mesh of n vertices leaves about n^(4/3) nonzero 3x3 blocks in
+    // the Cholesky factor (nested dissection's bound, George 1973); the per-tet and per-vertex bytes
+    // cover the mesh, the matrices, every model's per-tet data and the frames, chosen to err high.
+    e.factor_nonzeros = 9.0 * fill_per_vertex_block * std::pow(static_cast<double>(vertices), 4.0 / 3.0);
+    e.bytes = bytes_per_tet * static_cast<double>(tets) + bytes_per_vertex * static_cast<double>(vertices) +
+              12.0 * e.factor_nonzeros;
+    return e;
+}
+
+std::vector<std::filesystem::path> input_files(const SceneSpec& scene)
+{
+    std::vector<std::filesystem::path> files{scene.file};
+    for (const BodySpec& body : scene.bodies) {
+        const std::filesystem::path& mesh = body.mesh_spec.file;
+        if (mesh.empty())
+            continue;
+        files.push_back(mesh);
+        if (mesh.extension() == ".node" || mesh.extension() == ".ele")
+            files.push_back(std::filesystem::path(mesh).replace_extension(mesh.extension() == ".node" ? ".ele" : ".node"));
+    }
+    if (scene.skin)
+        files.push_back(scene.skin->file);
+    return files;
 }
 
 dynamics::Scene dynamics_scene(const SceneSpec& scene, const BodySpec& body)
@@ -879,60 +1094,6 @@ MatrixX3i boundary_faces(const TetMesh& mesh)
     for (std::size_t i = 0; i < kept.size(); ++i)
         F.row(static_cast<Eigen::Index>(i)) << kept[i][0], kept[i][1], kept[i][2];
     return F;
-}
-
-TetMesh tetrahedralize(const TriMesh& surface, const std::string& switches, const std::string& what)
-{
-    if (switches.find_first_not_of("pqaYAVQzcCfMnTo0123456789.e") != std::string::npos || switches.find('p') == std::string::npos)
-        throw Error(str(what, ": TetGen switches '", switches, "' must include p (tetrahedralise a surface) and be plain "
-                                                          "switches such as pq1.5aY"));
-    const std::filesystem::path folder =
-        std::filesystem::temp_directory_path() / str("fem-scene-tetgen-", ::getpid(), "-", std::rand());
-    std::filesystem::create_directories(folder);
-    struct Cleanup {
-        std::filesystem::path folder;
-        ~Cleanup() { std::error_code ignored; std::filesystem::remove_all(folder, ignored); }
-    } cleanup{folder};
-    // TetGen reads an .off surface (it has no .obj reader).
-    std::ostringstream off;
-    off.precision(17);
-    off << "OFF\n" << surface.V.rows() << ' ' << surface.F.rows() << " 0\n";
-    for (Eigen::Index v = 0; v < surface.V.rows(); ++v)
-        off << surface.V(v, 0) << ' ' << surface.V(v, 1) << ' ' << surface.V(v, 2) << '\n';
-    for (Eigen::Index f = 0; f < surface.F.rows(); ++f)
-        off << "3 " << surface.F(f, 0) << ' ' << surface.F(f, 1) << ' ' << surface.F(f, 2) << '\n';
-    write_file(folder / "surface.off", off.str());
-    const std::string command = str("tetgen -", switches, "Q '", (folder / "surface.off").string(), "' 2>&1");
-    std::string output;
-    FILE* pipe = ::popen(command.c_str(), "r");
-    if (pipe == nullptr)
-        throw Error(str(what, ": could not start TetGen (tools/setup.sh installs Debian's tetgen)"));
-    std::array<char, 512> buffer;
-    while (std::fgets(buffer.data(), buffer.size(), pipe) != nullptr)
-        output += buffer.data();
-    const int status = ::pclose(pipe);
-    const std::filesystem::path node = folder / "surface.1.node";
-    if (status != 0 || !std::filesystem::exists(node)) {
-        // TetGen's own words: its error or failed assertion if it printed one, else its last line.
-        std::string reason, last;
-        std::istringstream lines(output);
-        for (std::string line; std::getline(lines, line);) {
-            if (!line.empty())
-                last = line;
-            const std::size_t assertion = line.find("Assertion");
-            if (reason.empty() && assertion != std::string::npos)
-                reason = line.substr(assertion);
-            else if (reason.empty() && line.find("rror") != std::string::npos)
-                reason = line;
-        }
-        if (reason.empty())
-            reason = last;
-        if (WIFEXITED(status) && WEXITSTATUS(status) == 127)
-            reason = "the tetgen program is not installed (tools/setup.sh installs it)";
-        throw Error(str(what, ": TetGen could not tetrahedralise the surface (does it enclose a volume, closed and ",
-                        "free of self-intersections?): ", reason.empty() ? "no output" : reason));
-    }
-    return io::read_tet_mesh(node);
 }
 
 }  // namespace fem::scenes

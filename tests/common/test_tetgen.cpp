@@ -65,6 +65,6 @@ TEST_CASE("TetGen switches that ask too much stop at the time or memory limit, n
     fem::TetgenLimits small;
     small.memory = std::size_t(64) << 20;
     CHECK_THROWS_WITH(fem::tetrahedralize(bunny, "pq1.5a0.0000001", "bunny.obj", small),
-                      Contains("bunny.obj: TetGen") && Contains("memory limit is 64 MB"));
+                      Contains("bunny.obj: TetGen") && Contains("out of memory within its limit of 64 MB"));
     CHECK(leftover_folders() == 0);
 }

@@ -3,13 +3,18 @@
 #include "scenes/scene_file.hpp"
 
 #include "common/error.hpp"
+#include "common/files.hpp"
+#include "common/test_support.hpp"
 
 #include <catch2/catch.hpp>
 
 #include <Eigen/Geometry>
 
+#include <cstdlib>
 #include <filesystem>
-#include <fstream>
+#include <set>
+
+#include <sys/wait.h>
 
 using namespace fem;
 using namespace fem::scenes;
@@ -33,32 +38,38 @@ std::string error_of(const std::filesystem::path& file, const std::vector<std::s
 
 }  // namespace
 
-TEST_CASE("bad scene files: each names file, line, column, field and what is allowed", "[scenes]")
+TEST_CASE("bad scene files: each names file, line, column, field and what is allowed", "[scenes][scene_file]")
 {
-    struct Case {
-        const char* file;
-        std::vector<std::string> expected;  // parts of the message
-    };
-    const std::vector<Case> cases{
-        {"missing.toml", {"missing.toml", "no such file"}},
-        {"syntax.toml", {"syntax.toml:4:46:", "TOML syntax error"}},
-        {"unknown_field.toml", {"unknown_field.toml:13:", "time.substeps", "unknown field", "step, duration, integrator"}},
-        {"wrong_type.toml", {"wrong_type.toml:5:", "body[0].material.youngs_modulus", "a number > 0", "got string"}},
-        {"nu_half.toml", {"nu_half.toml:5:", "body[0].material.poisson_ratio", "(-1, 0.5)", "got 0.5"}},
-        {"dt_zero.toml", {"dt_zero.toml:11:8:", "time.step", "> 0", "got 0"}},
-        {"no_tets.toml", {"no_tets.toml:4:", "body[0].mesh.file", "0 tetrahedra"}},
-        {"pins_nothing.toml", {"pins_nothing.toml:10:1:", "body[0].pin[1]", "selects no vertex", "[0, 0.1]"}},
-        {"tetgen_fails.toml", {"tetgen_fails.toml:4:", "body[0].mesh.file", "TetGen could not tetrahedralise"}},
-    };
-    for (const Case& c : cases) {
-        const std::string message = error_of(bad / c.file);
+    // The table bad_scenes/errors.txt: file -> the texts its error must contain ("reads": none).
+    const auto expected = fem::test::error_table(bad / "errors.txt");
+    std::set<std::string> replayed;
+    for (const auto& entry : std::filesystem::directory_iterator(bad)) {
+        if (entry.path().extension() != ".toml")
+            continue;  // the meshes the scenes name, and the table
+        const std::string name = entry.path().filename().string();
+        INFO(name);
+        REQUIRE(expected.count(name) == 1);  // every bad scene is in the table
+        replayed.insert(name);
+        if (expected.at(name) == std::vector<std::string>{"reads"}) {
+            CHECK_NOTHROW(read_scene(entry.path()));
+            continue;
+        }
+        const std::string message = error_of(entry.path());
         INFO(message);
-        for (const std::string& part : c.expected)
+        for (const std::string& part : expected.at(name))
             CHECK(message.find(part) != std::string::npos);
     }
+    CHECK(replayed.size() == expected.size());  // and every row of the table is a file
+
+    const std::string missing = error_of(bad / "missing.toml");
+    CHECK(missing.find("missing.toml': no such file") != std::string::npos);
+    // A scene path longer than the system allows (4,096 characters): an error, not a filesystem_error.
+    const std::string long_name = error_of(bad / (std::string(5000, 's') + ".toml"));
+    CHECK(long_name.find("scene file '") != std::string::npos);
+    CHECK(long_name.find("s.toml'") != std::string::npos);  // the name's end is kept
 }
 
-TEST_CASE("every gallery scene reads, with and without its quick overrides", "[scenes]")
+TEST_CASE("every gallery scene reads, with and without its quick overrides", "[scenes][scene_file]")
 {
     int count = 0;
     for (const auto& entry : std::filesystem::directory_iterator(gallery)) {
@@ -78,7 +89,7 @@ TEST_CASE("every gallery scene reads, with and without its quick overrides", "[s
     CHECK(count >= 5);
 }
 
-TEST_CASE("overrides of --set are checked like the file and reach every body without an index", "[scenes]")
+TEST_CASE("overrides of --set are checked like the file and reach every body without an index", "[scenes][scene_file]")
 {
     const std::filesystem::path pair = gallery / "stiff_soft_pair.toml";
     const SceneSpec all = read_scene(pair, {"body.material.model=corotational", "time.step=1/120"});
@@ -99,9 +110,22 @@ TEST_CASE("overrides of --set are checked like the file and reach every body wit
     CHECK(model.find("linear, corotational, stvk, neo-hookean, stable-neo-hookean, auto") != std::string::npos);
     CHECK(error_of(pair, {"time.step"}).find("expected key=value") != std::string::npos);
     CHECK(error_of(pair, {"body.5.name=x"}).find("no 5") != std::string::npos);
+    // An index beyond any integer type: the same error, not std::out_of_range (issue 23, row 2).
+    const std::string huge = error_of(pair, {"body.99999999999999999999.x=1"});
+    CHECK(huge.find("--set body.99999999999999999999.x=1: body has 2 entries, no 99999999999999999999") !=
+          std::string::npos);
+    // Nested beyond max_nesting in the key or the value: refused before they are parsed (row 1).
+    std::string deep_key = "a";
+    for (int i = 0; i < 40; ++i)
+        deep_key += ".a";
+    CHECK(error_of(pair, {deep_key + "=1"}).find("the key has 41 parts; at most 32") != std::string::npos);
+    CHECK(error_of(pair, {"gravity=" + std::string(50000, '[')}).find("nested deeper than 32 levels") !=
+          std::string::npos);
+    // Every error of an override names the scene file too.
+    CHECK(error_of(pair, {"time.step"}).find("stiff_soft_pair.toml") != std::string::npos);
 }
 
-TEST_CASE("a skin section is read and checked: the file and the body it names", "[scenes]")
+TEST_CASE("a skin section is read and checked: the file and the body it names", "[scenes][scene_file]")
 {
     // The scene reads; binding the skin (chapter 13) is the runner's, which refuses this one.
     const SceneSpec scene = read_scene(bad / "skin.toml");
@@ -116,10 +140,12 @@ TEST_CASE("a skin section is read and checked: the file and the body it names", 
     CHECK(error_of(skinned, {"body.mesh.tetgen=pq1.5Y"}).find("either tetgen or lattice") != std::string::npos);
     CHECK(error_of(skinned, {"body.mesh.lattice=0"}).find("body[0].mesh.lattice") != std::string::npos);
     CHECK(error_of(skinned, {"skin.body=nobody"}).find("no body is called 'nobody'") != std::string::npos);
-    CHECK(error_of(skinned, {"skin.file=nothing.obj"}).find("nothing.obj' does not exist") != std::string::npos);
+    const std::string no_skin = error_of(skinned, {"skin.file=nothing.obj"});
+    CHECK(no_skin.find("skin.file: no such file: ") != std::string::npos);
+    CHECK(no_skin.find((gallery / "nothing.obj").string()) != std::string::npos);  // the first place looked
 }
 
-TEST_CASE("selectors: box, plane, list, and the vertices of a box mesh they pick", "[scenes]")
+TEST_CASE("selectors: box, plane, list, and the vertices of a box mesh they pick", "[scenes][scene_file]")
 {
     const TetMesh mesh = box_mesh(2, 2, 2, Eigen::Vector3d(1.0, 1.0, 1.0));  // 27 vertices on a 3x3x3 grid
     Selector plane;
@@ -143,7 +169,7 @@ TEST_CASE("selectors: box, plane, list, and the vertices of a box mesh they pick
     CHECK_THROWS_AS(select_vertices(mesh, list), Error);
 }
 
-TEST_CASE("prescribed motion: the smooth ramp reaches the rotation and holds it", "[scenes]")
+TEST_CASE("prescribed motion: the smooth ramp reaches the rotation and holds it", "[scenes][scene_file]")
 {
     Motion turn;
     turn.kind = Motion::Kind::rotate;
@@ -167,7 +193,7 @@ TEST_CASE("prescribed motion: the smooth ramp reaches the rotation and holds it"
     CHECK(prescribed_displacement(shift, X, 0.25).z() == Approx(0.3 * (3 * 0.0625 - 2 * 0.015625)));
 }
 
-TEST_CASE("boundary faces of a box mesh: 12 per face of cubes, outward, closing the volume", "[scenes]")
+TEST_CASE("boundary faces of a box mesh: 12 per face of cubes, outward, closing the volume", "[scenes][scene_file]")
 {
     const TetMesh mesh = box_mesh(2, 1, 1, Eigen::Vector3d(2.0, 1.0, 1.0));
     const MatrixX3i F = boundary_faces(mesh);
@@ -179,4 +205,26 @@ TEST_CASE("boundary faces of a box mesh: 12 per face of cubes, outward, closing 
         volume += a.dot(b.cross(c)) / 6.0;
     }
     CHECK(volume == Approx(2.0).epsilon(1e-14));
+}
+
+TEST_CASE("fem_scene refuses an --out that holds the scene or its mesh, before anything runs (issue 23, row 3)", "[scenes][scene_file]")
+{
+    // proj/mybar.toml reads proj/mybar/mesh.node; with --out proj the frames folder mybar/ replaced
+    // the user's folder, mesh included, and the run exited 0.
+    const std::filesystem::path proj = fem::test::fresh_output_dir("overlap") / "proj";
+    const std::filesystem::path mesh = proj / "mybar" / "mesh.node";
+    fem::write_file(mesh, "4 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n");
+    fem::write_file(proj / "mybar" / "mesh.ele", "1 4 0\n0 0 1 2 3\n");
+    fem::write_file(proj / "mybar.toml", "[[body]]\nmesh = { file = \"mybar/mesh.node\" }\n"
+                                         "material = { youngs_modulus = 1e5, poisson_ratio = 0.3, density = 1000 }\n"
+                                         "pin = [{ vertices = [0] }]\n[time]\nduration = 0.05\n"
+                                         "[output]\npng = false\ncharts = false\n");
+    for (const std::filesystem::path& out : {proj, proj / "mybar"}) {
+        const std::string command = std::string(FEM_SCENE_EXE) + " '" + (proj / "mybar.toml").string() + "' --out '" +
+                                    out.string() + "' --no-progress > /dev/null 2>&1";
+        INFO(command);
+        CHECK(WEXITSTATUS(std::system(command.c_str())) == 1);
+        CHECK(std::filesystem::exists(mesh));
+        CHECK_FALSE(std::filesystem::exists(proj / "mybar.pvd"));
+    }
 }
