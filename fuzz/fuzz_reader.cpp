@@ -10,10 +10,7 @@
 #include "fuzz/read_by_extension.hpp"
 
 #include "common/error.hpp"
-
-#include <vtkObject.h>
-
-#include <unistd.h>
+#include "fuzz/scratch.hpp"
 
 #include <cstdint>
 #include <cstdio>
@@ -33,21 +30,6 @@ constexpr std::string_view tetgen_separator = "===\n";
 /// The stem of the input files: every fem::Error must name it.
 constexpr std::string_view stem = "fuzz-input";
 
-/// This process's folder for its input files (libFuzzer's -jobs run several processes): in memory
-/// (/dev/shm) where there is one, since rewriting a file on ext4 waits for the disk (about 4 ms,
-/// fifteen times what a read costs).
-const fs::path& scratch()
-{
-    static const fs::path dir = [] {
-        const fs::path memory = "/dev/shm";
-        const fs::path d = (fs::is_directory(memory) ? memory : fs::temp_directory_path()) /
-                           ("fem-fuzz-" + std::to_string(getpid()));
-        fs::create_directories(d);
-        return d;
-    }();
-    return dir;
-}
-
 void write_bytes(const fs::path& path, std::string_view bytes)
 {
     std::ofstream out(path, std::ios::binary | std::ios::trunc);
@@ -61,7 +43,7 @@ void write_bytes(const fs::path& path, std::string_view bytes)
 /// Writes the input as the file(s) of the format; returns the path to read.
 fs::path write_input(std::string_view input)
 {
-    const fs::path base = scratch() / stem;
+    const fs::path base = fem::fuzz::scratch() / stem;
     if (format != "tetgen") {
         const fs::path path = fs::path(base).concat("." + std::string(format));
         write_bytes(path, input);
@@ -79,12 +61,7 @@ fs::path write_input(std::string_view input)
 
 extern "C" int LLVMFuzzerInitialize(int*, char***)
 {
-    // VTK's readers report into the fem::Error; their console output would only slow the fuzzing.
-    vtkObject::GlobalWarningDisplayOff();
-    std::atexit([] {
-        std::error_code ignored;
-        fs::remove_all(scratch(), ignored);
-    });
+    fem::fuzz::initialize();
     return 0;
 }
 

@@ -1,16 +1,17 @@
 #!/usr/bin/env bash
-# Fuzzes the course's file readers: builds the fuzz preset (clang, libFuzzer + ASan + UBSan; common/
-# and fuzz/ only) and runs each reader's target from its seed corpus (fuzz/corpus/<target>/) for a
-# bounded time, as many targets at once as there are cores. Exits 1 if any target found something,
-# naming the input that caused it. New inputs that reach new code are kept in
-# build/fuzz/corpus/<target>/ for the next run.
+# Fuzzes the course's file readers and the scene reader: builds the fuzz preset (clang, libFuzzer +
+# ASan + UBSan; common/, fuzz/ and the solution files the scene reader reaches) and runs each
+# reader's target from its seed corpus (fuzz/corpus/<target>/) for a bounded time, as many targets
+# at once as there are cores. Exits 1 if any target found something, naming the input that caused it.
+# New inputs that reach new code are kept in build/fuzz/corpus/<target>/ for the next run.
 #
 #   tools/fuzz.sh                         every target, 15 s each (the CI stage of tools/test.sh)
 #   tools/fuzz.sh --seconds 3600 ply      one target for an hour
 #   tools/fuzz.sh --runs 1000000 obj stl  until a million inputs each
 #
 # Targets: obj ply stl tetgen pvd vtu (whole files: the checks before VTK, VTK's XML reader, the
-# checks after it) and vtu_grid (the checks after VTK, on any grid VTK could return).
+# checks after it), vtu_grid (the checks after VTK, on any grid VTK could return) and scene (a scene
+# file and --set overrides, split at a line ===; read_scene without TetGen and with 256 MB for the run).
 # Limits: an input may take 10 s and allocate 512 MB at once (2 GB in all); a reader must refuse a
 # huge count with an fem::Error before it reserves memory for it. Leaks are not reported: VTK's XML
 # reader leaks on some errors.
@@ -26,12 +27,12 @@ while [ $# -gt 0 ]; do
     case "$1" in
         --seconds) seconds="$2"; shift 2 ;;
         --runs) runs="$2"; seconds=0; shift 2 ;;
-        -h|--help) sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        -h|--help) sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         -*) echo "error: unknown option '$1'; allowed: --seconds N, --runs N, formats" >&2; exit 1 ;;
         *) formats+=("$1"); shift ;;
     esac
 done
-[ ${#formats[@]} -eq 0 ] && formats=(obj ply stl tetgen pvd vtu vtu_grid)
+[ ${#formats[@]} -eq 0 ] && formats=(obj ply stl tetgen pvd vtu vtu_grid scene)
 for format in "${formats[@]}"; do
     [ -d "fuzz/corpus/$format" ] || { echo "error: no fuzz target '$format'; allowed: $(ls fuzz/corpus | xargs)" >&2; exit 1; }
 done
