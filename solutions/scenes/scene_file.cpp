@@ -155,8 +155,8 @@ struct Source {
     ReadLimits limits;
     mutable double estimated_bytes = 0.0;  ///< the memory estimates of the bodies read so far, summed
 
-    /// The option that set a field (e.g. "--set body.0.material.poisson_ratio=0.5"), matched on the
-    /// path without array indices; empty when none did.
+    /// The option that set a field (e.g. "--set body.0.material.poisson_ratio=0.5"), or a table
+    /// holding it, or a field inside it, matched on the path without array indices; empty when none did.
     std::string override_of(const std::string& field) const
     {
         const auto plain = [](std::string path) {
@@ -170,9 +170,13 @@ struct Source {
                     out += (out.empty() ? "" : ".") + part;
             return out;
         };
+        // It set the field itself, a table that holds it, or (making tables) a field inside it.
+        const auto within = [](const std::string& inner, const std::string& outer) {
+            return inner == outer || inner.starts_with(outer + ".");
+        };
         std::string found;
         for (const auto& [key, option] : overrides)
-            if (plain(key) == plain(field))
+            if (within(plain(field), plain(key)) || within(plain(key), plain(field)))
                 found = option;  // the last one set it
         return found;
     }
@@ -363,7 +367,7 @@ public:
         else if (node.is_number())
             out << *node.value<double>();
         else
-            out << "a " << node.type();
+            out << (node.is_array() ? "an " : "a ") << node.type();
         return out.str();
     }
 
@@ -601,8 +605,8 @@ TetMesh build_mesh(const Fields& fields, const std::filesystem::path& scene_file
             }
         } catch (const Error& e) {
             const std::string text = e.what();
-            if (text.rfind(fields.where(node), 0) == 0)
-                throw;
+            if (text.rfind(fields.source().file, 0) == 0)
+                throw;  // an error of the scene file itself (e.g. lattice), already located
             fields.fail(node, "file", text);
         }
         mesh.V *= spec.scale;
@@ -623,8 +627,13 @@ BodySpec read_body(const toml::table& table, const std::string& name, const Sour
                         {"name", "mesh", "material", "mass", "damping", "pin", "load", "initial_velocity"});
     BodySpec body;
     body.name = fields.text("name", str("body", index));
-    if (body.name.empty() || body.name.find_first_of("/\\ \t") != std::string::npos)
-        fields.fail(*fields.get("name"), "name", "must be a non-empty name without spaces or slashes");
+    // It names files and the rows of steps.csv: printable, and nothing a path or a CSV row would split at.
+    const bool plain = std::all_of(body.name.begin(), body.name.end(), [](char c) {
+        return static_cast<unsigned char>(c) > ' ' && c != 0x7f && std::string_view("/\\,\"'").find(c) == std::string_view::npos;
+    });
+    if (body.name.empty() || !plain)
+        fields.fail(*fields.get("name"), "name",
+                    "must be a non-empty name of printable characters without spaces, slashes, commas or quotes");
 
     const toml::table* mesh_table = fields.subtable("mesh");
     if (mesh_table == nullptr)

@@ -121,6 +121,19 @@ TEST_CASE("overrides of --set are checked like the file and reach every body wit
     CHECK(error_of(pair, {deep_key + "=1"}).find("the key has 41 parts; at most 32") != std::string::npos);
     CHECK(error_of(pair, {"gravity=" + std::string(50000, '[')}).find("nested deeper than 32 levels") !=
           std::string::npos);
+    // An override that sets a table, or makes one, is named by the errors inside it (issue 23, row 12).
+    CHECK(error_of(pair, {"body.material={model=1}"}).find("--set body.material={model=1}") != std::string::npos);
+    CHECK(error_of(pair, {"body.-1.name=x"}).find("--set body.-1.name=x") != std::string::npos);
+    CHECK(error_of(pair, {"gravity=[[1], 2, 3]"}).find("got an array") != std::string::npos);
+    // A body name is printable, one word, nothing a CSV row splits at.
+    for (const std::string name : {"\"a\\nb\"", "\"a\\u0000b\"", "\"a,b\""})
+        CHECK(error_of(pair, {"body.0.name=" + name}).find("body[0].name: must be a non-empty name of printable") !=
+              std::string::npos);
+    // Without PNG frames the default video is none (a null dereference the fuzzer found: the check
+    // named the video field, which the file did not have).
+    CHECK(read_scene(pair, {"output.png=false"}).output.video == "none");
+    CHECK(error_of(pair, {"output.png=false", "output.video=mp4"}).find("output.video: is made from the PNG frames") !=
+          std::string::npos);
     // Every error of an override names the scene file too.
     CHECK(error_of(pair, {"time.step"}).find("stiff_soft_pair.toml") != std::string::npos);
 }
@@ -138,7 +151,9 @@ TEST_CASE("a skin section is read and checked: the file and the body it names", 
     CHECK(lattice.bodies.front().mesh_spec.lattice == 6);
     CHECK(lattice.bodies.front().mesh.T.rows() % 6 == 0);  // whole cubes of six tets
     CHECK(error_of(skinned, {"body.mesh.tetgen=pq1.5Y"}).find("either tetgen or lattice") != std::string::npos);
-    CHECK(error_of(skinned, {"body.mesh.lattice=0"}).find("body[0].mesh.lattice") != std::string::npos);
+    const std::string lattice0 = error_of(skinned, {"body.mesh.lattice=0"});
+    CHECK(lattice0.find("body[0].mesh.lattice") != std::string::npos);
+    CHECK(lattice0.find("skinned_bunny.toml") == lattice0.rfind("skinned_bunny.toml"));  // its place once (row 12)
     CHECK(error_of(skinned, {"skin.body=nobody"}).find("no body is called 'nobody'") != std::string::npos);
     const std::string no_skin = error_of(skinned, {"skin.file=nothing.obj"});
     CHECK(no_skin.find("skin.file: no such file: ") != std::string::npos);
