@@ -40,7 +40,8 @@ struct ModelComparison {
 /// scene's Δt, and the reference (stable neo-Hookean at Δt/reference_refinement, and at twice that
 /// step to measure its convergence), and compares the positions frame by frame: RMS and max error
 /// of the tet vertices and of the boundary vertices, time per step and total. With run set, prints
-/// the table and writes <out>/models_<scene>.csv. fem::Error when the reference run fails.
+/// the table and writes <out>/models_<scene>.csv. fem::Error when the reference run fails. A stop
+/// signal (common/interrupt.hpp) ends it after the current run, with the rows so far.
 /// docs/scenes.md#what-each-model-costs
 ModelComparison compare_models(const SceneSpec& scene, const RunContext* run);
 

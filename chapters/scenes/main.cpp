@@ -96,6 +96,7 @@ int main(int argc, char** argv)
     bool stopped = false;
     const int code = cli.run(argc, argv, [&](const RunContext& run) {
         cg::set_blas_threads(1);
+        catch_stop_signals();  // a stop signal ends a run or a comparison after its current step
         for (const SceneSpec& scene : scenes) {
             std::cout << scene.title << " (" << scene.file.filename().string() << "): " << scene.bodies.size()
                       << " bodies, dt = " << scene.time_step << " s, " << scene.duration << " s, solver " << scene.solver
@@ -106,9 +107,10 @@ int main(int argc, char** argv)
             if (compare)
                 compare_models(scene, &run);
         }
-        if (compare)
+        if (compare) {
+            stopped = stop_requested();
             return;
-        catch_stop_signals();
+        }
         RunOptions options;
         options.run = &run;
         options.progress = !no_progress;

@@ -81,4 +81,12 @@ struct RunOptions {
 /// model). docs/scenes.md#the-runner
 RunResult run_scene(const SceneSpec& scene, const RunOptions& options);
 
+/// The steps between two frames: 1/(frame_rate Δt) rounded, at least 1 (a frame at every multiple
+/// of it, and at the last step).
+int steps_per_frame(const SceneSpec& scene);
+
+/// run_scene writing nothing and printing nothing, keeping every frame's positions (and every step's
+/// record): the run a comparison or a test looks at. model (when set) replaces every body's model.
+RunResult run_positions(const SceneSpec& scene, const std::string& model = "");
+
 }  // namespace fem::scenes

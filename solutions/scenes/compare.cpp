@@ -14,22 +14,16 @@
 namespace fem::scenes {
 namespace {
 
-/// The scene with its time step divided by `refinement` (the same frames: frame times do not move).
+/// The scene with its time step divided by `refinement` and its frames at the same times (every
+/// refinement × steps_per_frame(scene) of its steps).
 SceneSpec refined(const SceneSpec& scene, int refinement)
 {
     SceneSpec fine = scene;
+    fine.output.frame_rate = 1.0 / (steps_per_frame(scene) * scene.time_step);
     fine.time_step = scene.time_step / refinement;
     return fine;
 }
 
-RunResult positions_of(const SceneSpec& scene, const std::string& model)
-{
-    RunOptions options;
-    options.model = model;
-    options.keep_positions = true;
-    options.print_models = false;
-    return run_scene(scene, options);
-}
 
 /// The largest vertex distance between two runs over all frames [m].
 double largest_difference(const RunResult& a, const RunResult& b)
@@ -50,11 +44,15 @@ ModelComparison compare_models(const SceneSpec& scene, const RunContext* run)
     const std::string reference_model = "stable-neo-hookean";
     RunResult reference, coarser;
     try {
-        reference = positions_of(refined(scene, reference_refinement), reference_model);
-        coarser = positions_of(refined(scene, reference_refinement / 2), reference_model);
+        reference = run_positions(refined(scene, reference_refinement), reference_model);
+        coarser = run_positions(refined(scene, reference_refinement / 2), reference_model);
     } catch (const Error& e) {
         throw Error(str("--compare: the reference run (", reference_model, " at dt = ", comparison.reference_time_step,
                         " s) failed: ", e.what()));
+    }
+    if (reference.interrupted || coarser.interrupted) {
+        std::cout << "interrupted: the comparison stops before its reference is complete\n";
+        return comparison;
     }
     comparison.reference_change = largest_difference(reference, coarser);
     if (reference.frames.empty() || reference.frames[0].size() != coarser.frames[0].size())
@@ -76,12 +74,16 @@ ModelComparison compare_models(const SceneSpec& scene, const RunContext* run)
         row.model = model;
         RunResult result;
         try {
-            result = positions_of(scene, model);
+            result = run_positions(scene, model);
         } catch (const Error& e) {
             std::cout << "model " << model << " failed: " << e.what() << '\n';
             row.failed = true;
             comparison.rows.push_back(row);
             continue;
+        }
+        if (result.interrupted) {
+            std::cout << "interrupted: the comparison stops after " << comparison.rows.size() << " models\n";
+            break;
         }
         double tet_sum = 0.0, surface_sum = 0.0;
         long tet_count = 0, surface_count = 0;

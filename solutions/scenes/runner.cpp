@@ -147,7 +147,7 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
         bodies.push_back(start_body(spec, scene, options.model));
 
     const int steps = dynamics::step_count(scene.duration, scene.time_step);
-    const int frame_every = std::max(1, static_cast<int>(std::lround(1.0 / (scene.output.frame_rate * scene.time_step))));
+    const int frame_every = steps_per_frame(scene);
     const std::string stem = scene.file.stem().string();
     const bool png = run != nullptr && run->figures && scene.output.png;
     std::optional<io::MotionRecorder> recorder;
@@ -239,6 +239,20 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
             make_video(*run, skin_written > 0 ? stem + "_skin" : stem, scene.output);
     }
     return result;
+}
+
+int steps_per_frame(const SceneSpec& scene)
+{
+    return std::max(1, static_cast<int>(std::lround(1.0 / (scene.output.frame_rate * scene.time_step))));
+}
+
+RunResult run_positions(const SceneSpec& scene, const std::string& model)
+{
+    RunOptions options;
+    options.model = model;
+    options.keep_positions = true;
+    options.print_models = false;
+    return run_scene(scene, options);
 }
 
 }  // namespace fem::scenes

@@ -17,16 +17,6 @@ namespace {
 
 const std::filesystem::path gallery = FEM_SCENES_DIR;
 
-/// Runs a scene without files, keeping the positions of every step.
-RunResult positions_of(const SceneSpec& scene, const std::string& model)
-{
-    RunOptions options;
-    options.model = model;
-    options.keep_positions = true;
-    options.print_models = false;
-    return run_scene(scene, options);
-}
-
 /// The cantilever of the gallery, small and short, one frame per step.
 SceneSpec small_cantilever(std::vector<std::string> overrides)
 {
@@ -136,7 +126,7 @@ TEST_CASE("the volume rule fires before the strain rule under an even squeeze", 
 TEST_CASE("auto gives the linear result exactly on a small-load scene", "[scenes]")
 {
     const SceneSpec scene = small_cantilever({"gravity=[0.0, 0.0, -0.01]"});
-    const RunResult linear = positions_of(scene, "linear"), automatic = positions_of(scene, "auto");
+    const RunResult linear = run_positions(scene, "linear"), automatic = run_positions(scene, "auto");
     REQUIRE(automatic.segments.size() == 1);
     REQUIRE(automatic.segments[0].size() == 1);
     CHECK(automatic.segments[0][0].level == Level::linear);
@@ -161,7 +151,7 @@ TEST_CASE("auto switches at the first step whose linear state crosses a threshol
     };
     for (const Case& c : cases) {
         const SceneSpec scene = small_cantilever(c.overrides);
-        const RunResult linear = positions_of(scene, "linear");
+        const RunResult linear = run_positions(scene, "linear");
         int crossing = -1;
         Level crossed = Level::linear;
         for (std::size_t k = 0; k < linear.frames[0].size() && crossing < 0; ++k) {
@@ -172,7 +162,7 @@ TEST_CASE("auto switches at the first step whose linear state crosses a threshol
         }
         REQUIRE(crossing > 0);
         CHECK(crossed == c.expected);
-        const RunResult automatic = positions_of(scene, "auto");
+        const RunResult automatic = run_positions(scene, "auto");
         const std::vector<Segment>& segments = automatic.segments[0];
         REQUIRE(segments.size() >= 2);
         CHECK(segments[0].level == Level::linear);
@@ -208,8 +198,8 @@ TEST_CASE("a cube turned by half a turn stays free of ghost forces under auto", 
     turned.col(0) = 0.1 - X.col(0).array();
     turned.col(1) = 0.1 - X.col(1).array();
     const auto error = [&](const RunResult& r) { return (r.frames[0].back() - turned).rowwise().norm().maxCoeff(); };
-    const RunResult automatic = positions_of(scene, "auto"), corotational = positions_of(scene, "corotational"),
-                    linear = positions_of(scene, "linear");
+    const RunResult automatic = run_positions(scene, "auto"), corotational = run_positions(scene, "corotational"),
+                    linear = run_positions(scene, "linear");
     CAPTURE(describe_segments(automatic.segments[0]), error(automatic), error(corotational), error(linear));
     CHECK(error(linear) > 0.02);         // the ghost forces: centimetres on a 10 cm cube
     CHECK(error(corotational) < 2e-3);   // the turn itself, and a little swing left

@@ -30,14 +30,6 @@ SceneSpec scene_from(const std::string& name, const std::string& text, const std
     return read_scene(file, overrides);
 }
 
-RunResult run_model(const SceneSpec& scene, const std::string& model = "")
-{
-    RunOptions options;
-    options.model = model;
-    options.keep_positions = true;
-    options.print_models = false;
-    return run_scene(scene, options);
-}
 
 /// A 0.2 m bar of 8 × 2 × 2 cubes along x, clamped at x = 0, with the extra TOML text given.
 std::string bar(const std::string& model, const std::string& extra)
@@ -55,7 +47,7 @@ TEST_CASE("a scene that diverges on purpose is stopped at a named step of a name
     // Symplectic Euler at dt = 10 ms on a bar whose explicit limit is well under 1 ms.
     const SceneSpec scene = scene_from("diverging", bar("linear", "[time]\nstep = 0.01\nduration = 1.0\n"
                                                                   "integrator = \"symplectic-euler\"\n"));
-    CHECK_THROWS_WITH(run_model(scene), Contains("body 'bar'") && Contains("diverged at step") &&
+    CHECK_THROWS_WITH(run_positions(scene), Contains("body 'bar'") && Contains("diverged at step") &&
                                             Contains("symplectic Euler") && Contains("stability limit"));
 }
 
@@ -67,7 +59,7 @@ TEST_CASE("a constant point load's work over a run is f . du, and it puts nothin
         bar("corotational", "[[body.load]]\ntype = \"point\"\nforce = [0.0, 0.5, -2.0]\n"
                             "plane = { point = [0.2, 0.0, 0.0], normal = [1.0, 0.0, 0.0] }\n"
                             "[time]\nstep = 0.01\nduration = 0.3\n[output]\nframe_rate = 100\n"));
-    const RunResult result = run_model(scene);
+    const RunResult result = run_positions(scene);
     const std::vector<int>& loaded = scene.bodies[0].loads[0].select.vertices;
     const Eigen::Vector3d share = scene.bodies[0].loads[0].value / double(loaded.size());
     const MatrixX3d u = result.frames[0].back() - scene.bodies[0].mesh.V;
@@ -95,7 +87,7 @@ TEST_CASE("with the midpoint rule a scene's books balance to round-off: ramped l
         std::string text = bar("linear", extra);
         text.insert(text.find("[[body.pin]]"), damping);
         const SceneSpec scene = scene_from("midpoint_books", text);
-        const RunResult result = run_model(scene);
+        const RunResult result = run_positions(scene);
         double worst = 0.0, largest = 0.0;
         for (const dynamics::StepRecord& r : result.records[0]) {
             worst = std::max(worst, std::abs(r.integrator_dissipated));
@@ -132,14 +124,33 @@ TEST_CASE("a surface load whose vertices span no boundary triangle is refused, n
     const SceneSpec scene = scene_from("empty_surface_load",
         bar("linear", "[[body.load]]\ntype = \"surface\"\ntraction = [0.0, 0.0, -100.0]\nbox = [[0.19, -0.001, -0.001], [0.21, 0.021, 0.001]]\n"
                       "[time]\nstep = 0.01\nduration = 0.1\n"));
-    CHECK_THROWS_WITH(run_model(scene), Contains("body[0].load[0]") && Contains("span no boundary triangle"));
+    CHECK_THROWS_WITH(run_positions(scene), Contains("body[0].load[0]") && Contains("span no boundary triangle"));
 }
 
 TEST_CASE("the run's summary names the model it ran, for every fixed model", "[scenes]")
 {
     for (const std::string model : {"linear", "corotational", "stvk", "neo-hookean", "stable-neo-hookean"}) {
         const SceneSpec scene = scene_from("summary", bar(model, "[time]\nstep = 0.01\nduration = 0.05\n"));
-        const RunResult result = run_model(scene);
+        const RunResult result = run_positions(scene);
         CHECK(describe_segments(result.segments[0]) == model + " 0-5");
+    }
+}
+
+TEST_CASE("every model runs a damped scene, so --compare never refuses one", "[scenes]")
+{
+    // Chapter 12's Newton step has Rayleigh damping too (D = alpha M + beta K at the step's start):
+    // the comparison used to refuse damped scenes because its reference could not damp.
+    std::string text = bar("linear", "[time]\nstep = 0.02\nduration = 0.2\n");
+    text.insert(text.find("[[body.pin]]"), "damping = { alpha = 0.02, beta = 0.002 }\n");
+    const SceneSpec scene = scene_from("damped_compare", text);
+    const ModelComparison comparison = compare_models(scene, nullptr);
+    for (const ModelError& row : comparison.rows) {
+        CAPTURE(row.model, row.tet_max, comparison.reference_change);
+        CHECK_FALSE(row.failed);
+    }
+    for (const std::string model : {"linear", "stable-neo-hookean"}) {
+        const RunResult result = run_positions(scene, model);
+        CAPTURE(model);
+        CHECK(result.records[0].back().damping_dissipated > 0.0);
     }
 }

@@ -40,14 +40,6 @@ SceneSpec scene_from(const std::string& name, const std::string& text)
     return read_scene(file);
 }
 
-RunResult positions_of(const SceneSpec& scene, const std::string& model = "")
-{
-    RunOptions options;
-    options.model = model;
-    options.keep_positions = true;
-    options.print_models = false;
-    return run_scene(scene, options);
-}
 
 /// A free 0.1 m cube (no pin, no gravity) pushed by one load for 0.2 s at Δt = 0.02 s.
 std::string pushed_cube(const std::string& model, const std::string& load)
@@ -117,7 +109,7 @@ TEST_CASE("a point or surface load moves the centre of mass as F t^2 / 2m does u
     for (const Case& c : cases) {
         INFO(c.model << " " << c.load);
         const SceneSpec scene = scene_from("pushed_cube", pushed_cube(c.model, c.load));
-        const RunResult run = positions_of(scene);
+        const RunResult run = run_positions(scene);
         const TetMesh& mesh = scene.bodies[0].mesh;
         const Eigen::VectorXd m = assembly::vertex_masses(mesh, scene.bodies[0].material.density);
         const MatrixX3d u = run.frames[0].back() - mesh.V;
@@ -133,7 +125,7 @@ TEST_CASE("the twisted bar's moving end is where a half turn puts it, and the ba
 {
     const SceneSpec scene = read_scene(gallery / "twisted_bar.toml", {"body.material.model=corotational"}, true);
     const BodySpec& bar = scene.bodies[0];
-    const RunResult run = positions_of(scene);
+    const RunResult run = run_positions(scene);
     // [quick] ends the turn at 0.25 s = the last frame: a half turn about the axis y = z = 0.
     const MatrixX3d& x = run.frames[0].back();
     int moved = 0;
@@ -162,7 +154,7 @@ TEST_CASE("the twisted bar's moving end is where a half turn puts it, and the ba
 TEST_CASE("determinism: the same scene twice gives the same numbers to the last bit", "[scenes]")
 {
     const SceneSpec scene = read_scene(gallery / "stiff_soft_pair.toml", {}, true);
-    const RunResult first = positions_of(scene), second = positions_of(scene);
+    const RunResult first = run_positions(scene), second = run_positions(scene);
     REQUIRE(first.frames.size() == 2);
     for (std::size_t b = 0; b < 2; ++b)
         for (std::size_t f = 0; f < first.frames[b].size(); ++f)
