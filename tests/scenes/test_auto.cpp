@@ -207,3 +207,33 @@ TEST_CASE("a cube turned by half a turn stays free of ghost forces under auto", 
     for (const Segment& segment : automatic.segments[0])  // never linear once the turn is under way
         CHECK((segment.level != Level::linear || segment.last_step < 10));
 }
+
+TEST_CASE("every gallery scene's first switch is where its linear run first crosses a threshold", "[scenes]")
+{
+    // The switch points reproduced independently for every body that runs auto in the gallery's
+    // quick runs: the measures of the fixed linear run, step by step, say where auto must leave linear.
+    for (const std::string name : {"cantilever", "twisted_bar", "bunny", "stiff_soft_pair"}) {
+        const SceneSpec scene = read_scene(gallery / (name + ".toml"), {"output.frame_rate=60"}, true);
+        REQUIRE(steps_per_frame(scene) == 1);
+        const RunResult linear = run_positions(scene, "linear"), automatic = run_positions(scene);
+        for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
+            if (scene.bodies[b].model != "auto")
+                continue;
+            int crossing = -1;
+            for (std::size_t k = 0; k < linear.frames[b].size() && crossing < 0; ++k)
+                if (choose_level(deformation_measures(scene.bodies[b].mesh, linear.frames[b][k], scene.thresholds),
+                                 Level::linear, scene.thresholds) != Level::linear)
+                    crossing = static_cast<int>(k);
+            const std::vector<Segment>& segments = automatic.segments[b];
+            CAPTURE(name, scene.bodies[b].name, crossing, describe_segments(segments));
+            REQUIRE(segments.front().level == Level::linear);
+            if (crossing < 0) {  // never crosses within the quick run: auto stays linear throughout
+                CHECK(segments.size() == 1);
+                continue;
+            }
+            CHECK(segments.front().last_step == crossing);  // the state of step k decides step k + 1
+            REQUIRE(segments.size() >= 2);
+            CHECK(segments[1].first_step == crossing + 1);
+        }
+    }
+}
