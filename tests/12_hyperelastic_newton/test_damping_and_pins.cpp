@@ -8,12 +8,15 @@
 #include "12_hyperelastic_newton/newton.hpp"
 
 #include "common/error.hpp"
+#include "common/mesh.hpp"
 #include "common/random.hpp"
 
 #include "../10_linear_dynamics/dynamics_fixtures.hpp"
 #include "../common/test_support.hpp"
 
 #include <catch2/catch.hpp>
+
+#include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <cmath>
@@ -99,6 +102,30 @@ TEST_CASE("damped gradient: the damped objective's by finite differences, zero a
     dynamics::ThetaMethod(1.0).step(body, dt, stepped);
     const Eigen::VectorXd at_step = body.dofs().gather(backward_euler_gradient(body, state, dt, stepped.v, damping));
     CHECK(at_step.norm() <= 1e-10 * momentum_scale(body, state, dt));
+}
+
+TEST_CASE("the damping's K_t is the definite tangent: where StVK's exact K is indefinite, D still removes energy",
+          "[ex12.9]")
+{
+    dynamics::Scene scene;
+    scene.mesh = box_mesh(1, 1, 1, Eigen::Vector3d(0.1, 0.1, 0.1));
+    scene.material = {1e5, 0.3, 1000.0};
+    scene.damping = {0.0, 0.02};
+    dynamics::Body body(scene, make_force_model("stvk", scene.mesh, scene.material));
+    Eigen::VectorXd u = Eigen::VectorXd::Zero(body.dofs().full_size());
+    for (Eigen::Index v = 0; v < scene.mesh.V.rows(); ++v)
+        u[3 * v + 2] = -0.5 * scene.mesh.V(v, 2);  // squashed to half its height: StVK's K turns indefinite
+    const auto exact_model = make_force_model("stvk", scene.mesh, scene.material);
+    const Eigen::MatrixXd K = Eigen::MatrixXd(exact_model->stiffness(u));
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(K);
+    const Eigen::VectorXd v = eigen.eigenvectors().col(0);  // the most negative direction of K(u)
+    const StepDamping damping(body, u);
+    CAPTURE(eigen.eigenvalues()[0], eigen.eigenvalues().cwiseAbs().maxCoeff());
+    REQUIRE(v.dot(K * v) < -1e-3 * eigen.eigenvalues().cwiseAbs().maxCoeff());  // βK(u) would put energy in
+    CHECK(v.dot(damping.times(v)) >= -1e-12 * 0.02 * eigen.eigenvalues().cwiseAbs().maxCoeff());
+    const Eigen::VectorXd eigenvalues = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(
+        Eigen::MatrixXd(damping.start_stiffness())).eigenvalues();
+    CHECK(eigenvalues.minCoeff() >= -1e-12 * eigenvalues.maxCoeff());  // K_t is positive semi-definite
 }
 
 TEST_CASE("damped Newton backward Euler on a linear body is chapter 10's damped theta = 1 step", "[ex12.9]")
