@@ -26,7 +26,10 @@ struct Settings {
     double seconds = 0.2;                         ///< measuring time per timed kernel [s]
 };
 
-/// The force model called "linear" or "corotational" (polar fit) for a scene.
+/// The force model called "linear" or "corotational" for a scene: the corotational one in the
+/// lecture's configuration (polar fit, forces R K_e (Rᵀx − X)) that this chapter's tables teach and
+/// time. Chapter 12's hyper::make_force_model is the course's factory of every model by name (with
+/// the faster shape-gradient forces); this chapter cannot use it, a chapter using earlier ones only.
 std::unique_ptr<dynamics::ForceModel> force_model(const std::string& name, const dynamics::Scene& scene);
 
 /// The solvers of a changing step matrix compared side by side, by name: "refactor" (chapter 08's
