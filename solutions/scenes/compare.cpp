@@ -142,9 +142,9 @@ ModelComparison compare_models(const SceneSpec& scene, const RunContext* run)
         if (!row.failed)
             smallest = std::min(smallest, row.tet_max);
     Table converged(str("The reference converged (", scene.title, ")"),
-                    {{"reference dt (s)", Format::scientific, 3}, {"change when its dt doubles (m)", Format::scientific, 2},
-                     {"smallest model error (m)", Format::scientific, 2}});
-    converged.add_row({comparison.reference_time_step, comparison.reference_change, smallest});
+                    {{"scene", Format::text}, {"reference dt (s)", Format::scientific, 3},
+                     {"change when its dt doubles (m)", Format::scientific, 2}, {"smallest model error (m)", Format::scientific, 2}});
+    converged.add_row({scene.file.stem().string(), comparison.reference_time_step, comparison.reference_change, smallest});
     converged.write_csv(run->file("reference_" + scene.file.stem().string() + ".csv"));
     return comparison;
 }

@@ -4,6 +4,9 @@
 
 #include "13_skinning/skinning.hpp"
 
+#include "12_hyperelastic_newton/force_models.hpp"
+#include "12_hyperelastic_newton/materials.hpp"
+
 #include "10_linear_dynamics/time_integration.hpp"
 
 #include "common/error.hpp"
@@ -28,8 +31,11 @@ namespace fem::scenes {
 
 const std::vector<std::string>& model_names()
 {
-    static const std::vector<std::string> names{"linear", "corotational", "stvk", "neo-hookean", "stable-neo-hookean",
-                                                "auto"};
+    static const std::vector<std::string> names = [] {
+        std::vector<std::string> all = hyper::force_model_names();  // chapter 12's factory: every model by name
+        all.push_back("auto");
+        return all;
+    }();
     return names;
 }
 
@@ -569,6 +575,7 @@ TetMesh build_mesh(const Fields& fields, const std::filesystem::path& scene_file
         check_memory(fields, fields.has("cells") ? *fields.get("cells") : *fields.get("generator"), "cells",
                      (cells.array() + 1).prod(), 6 * cells.prod(), "use fewer cells");
         mesh = box_mesh(spec.cells.x(), spec.cells.y(), spec.cells.z(), spec.size);
+        mesh.V *= spec.scale;  // scale applies to a generated box too (it was ignored)
     } else {
         for (const std::string key : {"size", "cells"})
             if (fields.has(key))
@@ -886,11 +893,14 @@ SceneSpec read_scene(const std::filesystem::path& path, const std::vector<std::s
                                                [](double t) { return t > 0.0 && t < 1.0; }, "a number in (0, 1)");
     }
     if (const toml::table* auto_table = top.subtable("auto")) {
-        const Fields a(*auto_table, "auto", source, {"rotation", "strain", "volume_ratio", "hysteresis", "hyperelastic"});
+        const Fields a(*auto_table, "auto", source,
+                       {"rotation", "ghost_ratio", "strain", "volume_ratio", "hysteresis", "hyperelastic"});
         const double degrees = std::acos(-1.0) / 180.0;
         scene.thresholds.rotation =
             a.number("rotation", scene.thresholds.rotation / degrees, [](double x) { return x > 0.0 && x < 90.0; },
                      "a number in (0, 90) (degrees)") * degrees;
+        scene.thresholds.ghost_ratio = a.number("ghost_ratio", scene.thresholds.ghost_ratio,
+                                                [](double x) { return x > 0.0 && x <= 1.0; }, "a number in (0, 1]");
         scene.thresholds.strain = a.number("strain", scene.thresholds.strain, [](double x) { return x > 0.0 && x < 1.0; },
                                            "a number in (0, 1)");
         scene.thresholds.volume_ratio = a.number("volume_ratio", scene.thresholds.volume_ratio,
@@ -898,7 +908,7 @@ SceneSpec read_scene(const std::filesystem::path& path, const std::vector<std::s
         scene.thresholds.hysteresis = a.number("hysteresis", scene.thresholds.hysteresis,
                                                [](double x) { return x > 0.0 && x <= 1.0; }, "a number in (0, 1]");
         scene.thresholds.hyperelastic =
-            a.text("hyperelastic", scene.thresholds.hyperelastic, {"stvk", "neo-hookean", "stable-neo-hookean"});
+            a.text("hyperelastic", scene.thresholds.hyperelastic, hyper::material_names());
     }
     if (const toml::table* output_table = top.subtable("output")) {
         const Fields o(*output_table, "output", source,
@@ -980,10 +990,6 @@ SceneSpec read_scene(const std::filesystem::path& path, const std::vector<std::s
     for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
         const BodySpec& body = scene.bodies[i];
         const bool hyper = body.model != "linear" && body.model != "corotational";
-        if (hyper && (body.damping.alpha != 0.0 || body.damping.beta != 0.0))
-            throw Error(str(file, ": body[", i, "].damping: not with body[", i, "].material.model = '", body.model,
-                            "', which steps with chapter 12's Newton backward Euler, which has no Rayleigh damping: set "
-                            "damping to 0 or the model to linear or corotational"));
         if (hyper && scene.integrator != "backward-euler")
             throw Error(str(file, ": time.integrator: '", scene.integrator, "' is not for body[", i, "].material.model = '",
                             body.model, "', which steps with Newton backward Euler only: use backward-euler"));

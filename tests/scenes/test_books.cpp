@@ -4,6 +4,8 @@
 #include "scenes/compare.hpp"
 #include "scenes/runner.hpp"
 
+#include "12_hyperelastic_newton/materials.hpp"
+
 #include "common/error.hpp"
 
 #include <catch2/catch.hpp>
@@ -152,5 +154,27 @@ TEST_CASE("every model runs a damped scene, so --compare never refuses one", "[s
         const RunResult result = run_positions(scene, model);
         CAPTURE(model);
         CHECK(result.records[0].back().damping_dissipated > 0.0);
+    }
+}
+
+TEST_CASE("mesh.scale applies to a generated box as to a mesh file", "[scenes]")
+{
+    // It was read, checked and then ignored for generator = "box".
+    const SceneSpec scene = scene_from("scaled_box", "[[body]]\n"
+        "mesh = { generator = \"box\", size = [1.0, 2.0, 3.0], cells = [1, 1, 1], scale = 0.1, translate = [1.0, 0.0, 0.0] }\n"
+        "material = { model = \"linear\", youngs_modulus = 1e5, poisson_ratio = 0.3, density = 1000.0 }\n"
+        "[[body.pin]]\nplane = { point = [1.0, 0.0, 0.0], normal = [1.0, 0.0, 0.0] }\n");
+    const MatrixX3d& V = scene.bodies[0].mesh.V;
+    CHECK(V.colwise().minCoeff().isApprox(Eigen::RowVector3d(1.0, 0.0, 0.0)));
+    CHECK(V.colwise().maxCoeff().isApprox(Eigen::RowVector3d(1.1, 0.2, 0.3)));
+}
+
+TEST_CASE("every hyperelastic material of chapter 12's registry is a model a scene can name", "[scenes]")
+{
+    for (const std::string& material : hyper::material_names()) {
+        CAPTURE(material);
+        const SceneSpec scene = scene_from("registered", bar(material, "[time]\nstep = 0.01\nduration = 0.02\n"),
+                                           {"auto.hyperelastic=\"" + material + "\""});
+        CHECK(describe_segments(run_positions(scene).segments[0]) == material + " 0-2");
     }
 }

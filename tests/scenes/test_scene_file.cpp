@@ -107,7 +107,7 @@ TEST_CASE("overrides of --set are checked like the file and reach every body wit
     const std::string unknown = error_of(pair, {"time.substeps=3"});
     CHECK(unknown.find("time.substeps: unknown field") != std::string::npos);
     const std::string model = error_of(pair, {"body.material.model=plastic"});
-    CHECK(model.find("linear, corotational, stvk, neo-hookean, stable-neo-hookean, auto") != std::string::npos);
+    CHECK(model.find("linear, corotational, stvk, neo-hookean, stable-neo-hookean, stable-neo-hookean-paper, auto") != std::string::npos);
     CHECK(error_of(pair, {"time.step"}).find("expected key=value") != std::string::npos);
     CHECK(error_of(pair, {"body.5.name=x"}).find("no 5") != std::string::npos);
     // An index beyond any integer type: the same error, not std::out_of_range (issue 23, row 2).
