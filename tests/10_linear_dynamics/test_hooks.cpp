@@ -125,7 +125,7 @@ TEST_CASE("symplectic Euler moves pins at their velocity, lumped and consistent 
     }
 }
 
-TEST_CASE("with turning pins the midpoint rule's books balance to round-off, damped or not", "[ex10.4]")
+TEST_CASE("with turning pins the midpoint rule's books balance to round-off, damped or not", "[ex10.9]")
 {
     // The midpoint rule's energy identity on a linear body: H⁺ − H = Δt ṽ_pᵀ r_p − Δt v_θᵀ D v_θ
     // exactly, so H(t) − H(0) − W_in + damping must vanish up to round-off: a wrong boundary work
@@ -152,7 +152,7 @@ TEST_CASE("with turning pins the midpoint rule's books balance to round-off, dam
     }
 }
 
-TEST_CASE("with turning pins backward Euler dissipates, never adds energy", "[ex10.4]")
+TEST_CASE("with turning pins backward Euler dissipates, never adds energy", "[ex10.9]")
 {
     Scene scene = cantilever_scene();
     Body body(scene);
