@@ -131,8 +131,8 @@ Eigen::VectorXd step_right_hand_side(const SparseMatrix& M, const Eigen::VectorX
                                      const Eigen::VectorXd& external_forces, double time_step);
 
 /// The right-hand side of the velocity-change form, r = Δt [f + f_ext − D v − θΔt K v] with
-/// D v = α M v + β K v (all vectors of M's size; Kv = K v, needed when β ≠ 0 or θ < 1, else may be
-/// empty). A Δv = r gives v⁺ = v + Δv, the same v⁺ as A v⁺ = b with b from step_right_hand_side
+/// D v = α M v + β K v (all vectors of M's size, Kv = K v included: where β = 0 and θ = 1 its terms
+/// vanish, but its size is checked all the same — pass K v or zeros). A Δv = r gives v⁺ = v + Δv, the same v⁺ as A v⁺ = b with b from step_right_hand_side
 /// and its θ < 1 correction. fem::Error for Δt ≤ 0, θ outside [½, 1] or mismatched sizes.
 /// docs/10_linear_dynamics.md#two-forms-of-one-step
 Eigen::VectorXd velocity_change_right_hand_side(const SparseMatrix& M, const Eigen::VectorXd& v,

@@ -5,6 +5,8 @@
 // side by side. docs/11_corotational.md#a-large-swing
 #include "11_corotational/studies.hpp"
 
+#include "10_linear_dynamics/tip_path.hpp"
+
 #include "common/error.hpp"
 #include "common/figures.hpp"
 #include "common/motion.hpp"
@@ -17,12 +19,10 @@
 namespace fem::corot::study {
 namespace {
 
-/// One run of the swing: the tip's position at every step, and what the tables report.
+/// One run of the swing: the tip's path (chapter 10's TipPath), and what the tables report.
 struct SwingRun {
     std::string model, integrator;
-    double time_step = 0.0;
-    std::vector<double> times, tip_z, tip_x;
-    double largest_volume_change = 0.0;  ///< max over the run of |V(t)/V₀ − 1|
+    dynamics::TipPath path;
     double energy_drift = 0.0;           ///< max over the run of (H − H₀) / max (T + U + |W|)
     double lowest_tip_angle = 0.0;       ///< the steepest the tip's chord gets below the horizontal [deg]
     double seconds_per_step = 0.0;
@@ -37,40 +37,23 @@ SwingRun swing(const dynamics::Scene& base, const std::string& model, double the
     const auto stepper = std::make_unique<dynamics::ThetaMethod>(theta);
     dynamics::Simulation simulation(body, *stepper, dynamics::initial_state(body), time_step);
     const int tip = dynamics::far_corner(scene.mesh);
-    const double rest_volume = total_volume(scene.mesh);
-    SwingRun run{model, stepper->name(), time_step, {}, {}, {}, 0.0, 0.0, 0.0, 0.0};
+    SwingRun run{model, stepper->name(), {}, 0.0, 0.0, 0.0};
+    run.path.tip = tip;
+    run.path.time_step = time_step;
     double h0 = 0.0, scale = 0.0;
     const int steps = dynamics::step_count(scene.duration, time_step);
     Timer clock;
     simulation.run(steps, [&](const dynamics::State& state, const dynamics::StepRecord& record) {
-        const MatrixX3d x = body.positions(state.u);
-        run.times.push_back(state.time);
-        run.tip_x.push_back(x(tip, 0));
-        run.tip_z.push_back(x(tip, 2));
+        run.path.record(body, state);
         if (state.step == 0)
             h0 = record.energies.total();
         scale = std::max(scale, record.energies.magnitude());
         run.energy_drift = std::max(run.energy_drift, (record.energies.total() - h0) / std::max(scale, 1e-300));
-        run.largest_volume_change =
-            std::max(run.largest_volume_change, std::abs(total_volume(TetMesh{x, scene.mesh.T}) / rest_volume - 1.0));
-        const double drop = scene.mesh.V(tip, 2) - x(tip, 2);
-        run.lowest_tip_angle = std::max(run.lowest_tip_angle, std::atan2(drop, x(tip, 0)) * 180.0 / M_PI);
+        const double drop = scene.mesh.V(tip, 2) - run.path.z.back();
+        run.lowest_tip_angle = std::max(run.lowest_tip_angle, std::atan2(drop, run.path.x.back()) * 180.0 / M_PI);
     });
     run.seconds_per_step = clock.seconds() / steps;
     return run;
-}
-
-/// The largest distance between the tip of `run` and of `reference` at the run's own times (the
-/// reference's steps divide the run's).
-double tip_error(const SwingRun& run, const SwingRun& reference)
-{
-    const long ratio = std::lround(run.time_step / reference.time_step);
-    double error = 0.0;
-    for (std::size_t k = 0; k < run.times.size(); ++k) {
-        const std::size_t r = k * static_cast<std::size_t>(ratio);
-        error = std::max(error, std::hypot(run.tip_x[k] - reference.tip_x[r], run.tip_z[k] - reference.tip_z[r]));
-    }
-    return error;
 }
 
 /// Both bodies of one step side by side (the corotational one shifted by `offset` along x): one mesh,
@@ -156,11 +139,11 @@ void swing_study(const RunContext& run, const Settings& settings)
             for (const double rate : steps_per_second) {
                 runs.push_back(swing(scene, model, theta, 1.0 / rate));
                 const SwingRun& r = runs.back();
-                table.add_row({model, r.integrator, rate, tip_error(r, reference), r.largest_volume_change,
-                               r.energy_drift, r.lowest_tip_angle, r.seconds_per_step});
+                table.add_row({model, r.integrator, rate, dynamics::largest_tip_distance(r.path, reference.path),
+                               r.path.largest_volume_change, r.energy_drift, r.lowest_tip_angle, r.seconds_per_step});
             }
     table.add_row({std::string("corotational (reference)"), reference.integrator, 1.0 / reference_dt, 0.0,
-                   reference.largest_volume_change, reference.energy_drift, reference.lowest_tip_angle,
+                   reference.path.largest_volume_change, reference.energy_drift, reference.lowest_tip_angle,
                    reference.seconds_per_step});
     table.print(std::cout);
     table.write_csv(run.file("swing_table.csv"));
@@ -175,8 +158,8 @@ void swing_study(const RunContext& run, const Settings& settings)
             fig::Series series{str(model, ", ", integrator), {}, {}};
             for (const SwingRun& r : runs)
                 if (r.model == model && r.integrator == integrator) {
-                    series.x.push_back(r.seconds_per_step * double(r.times.size() - 1));
-                    series.y.push_back(tip_error(r, reference));
+                    series.x.push_back(r.seconds_per_step * double(r.path.times.size() - 1));
+                    series.y.push_back(dynamics::largest_tip_distance(r.path, reference.path));
                 }
             pareto.series.push_back(series);
         }
@@ -187,10 +170,10 @@ void swing_study(const RunContext& run, const Settings& settings)
     tips.x_label = "t [s]";
     tips.y_label = "tip height z [m]";
     tips.series.push_back({str("corotational, dt = 1/", std::lround(1.0 / reference_dt), " s (reference)"),
-                           reference.times, reference.tip_z});
+                           reference.path.times, reference.path.z});
     for (const SwingRun& r : runs)
-        if (std::abs(r.time_step - base_dt) < 1e-12)
-            tips.series.push_back({str(r.model, ", ", r.integrator), r.times, r.tip_z});
+        if (std::abs(r.path.time_step - base_dt) < 1e-12)
+            tips.series.push_back({str(r.model, ", ", r.integrator), r.path.times, r.path.z});
     tips.legend = fig::Corner::bottom_left;
     fig::save_chart(tips, run.file("swing_tips"), run.figures);
 

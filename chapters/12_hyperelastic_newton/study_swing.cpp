@@ -5,6 +5,7 @@
 #include "12_hyperelastic_newton/studies.hpp"
 
 #include "10_linear_dynamics/time_integration.hpp"
+#include "10_linear_dynamics/tip_path.hpp"
 
 #include "common/error.hpp"
 #include "common/figures.hpp"
@@ -18,12 +19,11 @@
 namespace fem::hyper::study {
 namespace {
 
-/// One run: the tip at every step and what the table reports.
+/// One run: the tip's path (chapter 10's TipPath) and what the table reports.
 struct SwingRun {
     std::string model;
-    double time_step = 0.0;
-    std::vector<double> times, tip_x, tip_z;
-    double mean_iterations = 0.0, seconds_per_step = 0.0, largest_volume_change = 0.0;
+    dynamics::TipPath path;
+    double mean_iterations = 0.0, seconds_per_step = 0.0;
     int most_iterations = 0;
 };
 
@@ -37,37 +37,21 @@ SwingRun swing(const dynamics::Scene& base, const std::string& model, double tim
     options.relative_tolerance = tolerance;
     NewtonBackwardEuler newton(options);
     dynamics::Simulation simulation(body, newton, dynamics::initial_state(body), time_step);
-    const int tip = dynamics::far_corner(scene.mesh), steps = dynamics::step_count(scene.duration, time_step);
-    const double rest_volume = total_volume(scene.mesh);
-    SwingRun run{model, time_step, {}, {}, {}, 0.0, 0.0, 0.0, 0};
+    const int steps = dynamics::step_count(scene.duration, time_step);
+    SwingRun run{model, {}, 0.0, 0.0, 0};
+    run.path.tip = dynamics::far_corner(scene.mesh);
+    run.path.time_step = time_step;
     Timer clock;
     simulation.run(steps, [&](const dynamics::State& state, const dynamics::StepRecord& record) {
-        const MatrixX3d x = body.positions(state.u);
-        run.times.push_back(state.time);
-        run.tip_x.push_back(x(tip, 0));
-        run.tip_z.push_back(x(tip, 2));
+        run.path.record(body, state);
         run.mean_iterations += record.newton_iterations;
         run.most_iterations = std::max(run.most_iterations, record.newton_iterations);
-        run.largest_volume_change =
-            std::max(run.largest_volume_change, std::abs(total_volume(TetMesh{x, scene.mesh.T}) / rest_volume - 1.0));
         if (recorder != nullptr)
             recorder->add(state.time, dynamics::body_frame(body, state));
     });
     run.seconds_per_step = clock.seconds() / steps;
     run.mean_iterations /= steps;
     return run;
-}
-
-/// The largest distance between the tips of run and reference at the run's times.
-double tip_error(const SwingRun& run, const SwingRun& reference)
-{
-    const long ratio = std::lround(run.time_step / reference.time_step);
-    double error = 0.0;
-    for (std::size_t k = 0; k < run.times.size(); ++k) {
-        const std::size_t r = k * static_cast<std::size_t>(ratio);
-        error = std::max(error, std::hypot(run.tip_x[k] - reference.tip_x[r], run.tip_z[k] - reference.tip_z[r]));
-    }
-    return error;
 }
 
 }  // namespace
@@ -93,8 +77,9 @@ void swing_study(const RunContext& run, const Settings& settings)
         for (const double rate : steps_per_second) {
             runs.push_back(swing(scene, model, 1.0 / rate, 1e-6));
             const SwingRun& r = runs.back();
-            table.add_row({model, rate, tip_error(r, reference), r.mean_iterations, double(r.most_iterations),
-                           r.largest_volume_change, r.seconds_per_step});
+            table.add_row({model, rate, dynamics::largest_tip_distance(r.path, reference.path), r.mean_iterations,
+                           double(r.most_iterations),
+                           r.path.largest_volume_change, r.seconds_per_step});
         }
     table.print(std::cout);
     table.write_csv(run.file("swing_table.csv"));
@@ -108,8 +93,8 @@ void swing_study(const RunContext& run, const Settings& settings)
         fig::Series series{model, {}, {}};
         for (const SwingRun& r : runs)
             if (r.model == model) {
-                series.x.push_back(r.seconds_per_step * double(r.times.size() - 1));
-                series.y.push_back(tip_error(r, reference));
+                series.x.push_back(r.seconds_per_step * double(r.path.times.size() - 1));
+                series.y.push_back(dynamics::largest_tip_distance(r.path, reference.path));
             }
         pareto.series.push_back(series);
     }
