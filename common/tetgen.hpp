@@ -1,6 +1,6 @@
 #pragma once
 // TetGen, Debian's tetgen program, run in a child process with a time and a memory limit: the
-// tetrahedra inside a closed triangle surface. docs/scenes.md#meshes
+// tetrahedra inside a closed triangle surface. docs/scenes.md#limits
 
 #include "common/mesh.hpp"
 

@@ -175,6 +175,9 @@ struct ReadLimits {
     /// The memory a run of the scene may need [bytes] (see memory_estimate); 0: the memory the
     /// machine has available now (and the process's address-space limit, if lower).
     std::size_t memory = 0;
+    /// The most winding-number terms (cubes × surface triangles) a mesh.lattice may cost: each
+    /// cube of the surface's bounding box is tested against every triangle (chapter 13).
+    double lattice_work = 5e9;
 };
 
 /// Reads and checks a scene file: first the [quick] table's overrides when quick is set, then

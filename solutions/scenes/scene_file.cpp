@@ -593,7 +593,25 @@ TetMesh build_mesh(const Fields& fields, const std::filesystem::path& scene_file
                     if (fields.has("tetgen"))
                         fields.fail(*fields.get("tetgen"), "tetgen", "give either tetgen or lattice, not both");
                     spec.lattice = fields.integer_of(*fields.get("lattice"), "lattice", 1, 100);
-                    mesh = skin::enclosing_lattice(io::read_tri_mesh(spec.file), spec.lattice);
+                    const TriMesh surface = io::read_tri_mesh(spec.file);
+                    // The lattice's cubes are at most those of the surface's bounding box at its
+                    // spacing: refused before they are built when their run would not fit in memory
+                    // or their winding numbers (each cube against every triangle) are too many.
+                    const Eigen::Vector3d extent = surface.V.colwise().maxCoeff() - surface.V.colwise().minCoeff();
+                    const double spacing = extent.maxCoeff() / spec.lattice;
+                    if (spacing > 0.0) {
+                        const Eigen::Vector3<long long> cubes =
+                            (extent / spacing).array().ceil().max(1.0).cast<long long>() + 1;
+                        check_memory(fields, *fields.get("lattice"), "lattice", (cubes.array() + 1).prod(),
+                                     6 * cubes.prod(), "use a smaller lattice");
+                        const double work = static_cast<double>(cubes.prod()) * static_cast<double>(surface.F.rows());
+                        if (work > fields.source().limits.lattice_work)
+                            fields.fail(*fields.get("lattice"), "lattice",
+                                        str("up to ", cubes.prod(), " cubes against ", surface.F.rows(),
+                                            " triangles are ", work, " winding-number terms; at most ",
+                                            fields.source().limits.lattice_work, " are allowed: use a smaller lattice"));
+                    }
+                    mesh = skin::enclosing_lattice(surface, spec.lattice);
                 } else {
                     spec.tetgen = fields.text("tetgen", spec.tetgen);
                     if (!fields.source().limits.tetgen)
@@ -617,9 +635,8 @@ TetMesh build_mesh(const Fields& fields, const std::filesystem::path& scene_file
             fields.fail(node, "file", text);
         }
         mesh.V *= spec.scale;
-        if (mesh.T.rows() > 0)
-            check_memory(fields, node, "file", mesh.V.rows(), mesh.T.rows(),
-                         fields.has("lattice") ? "use a smaller lattice" : "use a coarser mesh (or larger TetGen volumes)");
+        if (mesh.T.rows() > 0 && !fields.has("lattice"))  // a lattice was counted before it was built
+            check_memory(fields, node, "file", mesh.V.rows(), mesh.T.rows(), "use a coarser mesh (or larger TetGen volumes)");
     }
     if (mesh.T.rows() == 0)
         fields.fail(*fields.get(file ? "file" : "generator"), file ? "file" : "generator", "the mesh has no tets");

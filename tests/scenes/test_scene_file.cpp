@@ -25,10 +25,11 @@ const std::filesystem::path bad = FEM_SCENE_BAD_DIR;
 const std::filesystem::path gallery = FEM_SCENES_DIR;
 
 /// The message of the fem::Error read_scene throws (fails the test when it throws none).
-std::string error_of(const std::filesystem::path& file, const std::vector<std::string>& overrides = {})
+std::string error_of(const std::filesystem::path& file, const std::vector<std::string>& overrides = {},
+                     const ReadLimits& limits = {})
 {
     try {
-        read_scene(file, overrides);
+        read_scene(file, overrides, false, limits);
     } catch (const Error& e) {
         return e.what();
     }
@@ -154,6 +155,17 @@ TEST_CASE("a skin section is read and checked: the file and the body it names", 
     const std::string lattice0 = error_of(skinned, {"body.mesh.lattice=0"});
     CHECK(lattice0.find("body[0].mesh.lattice") != std::string::npos);
     CHECK(lattice0.find("skinned_bunny.toml") == lattice0.rfind("skinned_bunny.toml"));  // its place once (row 12)
+    // A lattice is counted before it is built: its memory, and its winding-number terms (cubes of the
+    // surface's bounding box times triangles), which for lattice = 100 took minutes (issue 23, the fuzzer).
+    ReadLimits small;
+    small.lattice_work = 2e6;
+    CHECK_NOTHROW(read_scene(skinned, {}, false, small));
+    const std::string work = error_of(skinned, {"body.mesh.lattice=8"}, small);
+    CHECK(work.find("body[0].mesh.lattice: up to ") != std::string::npos);
+    CHECK(work.find("3674 triangles are") != std::string::npos);
+    CHECK(work.find("at most 2e+06 are allowed: use a smaller lattice") != std::string::npos);
+    small.memory = std::size_t(1) << 20;
+    CHECK(error_of(skinned, {}, small).find("body[0].mesh.lattice: a run of this mesh needs about") != std::string::npos);
     CHECK(error_of(skinned, {"skin.body=nobody"}).find("no body is called 'nobody'") != std::string::npos);
     const std::string no_skin = error_of(skinned, {"skin.file=nothing.obj"});
     CHECK(no_skin.find("skin.file: no such file: ") != std::string::npos);
