@@ -25,6 +25,15 @@ struct Settings {
 void modes_study(const RunContext& run, const Settings& settings);
 void recurrence_study(const RunContext& run, const Settings& settings);
 void accuracy_study(const RunContext& run, const Settings& settings);
+
+/// The most steps symplectic Euler may take in the accuracy study: 8 runs' worth of its explicit
+/// limit for a beam stiffened far beyond rubber (ν → 0.5, a huge Y) would run for hours.
+constexpr long long max_explicit_steps = 2'000'000;
+
+/// The fewest steps symplectic Euler needs over settings.duration on the accuracy study's beam
+/// (Δt = 0.9 · 2/ω_max); the study runs 1, 2, 4 and 8 times as many. fem::Error naming --youngs,
+/// --poisson and --density, with the count, when 8 times as many exceed max_explicit_steps.
+long long explicit_steps(const Settings& settings);
 void statics_study(const RunContext& run, const Settings& settings);
 void hard_cases_study(const RunContext& run, const Settings& settings);
 void cost_study(const RunContext& run, const Settings& settings);
