@@ -92,7 +92,20 @@ public:
     std::string place(int line) const { return str(name_, ", line ", line); }
     std::istream& stream() { return in_; }
 
-    [[noreturn]] void fail(const std::string& what) const { throw Error(str(place(), ": ", what)); }
+    /// fem::Error at this line; bytes that are not printable (a NUL would end the message where it is
+    /// printed) are written as \xNN.
+    [[noreturn]] void fail(const std::string& what) const
+    {
+        std::string shown;
+        for (const char c : what) {
+            const auto byte = static_cast<unsigned char>(c);
+            if (byte < 0x20 || byte == 0x7f)
+                shown += str("\\x", "0123456789abcdef"[byte >> 4], "0123456789abcdef"[byte & 15]);
+            else
+                shown += c;
+        }
+        throw Error(str(place(), ": ", shown));
+    }
 
     double number(std::string_view token, std::string_view what) const
     {
