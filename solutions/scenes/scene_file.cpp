@@ -646,7 +646,7 @@ TetMesh build_mesh(const Fields& fields, const std::filesystem::path& scene_file
         for (int c = 0; c < 4; ++c)
             used[static_cast<std::size_t>(mesh.T(t, c))] = true;
     if (const auto unused = std::find(used.begin(), used.end(), false); unused != used.end())
-        fields.fail(*fields.get("file"), "file",
+        fields.fail(*fields.get(file ? "file" : "generator"), file ? "file" : "generator",
                     str("vertex ", unused - used.begin(), " belongs to no tet (", std::count(used.begin(), used.end(), false),
                         " of ", used.size(), " vertices do not); a vertex without a tet has no mass and no stiffness, ",
                         "and the step's matrix would be singular: remove it from the mesh"));
