@@ -170,7 +170,7 @@ TEST_CASE("the flag --no-figures turns the figures off", "[cli]")
     CHECK(run.body_ran);
 }
 
-TEST_CASE("--out \"\" is refused before anything is written (issue 23, row 7)", "[cli]")
+TEST_CASE("an empty --out is refused before anything is written (issue 23, row 7)", "[cli]")
 {
     const std::filesystem::path here = std::filesystem::current_path();
     const bool had_manifest = std::filesystem::exists(here / ".fem-run-files");
@@ -181,7 +181,7 @@ TEST_CASE("--out \"\" is refused before anything is written (issue 23, row 7)", 
     CHECK(std::filesystem::exists(here / ".fem-run-files") == had_manifest);  // nothing published here
 }
 
-TEST_CASE("any exception is one line 'error: …' and exit 1; one that is not an fem::Error is an internal error to report", "[cli]")
+TEST_CASE("any exception is one line 'error: …' and exit 1, and one that is not an fem::Error is an internal error to report", "[cli]")
 {
     const std::string out_dir = fem::test::fresh_output_dir("cli_internal_error").string();
     // In the options' check (it was std::terminate there) and in the run itself.

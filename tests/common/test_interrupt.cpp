@@ -13,7 +13,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-TEST_CASE("SIGINT, SIGTERM and SIGHUP each ask to stop and are told apart; request_stop asks without one", "[common][interrupt]")
+TEST_CASE("SIGINT, SIGTERM and SIGHUP each ask to stop and are told apart, and request_stop asks without one", "[common][interrupt]")
 {
     for (const int signal : {SIGINT, SIGTERM, SIGHUP}) {
         INFO(signal);
