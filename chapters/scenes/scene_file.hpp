@@ -218,8 +218,5 @@ std::vector<int> select_vertices(const TetMesh& mesh, const Selector& selector);
 /// The prescribed displacement g(X, t) of a rest position X under a motion at time t [m].
 Eigen::Vector3d prescribed_displacement(const Motion& motion, const Eigen::Vector3d& X, double t);
 
-/// The triangles on the boundary of a tet mesh (faces of one tet only), outward by the tet's
-/// orientation (#F×3).
-MatrixX3i boundary_faces(const TetMesh& mesh);
 
 }  // namespace fem::scenes

@@ -22,7 +22,6 @@
 #include <array>
 #include <cmath>
 #include <fstream>
-#include <map>
 #include <set>
 #include <sys/resource.h>
 #include <sstream>
@@ -1110,32 +1109,6 @@ Eigen::Vector3d prescribed_displacement(const Motion& motion, const Eigen::Vecto
         return s * motion.displacement;
     const Eigen::Matrix3d R = Eigen::AngleAxisd(s * motion.angle, motion.axis).toRotationMatrix();
     return R * (X - motion.center) + motion.center - X;
-}
-
-MatrixX3i boundary_faces(const TetMesh& mesh)
-{
-    // Each tet (a, b, c, d) of positive volume has the outward faces below; a face shared by two
-    // tets appears in both with opposite orientation, so only faces counted once are on the boundary.
-    static constexpr int faces[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
-    std::map<std::array<int, 3>, std::pair<int, std::array<int, 3>>> count;
-    for (Eigen::Index t = 0; t < mesh.T.rows(); ++t) {
-        for (const auto& f : faces) {
-            const std::array<int, 3> oriented{mesh.T(t, f[0]), mesh.T(t, f[1]), mesh.T(t, f[2])};
-            std::array<int, 3> key = oriented;
-            std::sort(key.begin(), key.end());
-            auto& entry = count[key];
-            entry.first += 1;
-            entry.second = oriented;
-        }
-    }
-    std::vector<std::array<int, 3>> kept;
-    for (const auto& [key, entry] : count)
-        if (entry.first == 1)
-            kept.push_back(entry.second);
-    MatrixX3i F(static_cast<Eigen::Index>(kept.size()), 3);
-    for (std::size_t i = 0; i < kept.size(); ++i)
-        F.row(static_cast<Eigen::Index>(i)) << kept[i][0], kept[i][1], kept[i][2];
-    return F;
 }
 
 }  // namespace fem::scenes

@@ -2,6 +2,8 @@
 // are checked like the file; selectors and prescribed motions. docs/scenes.md#the-scene-file
 #include "scenes/scene_file.hpp"
 
+#include "13_skinning/skinning.hpp"
+
 #include "common/error.hpp"
 #include "common/files.hpp"
 #include "common/test_support.hpp"
@@ -222,8 +224,9 @@ TEST_CASE("prescribed motion: the smooth ramp reaches the rotation and holds it"
 
 TEST_CASE("boundary faces of a box mesh: 12 per face of cubes, outward, closing the volume", "[scenes][scene_file]")
 {
+    // Surface loads lump a traction onto chapter 13's boundary faces: they must be outward and complete.
     const TetMesh mesh = box_mesh(2, 1, 1, Eigen::Vector3d(2.0, 1.0, 1.0));
-    const MatrixX3i F = boundary_faces(mesh);
+    const MatrixX3i F = skin::boundary_faces(mesh).faces;
     CHECK(F.rows() == 2 * (2 * 1 + 2 * 1 + 1 * 1) * 2);
     // Σ over outward faces of (x · n) area / 3 is the volume (the divergence theorem).
     double volume = 0.0;
