@@ -125,6 +125,24 @@ TEST_CASE("symplectic Euler moves pins at their velocity, lumped and consistent 
     }
 }
 
+TEST_CASE("symplectic Euler puts pins started from rest where their velocity takes them", "[ex10.5]")
+{
+    // The pins' step is u_p⁺ = u_p + Δt ṽ_p, whatever their velocity was: a step that kept v_p would
+    // leave them at rest.
+    Scene scene = cantilever_scene();
+    scene.time_step = 1e-5;
+    Body body(scene);
+    SymplecticEuler integrator;
+    const Eigen::VectorXd pins = on_pins(body, uniform_velocity(body, Eigen::Vector3d(0.3, -0.2, 0.5)));
+    body.set_pin_velocity(pins);
+    Simulation simulation(body, integrator, initial_state(body), scene.time_step);
+    simulation.run(20);
+    const Eigen::VectorXd where = on_pins(body, simulation.state().u) - simulation.state().time * pins;
+    CAPTURE(sci(where.cwiseAbs().maxCoeff()));
+    CHECK(where.cwiseAbs().maxCoeff() <= 1e-15);
+    CHECK(on_pins(body, simulation.state().v) == pins);
+}
+
 TEST_CASE("with turning pins the midpoint rule's books balance to round-off, damped or not", "[ex10.9]")
 {
     // The midpoint rule's energy identity on a linear body: H⁺ − H = Δt ṽ_pᵀ r_p − Δt v_θᵀ D v_θ
