@@ -2,6 +2,7 @@
 
 #include "common/error.hpp"
 #include "common/files.hpp"
+#include "common/memory.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -271,6 +272,9 @@ int ChapterCli::run(int argc, char** argv, const std::function<void(const RunCon
         write_file(context_.file(run_manifest), manifest);
         staged->publish(previous_run_files(out));
         std::cout << "\nwrote " << std::filesystem::absolute(out).lexically_normal().string() << '\n';
+        // The number varies by machine and library version: check_run.py compares files, never stdout.
+        std::cout << "peak memory: " << (peak_resident_bytes() + 500'000) / 1'000'000
+                  << " MB (resident, getrusage; 1 MB = 10^6 bytes)\n";
         return 0;
     } catch (...) {
         message = failure_message(std::current_exception());

@@ -94,7 +94,9 @@ public:
     /// Parses argv (running every option's check), runs the check of check_options(), and calls
     /// body, which writes into a staging folder (fem::StagedFiles) inside --out. Only when body
     /// returns do its files appear in --out, together, replacing the previous run's (whose files
-    /// this run did not write again are removed; other files are left alone). A run that fails
+    /// this run did not write again are removed; other files are left alone), and run() prints
+    /// "wrote <--out>" and the run's peak resident memory ("peak memory: 312 MB", from
+    /// peak_resident_bytes() of common/memory.hpp; not printed after a failure). A run that fails
     /// leaves --out as it was. The list of the files written (.fem-run-files in --out) names the
     /// files the next run may remove; a list that names anything but plain entries of --out is
     /// ignored with a warning. Returns the process exit code: 0 on success (and after --help); 1
