@@ -207,6 +207,14 @@ public:
 
     const Scene& scene() const { return scene_; }
     const TetMesh& mesh() const { return scene_.mesh; }
+
+    /// Δt [s] of every step taken on this body: the scene's, the one place it lives (Simulation
+    /// reads it here at each step).
+    double time_step() const { return scene_.time_step; }
+    /// Changes Δt, for a study that sweeps it on one body (M, the loads and the model do not depend
+    /// on it). fem::Error unless Δt is finite and > 0 and the scene's duration is a whole number of
+    /// steps of it (step_count).
+    void set_time_step(double time_step);
     ForceModel& model() { return *model_; }
     const ForceModel& model() const { return *model_; }
     const FreeDofs& dofs() const { return dofs_; }

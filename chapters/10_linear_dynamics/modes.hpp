@@ -83,13 +83,13 @@ Eigen::Matrix2d oscillator_step_matrix(double omega, double xi, double time_step
 Eigen::Matrix2d symplectic_oscillator_step_matrix(double omega, double xi, double time_step);
 
 /// How closely a body follows one mode's recurrence: starting at rest in `start` (3n, a mode shape
-/// φ times an amplitude), runs `steps` steps of integrator and returns
+/// φ times an amplitude), runs `steps` steps of integrator (Δt: the body's) and returns
 ///   max_n |u_dof(n) − (Gⁿ (1, 0)ᵀ)₀ · start_dof| / max_n |u_dof(n)|,
 /// G the integrator's 2×2 step matrix on that mode (oscillator_step_matrix and its kin). Round-off
 /// for an exact G. fem::Error for a dof outside [0, 3n), steps < 1, or what the run raises.
 /// docs/10_linear_dynamics.md#one-mode-one-oscillator
-double modal_recurrence_deviation(Body& body, Integrator& integrator, double time_step, const Eigen::VectorXd& start,
-                                  Eigen::Index dof, const Eigen::Matrix2d& G, int steps);
+double modal_recurrence_deviation(Body& body, Integrator& integrator, const Eigen::VectorXd& start, Eigen::Index dof,
+                                  const Eigen::Matrix2d& G, int steps);
 
 /// The exact (q(t), q̇(t)) of the damped oscillator from (q₀, p₀) at t = 0, for every ξ ≥ 0
 /// (under-, critically and over-damped). fem::Error unless ω > 0, ξ ≥ 0, t finite.

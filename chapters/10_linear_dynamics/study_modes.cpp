@@ -140,7 +140,7 @@ void recurrence_study(const RunContext& run, const Settings& settings)
                 explicit_step ? symplectic_oscillator_step_matrix(omega, xi, scene.time_step)
                               : oscillator_step_matrix(omega, xi, scene.time_step, name == "backward-euler" ? 1.0 : 0.5);
             table.add_row({integrator->name(), std::string(label), omega * scene.time_step, xi,
-                           modal_recurrence_deviation(body, *integrator, scene.time_step, phi, tip_dof, G, 100)});
+                           modal_recurrence_deviation(body, *integrator, phi, tip_dof, G, 100)});
         }
     }
     table.print(std::cout);
@@ -158,7 +158,7 @@ void recurrence_study(const RunContext& run, const Settings& settings)
         scene.time_step = omega_dt / omega;
         Body body(scene);
         ThetaMethod integrator(1.0);
-        Simulation simulation(body, integrator, initial_state(body, phi), scene.time_step);
+        Simulation simulation(body, integrator, initial_state(body, phi));
         const Eigen::VectorXd Mphi = body.mass_matrix() * phi;
         const double phi_norm = phi.dot(Mphi);
         std::complex<double> first, previous, last_ratio;

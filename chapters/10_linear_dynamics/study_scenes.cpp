@@ -21,7 +21,7 @@ std::vector<Cell> record(const RunContext& run, const std::string& name, const S
 {
     Body body(scene);
     ThetaMethod integrator(1.0);
-    Simulation simulation(body, integrator, initial_state(body, {}, v0), scene.time_step);
+    Simulation simulation(body, integrator, initial_state(body, {}, v0));
     io::MotionRecorder recorder(run.file(name + ".pvd"), run.figures ? png_every : 0);
     double largest = 0.0, peak_stress = 0.0;
     Timer clock;

@@ -283,8 +283,9 @@ public:
     /// docs/10_linear_dynamics.md#the-step-hook
     using BeforeStep = std::function<bool(Body& body, const State& state, double step_end)>;
 
-    /// fem::Error if Δt ≤ 0 or the state does not fit the body.
-    Simulation(Body& body, Integrator& integrator, State initial, double time_step);
+    /// Steps of Δt = body.time_step() (the scene's; Body::set_time_step changes it between runs).
+    /// fem::Error if the state does not fit the body.
+    Simulation(Body& body, Integrator& integrator, State initial);
 
     /// Sets the step hook (empty: none, the default): the scene's moving pins, loads and model.
     void set_before_step(BeforeStep hook) { before_step_ = std::move(hook); }
@@ -297,13 +298,12 @@ public:
 
     const State& state() const { return state_; }
     const StepRecord& last() const { return last_; }
-    double time_step() const { return time_step_; }
+    double time_step() const { return body_.time_step(); }
 
 private:
     Body& body_;
     Integrator& integrator_;
     State state_;
-    double time_step_;
     BeforeStep before_step_;
     double initial_total_ = 0.0;
     double largest_magnitude_ = 0.0;

@@ -35,7 +35,7 @@ SwingRun swing(const dynamics::Scene& base, const std::string& model, double the
     scene.time_step = time_step;
     dynamics::Body body(scene, force_model(model, scene));
     const auto stepper = std::make_unique<dynamics::ThetaMethod>(theta);
-    dynamics::Simulation simulation(body, *stepper, dynamics::initial_state(body), time_step);
+    dynamics::Simulation simulation(body, *stepper, dynamics::initial_state(body));
     const int tip = dynamics::far_corner(scene.mesh);
     SwingRun run{model, stepper->name(), {}, 0.0, 0.0, 0.0};
     run.path.tip = tip;
@@ -100,7 +100,7 @@ void swing_study(const RunContext& run, const Settings& settings)
             s.time_step = dt;
             dynamics::Body body(s, force_model("corotational", s));
             dynamics::ThetaMethod stepper(theta);
-            dynamics::Simulation simulation(body, stepper, dynamics::initial_state(body), dt);
+            dynamics::Simulation simulation(body, stepper, dynamics::initial_state(body));
             double h0 = 0.0, scale = 0.0, gain = 0.0, loss = 0.0;
             try {
                 simulation.run(dynamics::step_count(s.duration, dt),
@@ -181,9 +181,8 @@ void swing_study(const RunContext& run, const Settings& settings)
     dynamics::Body linear(scene, force_model("linear", scene)), corotational(scene, force_model("corotational", scene));
     const auto linear_stepper = dynamics::make_integrator("backward-euler");
     const auto corotational_stepper = dynamics::make_integrator("backward-euler");
-    dynamics::Simulation linear_run(linear, *linear_stepper, dynamics::initial_state(linear), base_dt);
-    dynamics::Simulation corotational_run(corotational, *corotational_stepper, dynamics::initial_state(corotational),
-                                          base_dt);
+    dynamics::Simulation linear_run(linear, *linear_stepper, dynamics::initial_state(linear));
+    dynamics::Simulation corotational_run(corotational, *corotational_stepper, dynamics::initial_state(corotational));
     io::MotionRecorder recorder(run.file("swing.pvd"), run.figures ? 9 : 0);
     const double offset = 0.3;
     recorder.add(0.0, side_by_side(linear, linear_run.state(), corotational, corotational_run.state(), offset));

@@ -139,7 +139,7 @@ void newton_study(const RunContext& run, const Settings& settings)
         NewtonOptions options;
         options.relative_tolerance = tolerance;
         NewtonBackwardEuler newton(options);
-        dynamics::Simulation simulation(body, newton, dynamics::initial_state(body), swing.time_step);
+        dynamics::Simulation simulation(body, newton, dynamics::initial_state(body));
         const int tip = dynamics::far_corner(swing.mesh), steps = dynamics::step_count(swing.duration, swing.time_step);
         std::vector<Eigen::Vector3d> path;
         iterations = 0.0;
@@ -200,7 +200,7 @@ void newton_study(const RunContext& run, const Settings& settings)
         const dynamics::Scene beam = dynamics::cantilever_scene(material, run.quick ? 10 : settings.swing_cells, 0.5);
         dynamics::Body body(beam, make_force_model("stable-neo-hookean", beam.mesh, beam.material));
         NewtonBackwardEuler newton;
-        dynamics::Simulation simulation(body, newton, dynamics::initial_state(body), beam.time_step);
+        dynamics::Simulation simulation(body, newton, dynamics::initial_state(body));
         const int tip = dynamics::far_corner(beam.mesh);
         const double rest_volume = total_volume(beam.mesh);
         double drop = 0.0, volume_change = 0.0, mean = 0.0;

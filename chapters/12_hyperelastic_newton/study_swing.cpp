@@ -36,7 +36,7 @@ SwingRun swing(const dynamics::Scene& base, const std::string& model, double tim
     NewtonOptions options;
     options.relative_tolerance = tolerance;
     NewtonBackwardEuler newton(options);
-    dynamics::Simulation simulation(body, newton, dynamics::initial_state(body), time_step);
+    dynamics::Simulation simulation(body, newton, dynamics::initial_state(body));
     const int steps = dynamics::step_count(scene.duration, time_step);
     SwingRun run{model, {}, 0.0, 0.0, 0};
     run.path.tip = dynamics::far_corner(scene.mesh);

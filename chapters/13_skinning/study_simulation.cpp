@@ -33,8 +33,7 @@ SkinnedRun simulate(const TetMesh& mesh, const TriMesh& surface, const Settings&
     Run run = bunny_run(mesh, surface, settings);
     const Skin skin = build_skin(mesh, surface);
     dynamics::Body& body = *run.body;
-    dynamics::Simulation simulation(body, *run.integrator, dynamics::initial_state(body, {}, run.push),
-                                    body.scene().time_step);
+    dynamics::Simulation simulation(body, *run.integrator, dynamics::initial_state(body, {}, run.push));
     SkinnedRun result;
     double observing = 0.0;  // the skin and the files, taken out of the step's time
     const int steps = dynamics::step_count(body.scene().duration, body.scene().time_step);

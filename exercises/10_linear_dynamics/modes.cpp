@@ -211,14 +211,14 @@ Eigen::Matrix2d symplectic_oscillator_step_matrix(double omega, double xi, doubl
     return G;
 }
 
-double modal_recurrence_deviation(Body& body, Integrator& integrator, double time_step, const Eigen::VectorXd& start,
-                                  Eigen::Index dof, const Eigen::Matrix2d& G, int steps)
+double modal_recurrence_deviation(Body& body, Integrator& integrator, const Eigen::VectorXd& start, Eigen::Index dof,
+                                  const Eigen::Matrix2d& G, int steps)
 {
     if (dof < 0 || dof >= body.dofs().full_size())
         throw Error(str("modal recurrence: dof ", dof, " is outside [0, ", body.dofs().full_size(), ")"));
     if (steps < 1)
         throw Error(str("modal recurrence: steps must be >= 1, got ", steps));
-    Simulation simulation(body, integrator, initial_state(body, start), time_step);
+    Simulation simulation(body, integrator, initial_state(body, start));
     Eigen::Vector2d modal(1.0, 0.0);
     double deviation = 0.0, largest = 0.0;
     simulation.run(steps, [&](const State& state, const StepRecord&) {

@@ -385,10 +385,9 @@ double apply_step_hook(const Simulation::BeforeStep& hook, Body& body, State& st
 
 // --- Simulation ----------------------------------------------------------------------------------
 
-Simulation::Simulation(Body& body, Integrator& integrator, State initial, double time_step)
-    : body_(body), integrator_(integrator), state_(std::move(initial)), time_step_(time_step)
+Simulation::Simulation(Body& body, Integrator& integrator, State initial)
+    : body_(body), integrator_(integrator), state_(std::move(initial))
 {
-    require_positive(time_step, "time step dt [s]");
     require_fits(body, state_);
 }
 
@@ -409,11 +408,12 @@ void Simulation::run(int steps, const Observer& observer)
     }
     for (int k = 0; k < steps; ++k) {
         Timer clock;
+        const double time_step = body_.time_step();
         StepRecord record;
         record.work_in = last_.work_in;
         if (before_step_)
-            record.work_in += apply_step_hook(before_step_, body_, state_, state_.time + time_step_);
-        const StepInfo info = integrator_.step(body_, time_step_, state_);
+            record.work_in += apply_step_hook(before_step_, body_, state_, state_.time + time_step);
+        const StepInfo info = integrator_.step(body_, time_step, state_);
         record.work_in += info.boundary_work;
         record.seconds = clock.seconds();
         record.step = state_.step;
@@ -424,7 +424,7 @@ void Simulation::run(int steps, const Observer& observer)
         record.damping_dissipated = last_.damping_dissipated + info.damping_work;
         const double total = record.energies.total();
         const auto where = [&] {
-            return str("step ", record.step, " (t = ", record.time, " s, dt = ", time_step_, " s, ",
+            return str("step ", record.step, " (t = ", record.time, " s, dt = ", time_step, " s, ",
                        integrator_.name(), ", ", body_.model().name(), " model)");
         };
         if (!std::isfinite(total) || !std::isfinite(record.work_in) || !state_.u.allFinite() || !state_.v.allFinite())

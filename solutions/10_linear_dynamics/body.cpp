@@ -190,6 +190,12 @@ Body::Body(const Scene& scene, std::unique_ptr<ForceModel> model)
     pin_velocity_ = Eigen::VectorXd::Zero(f_ext_.size());
 }
 
+void Body::set_time_step(double time_step)
+{
+    step_count(scene_.duration, time_step);
+    scene_.time_step = time_step;
+}
+
 namespace {
 
 /// fem::Error unless x has n entries, all finite (what: the quantity, for the message).

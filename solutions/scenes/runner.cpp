@@ -95,8 +95,7 @@ BodyRun start_body(const BodySpec& spec, const SceneSpec& scene, const std::stri
             v0.segment<3>(3 * v).setZero();  // pins start at rest: their motions ramp up from zero speed
     }
     b.integrator = std::make_unique<LevelIntegrator>(*b.forces, scene);
-    b.simulation = std::make_unique<dynamics::Simulation>(*b.body, *b.integrator, dynamics::initial_state(*b.body, {}, v0),
-                                                          scene.time_step);
+    b.simulation = std::make_unique<dynamics::Simulation>(*b.body, *b.integrator, dynamics::initial_state(*b.body, {}, v0));
     b.simulation->set_before_step(std::move(conditions));
     b.segments.push_back({0, 0, b.forces->level(), b.forces->level_model()});
     return b;

@@ -67,7 +67,7 @@ TEST_CASE("the midpoint rule keeps an undamped body's energy to round-off over 1
     Body body(scene);
     for (const StepForm form : {StepForm::velocity_change, StepForm::velocity}) {
         ThetaMethod midpoint(0.5, fem::test::with_form(form));
-        Simulation simulation(body, midpoint, initial_state(body, sag_shape(scene)), scene.time_step);
+        Simulation simulation(body, midpoint, initial_state(body, sag_shape(scene)));
         const double start = energies(body, simulation.state()).total();
         REQUIRE(start > 0.0);
         double drift = 0.0;
@@ -81,7 +81,7 @@ TEST_CASE("the midpoint rule keeps an undamped body's energy to round-off over 1
     }
     // Backward Euler on the same start loses energy every step.
     ThetaMethod backward(1.0);
-    Simulation damped(body, backward, initial_state(body, sag_shape(scene)), scene.time_step);
+    Simulation damped(body, backward, initial_state(body, sag_shape(scene)));
     const double start = energies(body, damped.state()).total();
     double previous = start;
     bool monotone = true;
@@ -100,7 +100,7 @@ TEST_CASE("energy balance: the loss splits into damping work and backward Euler'
     scene.damping = {0.02, 0.01};
     Body body(scene);
     ThetaMethod integrator(1.0);
-    Simulation simulation(body, integrator, initial_state(body), scene.time_step);
+    Simulation simulation(body, integrator, initial_state(body));
     const SparseMatrix& K = body.model().stiffness(simulation.state().u);
     double expected_integrator = 0.0, expected_damping = 0.0;
     Eigen::VectorXd u = simulation.state().u, v = simulation.state().v;
@@ -130,7 +130,7 @@ TEST_CASE("a damped beam under gravity settles to the static solution K^-1 f", "
     Body body(scene);
     const Eigen::VectorXd expected = static_solution(body);
     ThetaMethod integrator(1.0);
-    Simulation simulation(body, integrator, initial_state(body), scene.time_step);
+    Simulation simulation(body, integrator, initial_state(body));
     int settled_at = -1;
     simulation.run(300, [&](const State& state, const StepRecord&) {
         if (settled_at < 0 && (state.u - expected).norm() <= 1e-8 * expected.norm())
@@ -149,7 +149,7 @@ TEST_CASE("free fall: nothing pinned, the body falls rigidly on backward Euler's
     scene.time_step = 0.02;
     Body body(scene);
     ThetaMethod integrator(1.0);
-    Simulation simulation(body, integrator, initial_state(body), scene.time_step);
+    Simulation simulation(body, integrator, initial_state(body));
     const double g = -9.81, dt = scene.time_step;
     const Eigen::VectorXd masses = body.dof_masses();
     const double total_mass = masses.sum() / 3.0;
@@ -184,8 +184,8 @@ TEST_CASE("pinned dofs eliminated or kept with P A P + (I - P): the same traject
         ImplicitOptions keep;
         keep.pinned = PinnedRoute::keep;
         ThetaMethod a(theta), b(theta, keep);
-        Simulation sa(eliminated, a, initial_state(eliminated), scene.time_step);
-        Simulation sb(kept, b, initial_state(kept), scene.time_step);
+        Simulation sa(eliminated, a, initial_state(eliminated));
+        Simulation sb(kept, b, initial_state(kept));
         double pinned_motion = 0.0;
         const TrajectoryGap gap = trajectory_gap(sa, sb, 40, [&](const State& state) {
             pinned_motion += (state.u - state.u.cwiseProduct(kept.dofs().free_mask())).norm();
@@ -211,8 +211,8 @@ TEST_CASE("the lecture's velocity form equals the velocity-change form, damped t
             Body velocity_body(scene), change_body(scene);
             ThetaMethod lecture(theta, fem::test::with_form(StepForm::velocity)),
                 change(theta, fem::test::with_form(StepForm::velocity_change));
-            Simulation reference(change_body, change, initial_state(change_body), scene.time_step);
-            Simulation tested(velocity_body, lecture, initial_state(velocity_body), scene.time_step);
+            Simulation reference(change_body, change, initial_state(change_body));
+            Simulation tested(velocity_body, lecture, initial_state(velocity_body));
             const TrajectoryGap gap = trajectory_gap(reference, tested, 40);
             // The velocity form loses up to ~7× more to the cancellation of M v (the midpoint test above).
             const double bound = 10.0 * fem::test::trajectory_roundoff(change_body, scene.time_step, theta, 40);
@@ -235,9 +235,9 @@ TEST_CASE("solvers: factor once = refactor every step, and warm-started PCG agre
     pcg_options.solver = "ours-pcg-ic0";
     pcg_options.solver_options.relative_tolerance = 1e-12;
     ThetaMethod once(1.0), every(1.0, refactor), pcg(1.0, pcg_options);
-    Simulation s1(body, once, initial_state(body), scene.time_step);
-    Simulation s2(body, every, initial_state(body), scene.time_step);
-    Simulation s3(body, pcg, initial_state(body), scene.time_step);
+    Simulation s1(body, once, initial_state(body));
+    Simulation s2(body, every, initial_state(body));
+    Simulation s3(body, pcg, initial_state(body));
     s1.run(30);
     s2.run(30);
     std::vector<int> iterations;
@@ -264,21 +264,23 @@ TEST_CASE("symplectic Euler follows its own modal recurrence, with lumped and co
         Scene scene = cantilever_scene();
         scene.mass = mass;
         scene.damping = {0.02, 0.0};
+        scene.duration = 0.0;  // any dt is then a whole number of steps of it
         Body body(scene);
         const auto [K, M] = fem::test::free_matrices(body);
-        scene.time_step = 0.5 * 2.0 / highest_frequency(K, M);  // half the undamped limit 2/omega_max
+        body.set_time_step(0.5 * 2.0 / highest_frequency(K, M));  // half the undamped limit 2/omega_max
+        const double dt = body.time_step();
         const Modes modes = lowest_modes_dense(K, M, 1);
         const double omega = modes.omega[0], xi = damping_ratio(scene.damping, omega);
         const int tip = 3 * fem::test::tip_vertex(scene) + 2;
         const Eigen::VectorXd phi = fem::test::expanded(body, modes.shapes.col(0));
         SymplecticEuler integrator;
-        Simulation simulation(body, integrator, initial_state(body, 1e-3 * phi), scene.time_step);
+        Simulation simulation(body, integrator, initial_state(body, 1e-3 * phi));
         // p⁺ = p − Δt(ω² q + 2ξω p), q⁺ = q + Δt p⁺, written out here as the reference.
         double q = 1e-3, p = 0.0, deviation = 0.0;
         simulation.run(300, [&](const State& state, const StepRecord&) {
             if (state.step > 0) {
-                p = p - scene.time_step * (omega * omega * q + 2.0 * xi * omega * p);
-                q = q + scene.time_step * p;
+                p = p - dt * (omega * omega * q + 2.0 * xi * omega * p);
+                q = q + dt * p;
             }
             deviation = std::max(deviation, std::abs(state.u[tip] - q * phi[tip]));
         });
@@ -290,14 +292,16 @@ TEST_CASE("symplectic Euler follows its own modal recurrence, with lumped and co
 TEST_CASE("stability: explicit Euler blows up at 1.01x its limit and the loop says so, bounded at 0.99x",
           "[ex10.5]")
 {
-    const Scene scene = cantilever_scene(6, 2, true);
+    Scene scene = cantilever_scene(6, 2, true);
+    scene.duration = 0.0;  // any dt is then a whole number of steps of it
     Body body(scene);
     const auto [K, M] = fem::test::free_matrices(body);
     const double limit = 2.0 / highest_frequency(K, M);  // undamped: 2/omega_max
     const Eigen::VectorXd start = 0.5 * static_solution(body);
 
     SymplecticEuler above;
-    Simulation unstable(body, above, initial_state(body, start), 1.01 * limit);
+    body.set_time_step(1.01 * limit);
+    Simulation unstable(body, above, initial_state(body, start));
     int seen = 0;
     REQUIRE_THROWS_WITH(unstable.run(20000, [&](const State& state, const StepRecord&) {
                             CHECK(state.u.allFinite());  // no observer ever sees a NaN state
@@ -307,7 +311,8 @@ TEST_CASE("stability: explicit Euler blows up at 1.01x its limit and the loop sa
     CHECK(seen > 10);
 
     SymplecticEuler below;
-    Simulation stable(body, below, initial_state(body, start), 0.99 * limit);
+    body.set_time_step(0.99 * limit);
+    Simulation stable(body, below, initial_state(body, start));
     double largest = 0.0;
     stable.run(20000, [&](const State& state, const StepRecord&) { largest = std::max(largest, state.u.norm()); });
     CHECK(largest <= 3.0 * static_solution(body).norm());
@@ -317,11 +322,13 @@ TEST_CASE("backward Euler at 100x the explicit limit and a very stiff body at dt
           "[ex10.4]")
 {
     Scene scene = cantilever_scene(6, 2, true);
+    scene.duration = 0.0;
     Body body(scene);
     const auto [K, M] = fem::test::free_matrices(body);
     const double dt = 100.0 * 2.0 / highest_frequency(K, M);  // 100 x the explicit limit 2/omega_max
+    body.set_time_step(dt);
     ThetaMethod integrator(1.0);
-    Simulation simulation(body, integrator, initial_state(body), dt);
+    Simulation simulation(body, integrator, initial_state(body));
     double previous = 0.0;
     bool monotone = true;
     simulation.run(500, [&](const State& state, const StepRecord& record) {
@@ -338,7 +345,7 @@ TEST_CASE("backward Euler at 100x the explicit limit and a very stiff body at dt
     scene.time_step = 1.0 / 30.0;
     Body stiff(scene);
     ThetaMethod stiff_integrator(1.0);
-    Simulation stiff_run(stiff, stiff_integrator, initial_state(stiff), scene.time_step);
+    Simulation stiff_run(stiff, stiff_integrator, initial_state(stiff));
     double largest = 0.0;
     stiff_run.run(90, [&](const State& state, const StepRecord&) { largest = std::max(largest, state.u.norm()); });
     CHECK(std::isfinite(largest));
@@ -361,10 +368,18 @@ TEST_CASE("integrators by name, and steps that refuse bad input", "[ch10]")
     State state = initial_state(body);
     ThetaMethod integrator(1.0);
     CHECK_THROWS_AS(integrator.step(body, 0.0, state), fem::Error);
-    CHECK_THROWS_AS(Simulation(body, integrator, state, -1.0), fem::Error);
+    // Δt lives in the body's scene: a bad one is refused there, and so is one the duration
+    // (1 s here) is no whole number of steps of.
+    CHECK_THROWS_WITH(body.set_time_step(0.0), Contains("dt"));
+    CHECK_THROWS_WITH(body.set_time_step(-1.0), Contains("dt"));
+    CHECK_THROWS_WITH(body.set_time_step(std::nan("")), Contains("dt"));
+    CHECK_THROWS_WITH(body.set_time_step(0.3), Contains("whole number of steps"));
+    CHECK(body.time_step() == body.scene().time_step);
+    body.set_time_step(0.25);
+    CHECK(body.scene().time_step == 0.25);
     State wrong = state;
     wrong.u.resize(3);
     CHECK_THROWS_WITH(integrator.step(body, 0.01, wrong), Contains("does not fit"));
-    Simulation simulation(body, integrator, state, 0.01);
+    Simulation simulation(body, integrator, state);
     CHECK_THROWS_AS(simulation.run(-1), fem::Error);
 }

@@ -28,7 +28,7 @@ double recurrence_deviation(const Scene& scene, Integrator& integrator, const Ei
     const int tip_dof = 3 * fem::test::tip_vertex(scene) + 2;
     Eigen::VectorXd phi = fem::test::expanded(body, modes.shapes.col(0));
     phi *= 1e-3 / std::abs(phi[tip_dof]);
-    return modal_recurrence_deviation(body, integrator, scene.time_step, phi, tip_dof, G, steps);
+    return modal_recurrence_deviation(body, integrator, phi, tip_dof, G, steps);
 }
 
 }  // namespace
@@ -120,7 +120,7 @@ TEST_CASE("backward Euler's amplitude factor 1/sqrt(1 + w^2 dt^2) and phase atan
         Body moving(scene);
         ThetaMethod integrator(1.0);
         const Eigen::VectorXd phi = fem::test::expanded(moving, modes.shapes.col(0));
-        Simulation simulation(moving, integrator, initial_state(moving, 1e-3 * phi), scene.time_step);
+        Simulation simulation(moving, integrator, initial_state(moving, 1e-3 * phi));
         // w = p + iωq, with q = φᵀMu and p = φᵀMv, is multiplied by λ = 1/(1 − iωΔt) per step.
         std::complex<double> previous;
         double worst_modulus = 0.0, worst_phase = 0.0;

@@ -463,7 +463,7 @@ TEST_CASE("a spinning body: linear elasticity swells, corotational keeps its vol
         scene.time_step = dt;
         dynamics::Body body(scene, std::move(model));
         const auto stepper = dynamics::make_integrator(integrator);
-        dynamics::Simulation simulation(body, *stepper, dynamics::initial_state(body, {}, v0), dt);
+        dynamics::Simulation simulation(body, *stepper, dynamics::initial_state(body, {}, v0));
         Outcome outcome;
         double h0 = 0.0;
         simulation.run(static_cast<int>(std::lround(horizon / dt)),
@@ -559,7 +559,7 @@ TEST_CASE("the midpoint rule with the warped stiffness diverges on a large swing
     const auto run = [&](double theta, double& gain) {
         dynamics::Body body(scene, std::make_unique<CorotationalElasticity>(scene.mesh, scene.material));
         dynamics::ThetaMethod stepper(theta);
-        dynamics::Simulation simulation(body, stepper, dynamics::initial_state(body), scene.time_step);
+        dynamics::Simulation simulation(body, stepper, dynamics::initial_state(body));
         double h0 = 0.0, scale = 0.0;
         simulation.run(90, [&](const dynamics::State& state, const dynamics::StepRecord& record) {
             if (state.step == 0)

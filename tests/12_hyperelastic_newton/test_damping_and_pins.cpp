@@ -162,7 +162,7 @@ TEST_CASE("a damped swing loses energy: damping's books against D written out, b
         // An independent model for the damping's K_t: definite_stiffness at the step's start.
         const auto reference = make_force_model("stable-neo-hookean", scene.mesh, scene.material);
         NewtonBackwardEuler newton;
-        dynamics::Simulation simulation(body, newton, dynamics::initial_state(body), scene.time_step);
+        dynamics::Simulation simulation(body, newton, dynamics::initial_state(body));
         Eigen::VectorXd start = Eigen::VectorXd::Zero(body.dofs().full_size());
         double worst_gain = 0.0, largest = 0.0;
         computed_damping = 0.0;
@@ -202,7 +202,7 @@ TEST_CASE("pins translating at constant speed carry a damped stable neo-Hookean 
     const Eigen::VectorXd velocity = c.replicate(body.dofs().full_size() / 3, 1);
     body.set_pin_velocity(velocity.cwiseProduct(Eigen::VectorXd::Ones(velocity.size()) - body.dofs().free_mask()));
     NewtonBackwardEuler newton;
-    dynamics::Simulation simulation(body, newton, dynamics::initial_state(body, {}, velocity), scene.time_step);
+    dynamics::Simulation simulation(body, newton, dynamics::initial_state(body, {}, velocity));
     const int steps = 40;
     double damping = 0.0, boundary = 0.0, strain = 0.0;
     simulation.run(steps, [&](const dynamics::State& state, const dynamics::StepRecord& record) {
@@ -237,8 +237,8 @@ TEST_CASE("moving pins in Newton backward Euler: chapter 10's theta = 1 step and
         dynamics::Body newton_body(scene), theta_body(scene);
         NewtonBackwardEuler newton;
         dynamics::ThetaMethod theta(1.0);
-        dynamics::Simulation a(newton_body, newton, dynamics::initial_state(newton_body), scene.time_step);
-        dynamics::Simulation b(theta_body, theta, dynamics::initial_state(theta_body), scene.time_step);
+        dynamics::Simulation a(newton_body, newton, dynamics::initial_state(newton_body));
+        dynamics::Simulation b(theta_body, theta, dynamics::initial_state(theta_body));
         const Eigen::Vector3d c(0.0, 0.05, 0.1);
         a.set_before_step(shaking_pins(c, 20.0, scene.time_step));
         b.set_before_step(shaking_pins(c, 20.0, scene.time_step));
@@ -267,7 +267,7 @@ TEST_CASE("moving pins on stable neo-Hookean: backward Euler's books balance and
     scene.material = {2e5, 0.45, 1100.0};
     dynamics::Body body(scene, make_force_model("stable-neo-hookean", scene.mesh, scene.material));
     NewtonBackwardEuler newton;
-    dynamics::Simulation simulation(body, newton, dynamics::initial_state(body), scene.time_step);
+    dynamics::Simulation simulation(body, newton, dynamics::initial_state(body));
     simulation.set_before_step(shaking_pins(Eigen::Vector3d(0.0, 0.2, 0.4), 20.0, scene.time_step));
     double lowest = 0.0, largest = 0.0;
     simulation.run(30, [&](const dynamics::State&, const dynamics::StepRecord& record) {

@@ -541,7 +541,7 @@ TEST_CASE("hard cases: Y = 1e7 at dt = 1/24 s stays stable, nu up to 0.499 conve
         dynamics::Body body(scene, std::make_unique<HyperelasticElasticity>(
                                        scene.mesh, make_material("neo-hookean", scene.material.youngs_modulus, poisson)));
         NewtonBackwardEuler newton;
-        dynamics::Simulation simulation(body, newton, dynamics::initial_state(body), scene.time_step);
+        dynamics::Simulation simulation(body, newton, dynamics::initial_state(body));
         double h0 = 0.0, highest = -1e300;
         int most_iterations = 0;
         simulation.run(24, [&](const dynamics::State& state, const dynamics::StepRecord& record) {
@@ -593,7 +593,7 @@ TEST_CASE("inexact Newton: CG solved only as tightly as the gradient needs, the 
         options.solver = solver;
         options.forcing = forcing;
         NewtonBackwardEuler newton(options);
-        dynamics::Simulation simulation(body, newton, dynamics::initial_state(body), scene.time_step);
+        dynamics::Simulation simulation(body, newton, dynamics::initial_state(body));
         cg_iterations = 0;
         simulation.run(10, [&](const dynamics::State&, const dynamics::StepRecord& record) {
             cg_iterations += record.solver_iterations;

@@ -327,8 +327,7 @@ TEST_CASE("skinning a coarse simulation: the skinned lattice approaches the fine
         dynamics::Body body(scene, std::make_unique<corot::CorotationalElasticity>(scene.mesh, scene.material));
         dynamics::ThetaMethod integrator(1.0);
         dynamics::Simulation simulation(body, integrator,
-                                        dynamics::initial_state(body, {}, dynamics::sideways_push(scene, low, high, 0.5)),
-                                        scene.time_step);
+                                        dynamics::initial_state(body, {}, dynamics::sideways_push(scene, low, high, 0.5)));
         simulation.run(4);
         const MatrixX3d x = body.positions(simulation.state().u);
         if (own_surface)  // TetGen's first nodes are the bunny's vertices (the test of W = [I 0])
