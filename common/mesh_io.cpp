@@ -6,12 +6,18 @@
 
 #include <Eigen/Geometry>
 
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
 #include <bit>
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <cerrno>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
@@ -46,34 +52,65 @@ void require_readable_file(const fs::path& path)
 // ---------------------------------------------------------------------------------------------
 // Text files: lines split into whitespace-separated tokens, with the line number for messages.
 
+/// isspace() of the "C" locale: ' ', '\t', '\n', '\v', '\f', '\r'.
+constexpr bool is_space(char c) { return c == ' ' || (c >= '\t' && c <= '\r'); }
+
+/// A text file mapped into memory (mmap, read-only), then walked line by line in one pass: a line's
+/// tokens are views into that memory (no copy of the file, no allocation per line), numbers are
+/// parsed by std::from_chars.
 class TextFile {
 public:
     /// comment: the character that starts a comment up to the end of the line ('\0': none).
     TextFile(const fs::path& path, char comment) : name_(path.string()), comment_(comment)
     {
         require_readable_file(path);
-        in_.open(path, std::ios::binary);
-        if (!in_)
-            throw Error(str("cannot open '", name_, "' for reading"));
+        const int descriptor = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+        if (descriptor < 0)
+            throw Error(str("cannot open '", name_, "' for reading: ", std::strerror(errno)));
+        struct stat status {};
+        if (::fstat(descriptor, &status) == 0 && status.st_size > 0) {
+            size_ = static_cast<std::size_t>(status.st_size);
+            void* mapped = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE, descriptor, 0);
+            if (mapped == MAP_FAILED) {
+                const int reason = errno;
+                ::close(descriptor);
+                throw Error(str("cannot read '", name_, "': ", std::strerror(reason)));
+            }
+            ::madvise(mapped, size_, MADV_SEQUENTIAL);
+            text_ = static_cast<const char*>(mapped);
+        }
+        ::close(descriptor);  // the mapping stays valid
+    }
+    TextFile(const TextFile&) = delete;
+    TextFile& operator=(const TextFile&) = delete;
+    ~TextFile()
+    {
+        if (text_ != nullptr)
+            ::munmap(const_cast<char*>(text_), size_);
     }
 
     /// Moves to the next line that holds a token; false at the end of the file.
     bool next_line()
     {
-        while (std::getline(in_, text_)) {
+        tokens_.clear();
+        while (next_ < size_) {
+            const char* begin = text_ + next_;
+            const std::size_t left = size_ - next_;
+            const auto* newline = static_cast<const char*>(std::memchr(begin, '\n', left));
+            const std::size_t length = newline ? static_cast<std::size_t>(newline - begin) : left;
+            next_ += newline ? length + 1 : length;
             ++line_;
-            tokens_.clear();
-            std::string_view rest(text_);
+            std::string_view rest(begin, length);
             if (comment_ != '\0')
                 rest = rest.substr(0, rest.find(comment_));
             std::size_t at = 0;
             while (true) {
-                while (at < rest.size() && std::isspace(static_cast<unsigned char>(rest[at])))
+                while (at < rest.size() && is_space(rest[at]))
                     ++at;
                 if (at == rest.size())
                     break;
                 std::size_t end = at;
-                while (end < rest.size() && !std::isspace(static_cast<unsigned char>(rest[end])))
+                while (end < rest.size() && !is_space(rest[end]))
                     ++end;
                 tokens_.push_back(rest.substr(at, end - at));
                 at = end;
@@ -81,8 +118,18 @@ public:
             if (!tokens_.empty())
                 return true;
         }
-        tokens_.clear();
         return false;
+    }
+
+    /// Copies the next `count` bytes after the current line (binary data after a text header) into
+    /// bytes; false, copying nothing, if fewer are left.
+    bool read_bytes(unsigned char* bytes, std::size_t count)
+    {
+        if (count > size_ - next_)
+            return false;
+        std::memcpy(bytes, text_ + next_, count);
+        next_ += count;
+        return true;
     }
 
     const std::vector<std::string_view>& tokens() const { return tokens_; }
@@ -90,7 +137,6 @@ public:
     const std::string& name() const { return name_; }
     std::string place() const { return place(line_); }
     std::string place(int line) const { return str(name_, ", line ", line); }
-    std::istream& stream() { return in_; }
 
     /// fem::Error at this line; bytes that are not printable (a NUL would end the message where it is
     /// printed) are written as \xNN.
@@ -132,11 +178,16 @@ public:
 private:
     std::string name_;
     char comment_;
-    std::ifstream in_;
-    std::string text_;
+    const char* text_ = nullptr;  // the whole file, mapped (nullptr when it is empty)
+    std::size_t size_ = 0;        // its bytes
+    std::size_t next_ = 0;        // where the next line starts in text_
     std::vector<std::string_view> tokens_;
     int line_ = 0;
 };
+
+/// What number() and integer() call the coordinates of a point (a literal: no string is built per
+/// value read).
+constexpr std::array<const char*, 3> coordinate_names{"coordinate x", "coordinate y", "coordinate z"};
 
 /// Splits polygon `corners` into triangles (a fan from its first corner), appending them to
 /// `triangles` and, for each, the line it came from to `lines`.
@@ -185,6 +236,8 @@ TriMesh read_obj(const fs::path& path)
     std::vector<Eigen::Vector3d> points;
     std::vector<int> vertex_lines;
     std::vector<std::vector<int>> faces;  // corners as written (1-based or negative)
+    constexpr std::array<const char*, 3> vertex_coordinate_names{"coordinate x of a vertex", "coordinate y of a vertex",
+                                                                 "coordinate z of a vertex"};
     std::vector<int> face_lines;
     while (file.next_line()) {
         const auto& tokens = file.tokens();
@@ -193,7 +246,7 @@ TriMesh read_obj(const fs::path& path)
                 file.fail(str("a vertex needs three coordinates 'v x y z', got ", tokens.size() - 1));
             Eigen::Vector3d p;
             for (int c = 0; c < 3; ++c)
-                p[c] = file.number(tokens[c + 1], str("coordinate ", "xyz"[c], " of a vertex"));
+                p[c] = file.number(tokens[c + 1], vertex_coordinate_names[c]);
             points.push_back(p);
             vertex_lines.push_back(file.line());
         } else if (tokens[0] == "f") {
@@ -338,7 +391,7 @@ std::vector<Eigen::Vector3d> read_ascii_stl(const fs::path& path, std::vector<in
                 expect("vertex", 3, "vertex x y z");
                 Eigen::Vector3d corner;
                 for (int c = 0; c < 3; ++c)
-                    corner[c] = file.number(file.tokens()[c + 1], str("coordinate ", "xyz"[c]));
+                    corner[c] = file.number(file.tokens()[c + 1], coordinate_names[c]);
                 corners.push_back(corner);
             }
             expect("endloop", 0, "endloop");
@@ -472,8 +525,7 @@ public:
                                  : static_cast<double>(file_.integer(token, what));
         }
         unsigned char bytes[8];
-        file_.stream().read(reinterpret_cast<char*>(bytes), type.bytes);
-        if (!file_.stream())
+        if (!file_.read_bytes(bytes, static_cast<std::size_t>(type.bytes)))
             throw Error(str(file_.name(), ": the binary data ends inside ", element_->name, " ", index_,
                             " of the ", element_->count, " its header (line ", element_->header_line,
                             ") announces (reading ", what, ")"));
@@ -774,6 +826,7 @@ TetMesh read_tetgen(const TetGenPaths& paths, Inverted inverted)
         const std::size_t columns = 4 + static_cast<std::size_t>(header[2] + header[3]);
         require_plausible_count(paths.node, header[0], 8, "points", header_line);
         mesh.V.resize(header[0], 3);
+        node_lines.reserve(static_cast<std::size_t>(header[0]));
         for (long long i = 0; i < header[0]; ++i) {
             if (!node.next_line())
                 throw Error(str(node.name(), ": the file ends after line ", node.line(), " with ", i,
@@ -785,7 +838,7 @@ TetMesh read_tetgen(const TetGenPaths& paths, Inverted inverted)
                               header[3] > 0 ? ", boundary marker" : "", "), got ", t.size()));
             check_item_number(node, node.integer(t[0], "the point number"), i, base, "point");
             for (int c = 0; c < 3; ++c)
-                mesh.V(i, c) = node.number(t[c + 1], str("coordinate ", "xyz"[c]));
+                mesh.V(i, c) = node.number(t[c + 1], coordinate_names[c]);
             node_lines.push_back(node.line());
         }
         if (node.next_line())
@@ -806,6 +859,7 @@ TetMesh read_tetgen(const TetGenPaths& paths, Inverted inverted)
         const std::size_t columns = 5 + static_cast<std::size_t>(header[2]);
         require_plausible_count(paths.ele, header[0], 10, "tetrahedra", header_line);
         mesh.T.resize(header[0], 4);
+        tet_lines.reserve(static_cast<std::size_t>(header[0]));
         long long tet_base = 0;
         for (long long e = 0; e < header[0]; ++e) {
             if (!ele.next_line())
@@ -818,7 +872,9 @@ TetMesh read_tetgen(const TetGenPaths& paths, Inverted inverted)
                              t.size()));
             check_item_number(ele, ele.integer(t[0], "the tetrahedron number"), e, tet_base, "tetrahedron");
             for (int k = 0; k < 4; ++k) {
-                const long long v = ele.integer(t[k + 1], str("node ", k + 1, " of the tetrahedron"));
+                constexpr std::array<const char*, 4> corner_names{"node 1 of the tetrahedron", "node 2 of the tetrahedron",
+                                                                  "node 3 of the tetrahedron", "node 4 of the tetrahedron"};
+                const long long v = ele.integer(t[k + 1], corner_names[k]);
                 if (v < base || v >= base + mesh.V.rows())
                     ele.fail(str("tetrahedron ", e, " refers to node ", v, "; ", paths.node.string(),
                                  " numbers its ", mesh.V.rows(), " nodes ", base, " to ",
