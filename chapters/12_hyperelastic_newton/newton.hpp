@@ -98,6 +98,38 @@ private:
     dynamics::SparseMatrix K_start_;
 };
 
+/// An energy P(u) the incremental potential gains beyond the elastic U and the loads: a term of E
+/// that a later chapter adds without changing this one (chapter 14's contact barrier and friction).
+/// Like U it is a function of the displacement u = q (3n) at the step's end, so E(v) gains
+/// P(qᵗ + Δt v), ∇E gains Δt ∇P and the Hessian Δt² ∇²P. It may be +∞ (infeasible: a vertex
+/// inside an obstacle); then it says, for a Newton direction, how far the line search may go
+/// before P becomes infinite (largest_safe_step), and the line search starts there instead of at 1.
+/// docs/12_hyperelastic_newton.md#an-extra-potential
+class StepPotential {
+public:
+    virtual ~StepPotential() = default;
+    /// Called once before each step's Newton iterations with the state at t and Δt: what the
+    /// potential lags or adapts over a step is fixed here (default: nothing).
+    virtual void begin_step(dynamics::Body& body, const dynamics::State& state, double time_step)
+    {
+        (void)body, (void)state, (void)time_step;
+    }
+    /// P(u) [J] (u: 3n); +∞ where the potential is undefined.
+    virtual double energy(const Eigen::VectorXd& u) const = 0;
+    /// ∇P(u) (3n) [N].
+    virtual Eigen::VectorXd gradient(const Eigen::VectorXd& u) const = 0;
+    /// A positive semi-definite ∇²P(u) (3n×3n) [N/m] whose entries lie in the vertex-diagonal 3×3
+    /// blocks (the pattern of every stiffness matrix of the course holds them).
+    virtual dynamics::SparseMatrix hessian(const Eigen::VectorXd& u) const = 0;
+    /// The largest α in (0, 1] with P finite on the whole segment u + s·du, s ∈ [0, α], shrunk by
+    /// a safety factor (default: 1, a potential that is finite everywhere).
+    virtual double largest_safe_step(const Eigen::VectorXd& u, const Eigen::VectorXd& du) const
+    {
+        (void)u, (void)du;
+        return 1.0;
+    }
+};
+
 /// E(v) of the header comment for the full velocity v (3n), with model's energy at qᵗ + Δt v
 /// (+∞ where the model is undefined) and damping's D; magnitude (if given) receives
 /// |½ΔvᵀMΔv| + |U| + |Δt vᵀf_ext| + (Δt/2) vᵀDv, the scale of E's round-off. fem::Error on sizes,
@@ -127,6 +159,9 @@ struct NewtonProblem {
     /// The Hessian at x, exact or made positive semi-definite (definite = true): a reference to a
     /// matrix the problem keeps (refilled in its fixed pattern), valid until the next call.
     std::function<const dynamics::SparseMatrix&(const Eigen::VectorXd& x, bool definite)> hessian;
+    /// Optional: the largest step length α ≤ 1 along d from x that keeps the objective finite (a
+    /// StepPotential's continuous collision check); the line search starts there instead of at 1.
+    std::function<double(const Eigen::VectorXd& x, const Eigen::VectorXd& d)> largest_step;
     double scale = 0.0;   ///< converged when ‖gradient‖ ≤ relative_tolerance × scale
     std::string what;     ///< names the problem in error messages, e.g. "step 12 (t = 0.2 s)"
 };
@@ -143,7 +178,8 @@ struct NewtonResult {
 /// finite): solve H d = −∇ with `solver`, the Hessian chosen as options.hessian says, take the
 /// largest α = shrinkᵏ with objective(x + αd) ≤ objective(x) + c α ∇ᵀd (+ its round-off), until
 /// ‖∇‖ ≤ tolerance × scale (or ≤ smallest_measurable_norm). fem::Error naming problem.what when
-/// the cap is reached, the line search fails, or no Hessian gives a descent direction.
+/// the cap is reached, the line search fails, or no Hessian gives a descent direction. When the
+/// problem has a largest_step, the trials start at α = largest_step(x, d) instead of 1.
 /// docs/12_hyperelastic_newton.md#newton-with-line-search
 NewtonResult newton_minimize(const NewtonProblem& problem, Eigen::VectorXd x0, const NewtonOptions& options,
                              cg::LinearSolver& solver);
@@ -177,6 +213,10 @@ public:
     const NewtonResult& last() const { return last_; }
     /// The solver of Newton's systems (made from the options).
     const cg::LinearSolver& solver() const { return *solver_; }
+    /// Adds potential's P(q⁺) to every later step's E (nullptr: none, the default). Not owned: it
+    /// must outlive the steps. Each step calls its begin_step first, starts Newton from the part of
+    /// v = q̇ᵗ that largest_safe_step allows from v = 0, and cuts every line search by it.
+    void set_potential(StepPotential* potential) { potential_ = potential; }
 
 private:
     NewtonOptions options_;
@@ -184,6 +224,7 @@ private:
     std::optional<dynamics::ReducedStepMatrix> reduced_;  // M + Δt² K on the free dofs, pattern fixed
     const dynamics::Body* reduced_body_ = nullptr;
     NewtonResult last_;
+    StepPotential* potential_ = nullptr;
 };
 
 }  // namespace fem::hyper

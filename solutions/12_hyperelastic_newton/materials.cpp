@@ -361,6 +361,7 @@ Eigen::Matrix<double, N, N> project_to_psd(const Eigen::Matrix<double, N, N>& A,
     return projected;
 }
 
+template Eigen::Matrix<double, 3, 3> project_to_psd<3>(const Eigen::Matrix<double, 3, 3>&, Projection);
 template Eigen::Matrix<double, 9, 9> project_to_psd<9>(const Eigen::Matrix<double, 9, 9>&, Projection);
 template Eigen::Matrix<double, 12, 12> project_to_psd<12>(const Eigen::Matrix<double, 12, 12>&, Projection);
 

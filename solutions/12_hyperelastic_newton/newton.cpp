@@ -2,6 +2,7 @@
 
 #include "common/error.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -180,8 +181,12 @@ NewtonResult newton_minimize(const NewtonProblem& problem, Eigen::VectorXd x0, c
         if (!found)
             throw Error(str("Newton: ", problem.what, ": the Hessian is not positive definite, so Newton has no ",
                             "descent direction (gradientᵀd = ", slope, "); use HessianChoice::exact_then_definite or definite"));
-        // Backtracking: the largest α = shrinkᵏ with E(x + α d) ≤ E(x) + c α ∇ᵀd.
-        double alpha = 1.0;
+        // Backtracking: the largest α = shrinkᵏ with E(x + α d) ≤ E(x) + c α ∇ᵀd, from 1 or from
+        // the largest step that keeps E finite (a potential's continuous collision check).
+        double alpha = problem.largest_step ? std::min(1.0, problem.largest_step(x, direction)) : 1.0;
+        if (!(alpha >= options.smallest_step))
+            throw Error(str("Newton: ", problem.what, ": the largest safe step along d is α = ", alpha,
+                            ", below the smallest step ", options.smallest_step));
         if (options.line_search) {
             if (std::isnan(objective))
                 objective = problem.objective(x, &magnitude);
@@ -250,6 +255,8 @@ dynamics::StepInfo NewtonBackwardEuler::step(dynamics::Body& body, double time_s
     require_positive(time_step, "time step dt [s]");
     const dynamics::FreeDofs& dofs = body.dofs();
     const StepDamping damping(body, state.u);  // D = αM + βK_t, K_t at the step's start
+    if (potential_ != nullptr)
+        potential_->begin_step(body, state, time_step);
     // The full velocity: the unknowns x on the free dofs, the pins' ṽ_p (zero on free dofs) on theirs.
     const auto full = [&](const Eigen::VectorXd& x) {
         Eigen::VectorXd v = body.pin_velocity();
@@ -257,20 +264,47 @@ dynamics::StepInfo NewtonBackwardEuler::step(dynamics::Body& body, double time_s
         return v;
     };
     NewtonProblem problem;
+    // A direction d on the free dofs as a full displacement change Δt d (zero on the pins).
+    const auto full_change = [&](const Eigen::VectorXd& d) {
+        Eigen::VectorXd change = Eigen::VectorXd::Zero(dofs.full_size());
+        dofs.scatter(time_step * d, change);
+        return change;
+    };
     problem.objective = [&](const Eigen::VectorXd& x, double* magnitude) {
-        return backward_euler_objective(body, state, time_step, full(x), magnitude, damping);
+        const Eigen::VectorXd v = full(x);
+        double objective = backward_euler_objective(body, state, time_step, v, magnitude, damping);
+        if (potential_ != nullptr && std::isfinite(objective)) {
+            const double extra = potential_->energy(state.u + time_step * v);
+            objective = std::isfinite(extra) ? objective + extra : std::numeric_limits<double>::infinity();
+            if (magnitude != nullptr)
+                *magnitude += std::abs(extra);
+        }
+        return objective;
     };
     problem.gradient = [&](const Eigen::VectorXd& x) {
-        return Eigen::VectorXd(dofs.gather(backward_euler_gradient(body, state, time_step, full(x), damping)));
+        const Eigen::VectorXd v = full(x);
+        Eigen::VectorXd gradient = backward_euler_gradient(body, state, time_step, v, damping);
+        if (potential_ != nullptr)
+            gradient += time_step * potential_->gradient(state.u + time_step * v);
+        return Eigen::VectorXd(dofs.gather(gradient));
     };
+    if (potential_ != nullptr)
+        problem.largest_step = [&](const Eigen::VectorXd& x, const Eigen::VectorXd& d) {
+            return potential_->largest_safe_step(state.u + time_step * full(x), full_change(d));
+        };
     // H = M + Δt D + Δt² K = (1 + Δt α) M + Δt² (K + (β/Δt) K_t), in the fixed pattern.
     const dynamics::Damping& coefficients = damping.coefficients();
+    // P's Hessian joins K (both are weighted by Δt²); its vertex blocks lie in K's pattern.
     dynamics::SparseMatrix damped_K;
     problem.hessian = [&](const Eigen::VectorXd& x, bool definite) -> const dynamics::SparseMatrix& {
         const Eigen::VectorXd u = state.u + time_step * full(x);
         const dynamics::SparseMatrix* K = definite ? &body.model().definite_stiffness(u) : &body.model().stiffness(u);
-        if (coefficients.beta != 0.0) {
-            damped_K = *K + (coefficients.beta / time_step) * damping.start_stiffness();
+        if (coefficients.beta != 0.0 || potential_ != nullptr) {
+            damped_K = *K;
+            if (coefficients.beta != 0.0)
+                damped_K += (coefficients.beta / time_step) * damping.start_stiffness();
+            if (potential_ != nullptr)
+                damped_K += potential_->hessian(u);
             K = &damped_K;
         }
         const dynamics::SparseMatrix& M = body.mass_matrix();
@@ -284,7 +318,16 @@ dynamics::StepInfo NewtonBackwardEuler::step(dynamics::Body& body, double time_s
     problem.what = str("step ", state.step + 1, " (t = ", state.time + time_step, " s)");
     // The start: the last velocity, unless it already leaves the material's domain (a neo-Hookean
     // tet inverted by qᵗ + Δt q̇ᵗ); then v = 0, which keeps qᵗ, where E is finite.
+    // With a potential the start is the part of that velocity the potential allows from v = 0
+    // (its continuous collision check: no vertex passes through an obstacle on the way there).
     Eigen::VectorXd start = dofs.gather(state.v);
+    if (potential_ != nullptr) {
+        const Eigen::VectorXd rest = Eigen::VectorXd::Zero(start.size());
+        if (!std::isfinite(problem.objective(rest, nullptr)))
+            throw Error(str("Newton: ", problem.what, ": the potential is infinite at v = 0 (the positions of the "
+                            "step's start); a moving obstacle must not reach a vertex within one step"));
+        start *= std::min(1.0, problem.largest_step(rest, start));
+    }
     if (!std::isfinite(problem.objective(start, nullptr)))
         start.setZero();
     last_ = newton_minimize(problem, std::move(start), options_, *solver_);

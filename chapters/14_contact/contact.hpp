@@ -1,0 +1,122 @@
+#pragma once
+// Chapter 14: incremental potential contact (Li et al. 2020) against obstacles, as a chapter 12
+// StepPotential: the barrier of every surface vertex against every obstacle, lagged smoothed Coulomb
+// friction, the adaptive barrier stiffness κ, and the continuous collision check that cuts every
+// Newton step before Armijo. docs/14_contact.md
+//
+// For a body with surface vertices x_v = X_v + u_v and obstacles o (at the step's end time t + Δt):
+//
+//   P(u) = Σ_v Σ_o κ b(d_o(x_v))  +  Σ_k μ_k λ_k f₀(‖T_kᵀ (x_v − x_vᵗ − Δt w_o)‖)
+//
+// the barrier (b of barrier.hpp, active where d < d̂) and the friction of every pair k = (v, o) that
+// was within d̂ at the step's start: λ_k = κ |b'(d_o(x_vᵗ))| its lagged normal force [N], T_k (3×2)
+// an orthonormal basis of the tangent plane ⟂ ∇d_o(x_vᵗ), w_o the obstacle's velocity (IPC §5).
+
+#include "14_contact/obstacles.hpp"
+
+#include "12_hyperelastic_newton/newton.hpp"
+
+#include "10_linear_dynamics/body.hpp"
+#include "10_linear_dynamics/time_integration.hpp"
+
+#include <Eigen/Core>
+
+#include <memory>
+#include <vector>
+
+namespace fem::contact {
+
+/// The constants of contact, named once (docs/14_contact.md#the-constants).
+struct ContactOptions {
+    double activation_distance = 1e-3;  ///< d̂ [m]: the barrier acts where d < d̂
+    /// κ [N/m]: > 0 fixed; 0 adaptive (the rule of adapt_stiffness, IPC §4.3).
+    double stiffness = 0.0;
+    double safety = 0.8;                ///< the line search starts at safety × the time of impact, in (0, 1)
+    double friction_velocity = 1e-3;    ///< ε_v [m/s]: slower tangential motion is sticking (f₁ < 1)
+    /// ε_d as a fraction of the body's bounding-box diagonal: κ doubles when the smallest distance
+    /// is below it and still falling (IPC §4.3: 10⁻⁹).
+    double doubling_distance = 1e-9;
+};
+
+/// One lagged friction pair: vertex v against obstacle o, with the normal force and tangent basis
+/// of the step's start.
+struct FrictionPair {
+    int vertex = 0, obstacle = 0;
+    double normal_force = 0.0;           ///< λ = κ |b'(d(x_vᵗ))| [N]
+    double coefficient = 0.0;            ///< μ of the obstacle
+    Eigen::Matrix<double, 3, 2> tangent; ///< T: orthonormal, ⟂ ∇d(x_vᵗ)
+    Eigen::Vector3d start;               ///< x_vᵗ + Δt w_o: where the vertex sticks to the obstacle
+};
+
+/// The minimiser of ‖g + κ h‖ over κ: κ = −gᵀh/‖h‖² (g, h of one size), the κ whose barrier force
+/// best balances the body's force (IPC §4.3); 0 when h = 0. fem::Error on sizes.
+double balancing_stiffness(const Eigen::VectorXd& g, const Eigen::VectorXd& h);
+
+/// κ_min = m̄ / (Δt² b''(d̂/2)): the barrier's stiffness at d = d̂/2 equals the inertia m̄/Δt² of
+/// the average vertex mass m̄ [kg] in backward Euler's Hessian (b'' of the unit barrier; the
+/// course's counterpart of IPC's κ_min, which ties the barrier's Hessian to the mass in the same
+/// way). fem::Error unless m̄, Δt, d̂ > 0.
+double smallest_stiffness(double average_mass, double time_step, double activation_distance);
+
+/// The contact potential of a body against obstacles (a chapter 12 StepPotential: hand it to
+/// NewtonBackwardEuler::set_potential). docs/14_contact.md#the-contact-potential
+class ContactPotential final : public hyper::StepPotential {
+public:
+    /// The surface vertices of body's mesh (chapter 13's boundary faces) against every obstacle.
+    /// fem::Error for no obstacle, d̂ ≤ 0, κ < 0, a safety outside (0, 1), ε_v ≤ 0, ε_d < 0.
+    ContactPotential(const dynamics::Body& body, std::vector<std::shared_ptr<const Obstacle>> obstacles,
+                     ContactOptions options = {});
+
+    /// Fixes the step: the obstacles at t + Δt; κ (adaptive: κ_min = smallest_stiffness, κ_max =
+    /// 100 κ_min; at the first step with a vertex within d̂, κ = balancing_stiffness(−f − f_ext,
+    /// ∇B) clamped to [κ_min, κ_max] (B: the unit-κ barrier sum, over free dofs); later κ doubles,
+    /// up to κ_max, when the smallest distance is below ε_d and smaller than at the last step); the
+    /// friction pairs from x_vᵗ (FrictionPair).
+    void begin_step(dynamics::Body& body, const dynamics::State& state, double time_step) override;
+
+    /// P(u) of the header [J] (+∞ when some surface vertex has d ≤ 0).
+    double energy(const Eigen::VectorXd& u) const override;
+    /// ∇P (3n): κ b'(d) ∇d per active pair, plus μλ f₁(y) T ŷ per friction pair (ŷ = Tᵀ(x − start)/y).
+    Eigen::VectorXd gradient(const Eigen::VectorXd& u) const override;
+    /// ∇²P made PSD (3n×3n, vertex blocks only): each vertex's block is the sum of κ (b'' ∇d ∇dᵀ + b' ∇²d)
+    /// over its active pairs and, per friction pair with s = Tᵀ(x − start), y = ‖s‖,
+    /// μλ T [ (f₁'(y) y − f₁(y))/y³ · s sᵀ + f₁(y)/y · I₂ ] Tᵀ; the sum is projected once
+    /// (chapter 12's project_to_psd): b' ∇²d of a sphere is negative semi-definite.
+    dynamics::SparseMatrix hessian(const Eigen::VectorXd& u) const override;
+    /// min(1, safety × the earliest time of impact of any surface vertex's path x_v + s·Δx_v).
+    double largest_safe_step(const Eigen::VectorXd& u, const Eigen::VectorXd& du) const override;
+
+    /// The barrier's force on every vertex, −κ b'(d) ∇d summed over obstacles (3n) [N].
+    Eigen::VectorXd barrier_forces(const Eigen::VectorXd& u) const;
+    /// The smallest d_o(x_v) over surface vertices and obstacles at the step's end time [m].
+    double smallest_distance(const Eigen::VectorXd& u) const;
+
+    /// Sets the time the obstacles are held at (begin_step sets t + Δt), for a static solve.
+    void set_time(double time) { time_ = time; }
+    /// Sets κ [N/m] (> 0; begin_step re-adapts it when the options' stiffness is 0).
+    void set_stiffness(double stiffness);
+
+    double stiffness() const { return stiffness_; }
+    const std::vector<int>& surface_vertices() const { return surface_; }
+    const std::vector<FrictionPair>& friction_pairs() const { return pairs_; }
+    const ContactOptions& options() const { return options_; }
+    const std::vector<std::shared_ptr<const Obstacle>>& obstacles() const { return obstacles_; }
+
+private:
+    Eigen::Vector3d position(const Eigen::VectorXd& u, int vertex) const;
+
+    std::vector<std::shared_ptr<const Obstacle>> obstacles_;
+    ContactOptions options_;
+    Eigen::MatrixX3d rest_;            // X (#V × 3)
+    std::vector<int> surface_;
+    double average_mass_ = 0.0, diagonal_ = 0.0;
+    double time_ = 0.0, stiffness_ = 0.0, friction_step_ = 0.0;  // friction_step_: ε = ε_v Δt
+    double last_smallest_ = 0.0;
+    bool stiffness_set_ = false;
+    std::vector<FrictionPair> pairs_;
+};
+
+/// The tangent-plane basis of a unit normal n: T (3×2) with orthonormal columns ⟂ n.
+Eigen::Matrix<double, 3, 2> tangent_basis(const Eigen::Vector3d& normal);
+
+}  // namespace fem::contact

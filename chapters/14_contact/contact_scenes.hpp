@@ -1,0 +1,68 @@
+#pragma once
+// Chapter 14: the small scenes its checks and studies run — a block dropped on, resting on or sliding
+// along the floor z = 0 — and the closed forms they are measured against. docs/14_contact.md#checks
+//
+// A slope of angle θ is the floor with gravity tilted by θ: g = g (sin θ, 0, −cos θ), the same
+// physics as a tilted plane with vertical gravity, with the block's faces on the axes.
+
+#include "14_contact/contact.hpp"
+
+#include "12_hyperelastic_newton/newton.hpp"
+
+#include "10_linear_dynamics/body.hpp"
+#include "10_linear_dynamics/time_integration.hpp"
+
+#include <Eigen/Core>
+
+#include <memory>
+#include <string>
+
+namespace fem::contact {
+
+/// What a block scene is made of.
+struct BlockSettings {
+    double edge = 0.1;                  ///< the cube's edge [m]
+    int cells = 1;                      ///< cubes along an edge (box_mesh)
+    double height = 5e-4;               ///< the gap under its lowest face at t = 0 [m]
+    double slope = 0.0;                 ///< θ [rad] in [0, π/2): gravity tilted along +x
+    double friction = 0.0;              ///< μ of the floor
+    double gravity = 9.81;              ///< |g| [m/s²]
+    double time_step = 1.0 / 100.0;     ///< Δt [s]
+    dynamics::Material material{1e6, 0.3, 1000.0};  ///< a stiff rubber, ρ of water
+    /// Chapter 12's force model by name (make_force_model). Hyperelastic: its energy is a function of
+    /// F alone, so a block that has fallen far carries no round-off of ½uᵀKu with u large, which
+    /// near rest would hide the last Newton decrease from the line search.
+    std::string model = "stable-neo-hookean";
+    hyper::NewtonOptions newton;        ///< chapter 12's Newton
+    ContactOptions contact;             ///< d̂, κ, ε_v, …
+};
+
+/// A block of settings.model on the floor z = 0 (a HalfSpace with μ), its Newton
+/// integrator with the contact potential set, and its state at rest. Not copyable (the integrator
+/// points at the potential).
+struct BlockScene {
+    std::unique_ptr<dynamics::Body> body;
+    std::unique_ptr<ContactPotential> contact;
+    std::unique_ptr<hyper::NewtonBackwardEuler> integrator;
+    dynamics::State state;
+
+    /// One backward Euler step with contact (Δt of the settings).
+    void step();
+    double time_step = 0.0;
+};
+
+/// The block of settings. fem::Error for an edge ≤ 0, cells < 1, a height < 0, θ outside [0, π/2),
+/// and what Scene, ContactPotential and NewtonBackwardEuler refuse.
+BlockScene block_scene(const BlockSettings& settings);
+
+/// The mass-weighted mean of the vertex velocities (3) [m/s]: the block's centre-of-mass velocity.
+Eigen::Vector3d mean_velocity(const dynamics::Body& body, const Eigen::VectorXd& v);
+/// The lowest z of the body's vertices at u [m].
+double lowest_height(const dynamics::Body& body, const Eigen::VectorXd& u);
+
+/// The slide's closed form: a = g (sin θ − μ cos θ) when tan θ > μ, 0 when it sticks [m/s²].
+double slope_acceleration(double gravity, double slope, double friction);
+/// The speed of a fall from rest through height h: √(2 g h) [m/s].
+double drop_speed(double gravity, double height);
+
+}  // namespace fem::contact

@@ -1,0 +1,121 @@
+#pragma once
+// Chapter 14: obstacles — rigid shapes the body must stay out of, fixed or moving with a constant
+// velocity, each with a signed distance d(x) (> 0 outside, < 0 inside), its gradient ∇d (the unit
+// outward normal) and Hessian ∇²d, and the time of impact of a straight vertex path.
+// docs/14_contact.md#obstacles
+//
+// A moving obstacle translates: at time t it is its rest placement shifted by t·w (w: its velocity),
+// so d(x, t) = d₀(x − t w), where d₀ is the distance to the rest placement. Every function taking a
+// point in the obstacle's rest frame is named local_*; the public ones take the time.
+
+#include <Eigen/Core>
+
+#include <memory>
+#include <string>
+
+namespace fem::contact {
+
+/// A rigid obstacle. The body's vertices are kept at d > 0 by chapter 14's barrier.
+class Obstacle {
+public:
+    /// velocity: w [m/s] (finite); friction: Coulomb's μ ≥ 0 between it and the body.
+    /// fem::Error for a non-finite velocity or μ < 0 (or not finite).
+    Obstacle(const Eigen::Vector3d& velocity, double friction);
+    virtual ~Obstacle() = default;
+
+    /// A short name for tables, e.g. "half-space".
+    virtual std::string name() const = 0;
+
+    /// d₀(p): the signed distance of p from the rest placement [m] (> 0 outside).
+    virtual double local_distance(const Eigen::Vector3d& p) const = 0;
+    /// ∇d₀(p) (3): the outward unit normal of the nearest surface point (outside).
+    virtual Eigen::Vector3d local_gradient(const Eigen::Vector3d& p) const = 0;
+    /// ∇²d₀(p) (3×3, symmetric) [1/m]: 0 for a plane or a box face, (I − n nᵀ)/|p − c| for a sphere.
+    virtual Eigen::Matrix3d local_hessian(const Eigen::Vector3d& p) const = 0;
+    /// The first s ≥ 0 at which the path p + s·dp (p outside, d₀(p) > 0) reaches d₀ = 0, or +∞ when
+    /// it never does. Exact for a half-space and a sphere; a box answers a conservative s (never
+    /// beyond the true one).
+    virtual double local_time_of_impact(const Eigen::Vector3d& p, const Eigen::Vector3d& dp) const = 0;
+
+    /// d(x, t) = d₀(x − t w) [m].
+    double distance(const Eigen::Vector3d& x, double time) const { return local_distance(x - time * velocity_); }
+    /// ∇d(x, t) (3).
+    Eigen::Vector3d gradient(const Eigen::Vector3d& x, double time) const { return local_gradient(x - time * velocity_); }
+    /// ∇²d(x, t) (3×3).
+    Eigen::Matrix3d hessian(const Eigen::Vector3d& x, double time) const { return local_hessian(x - time * velocity_); }
+    /// The time of impact of x + s·dx against the obstacle held at time t (s ≥ 0, +∞: none).
+    double time_of_impact(const Eigen::Vector3d& x, const Eigen::Vector3d& dx, double time) const
+    {
+        return local_time_of_impact(x - time * velocity_, dx);
+    }
+
+    const Eigen::Vector3d& velocity() const { return velocity_; }
+    double friction() const { return friction_; }
+
+private:
+    Eigen::Vector3d velocity_;
+    double friction_;
+};
+
+/// The half-space {x : n·(x − p) < 0} below the plane through p with unit normal n (a floor, a
+/// slope): d = n·(x − p), ∇d = n, ∇²d = 0; time of impact d/(−n·dx) when n·dx < 0.
+class HalfSpace final : public Obstacle {
+public:
+    /// fem::Error for a zero or non-finite normal (it is normalised) or a non-finite point.
+    HalfSpace(const Eigen::Vector3d& point, const Eigen::Vector3d& normal, double friction = 0.0,
+              const Eigen::Vector3d& velocity = Eigen::Vector3d::Zero());
+    std::string name() const override { return "half-space"; }
+    double local_distance(const Eigen::Vector3d& p) const override;
+    Eigen::Vector3d local_gradient(const Eigen::Vector3d& p) const override;
+    Eigen::Matrix3d local_hessian(const Eigen::Vector3d& p) const override;
+    double local_time_of_impact(const Eigen::Vector3d& p, const Eigen::Vector3d& dp) const override;
+    const Eigen::Vector3d& normal() const { return normal_; }
+
+private:
+    Eigen::Vector3d point_, normal_;
+};
+
+/// A solid ball of centre c and radius r: d = |x − c| − r, ∇d = n = (x − c)/|x − c|,
+/// ∇²d = (I − n nᵀ)/|x − c|; the time of impact is the smaller root of |x + s dx − c|² = r².
+class Sphere final : public Obstacle {
+public:
+    /// fem::Error for r ≤ 0 or a non-finite centre.
+    Sphere(const Eigen::Vector3d& centre, double radius, double friction = 0.0,
+           const Eigen::Vector3d& velocity = Eigen::Vector3d::Zero());
+    std::string name() const override { return "sphere"; }
+    double local_distance(const Eigen::Vector3d& p) const override;
+    Eigen::Vector3d local_gradient(const Eigen::Vector3d& p) const override;
+    Eigen::Matrix3d local_hessian(const Eigen::Vector3d& p) const override;
+    double local_time_of_impact(const Eigen::Vector3d& p, const Eigen::Vector3d& dp) const override;
+
+private:
+    Eigen::Vector3d centre_;
+    double radius_;
+};
+
+/// A solid box: centre c, axes the columns of the rotation R, half extents h. In box coordinates
+/// q = Rᵀ(x − c), with e = |q| − h (per axis): outside d = |max(e, 0)| (the nearest face, edge or
+/// corner), inside d = max eᵢ. ∇d = R (sign(q) ∘ max(e, 0))/d outside; ∇²d = R (P_A − n nᵀ)/d Rᵀ with
+/// P_A the diagonal of the axes where eᵢ > 0 (0 on a face, a cylinder's on an edge, a sphere's at a
+/// corner). Its time of impact is conservative advancement (d is 1-Lipschitz: a path of length
+/// s|dx| cannot lose more than that of distance), stopped when d has fallen to 5 % of its start;
+/// +∞ when the path does not reach the box by s = 2 (callers step at most s = 1).
+class Box final : public Obstacle {
+public:
+    /// fem::Error for a half extent ≤ 0, a rotation that is not orthonormal with det +1 (to 1e-9),
+    /// or a non-finite centre.
+    Box(const Eigen::Vector3d& centre, const Eigen::Vector3d& half_extents,
+        const Eigen::Matrix3d& rotation = Eigen::Matrix3d::Identity(), double friction = 0.0,
+        const Eigen::Vector3d& velocity = Eigen::Vector3d::Zero());
+    std::string name() const override { return "box"; }
+    double local_distance(const Eigen::Vector3d& p) const override;
+    Eigen::Vector3d local_gradient(const Eigen::Vector3d& p) const override;
+    Eigen::Matrix3d local_hessian(const Eigen::Vector3d& p) const override;
+    double local_time_of_impact(const Eigen::Vector3d& p, const Eigen::Vector3d& dp) const override;
+
+private:
+    Eigen::Vector3d centre_, half_;
+    Eigen::Matrix3d rotation_;
+};
+
+}  // namespace fem::contact

@@ -1,0 +1,187 @@
+#include "14_contact/obstacles.hpp"
+
+#include "common/error.hpp"
+
+#include <Eigen/LU>
+
+#include <cmath>
+#include <limits>
+
+namespace fem::contact {
+namespace {
+
+constexpr double infinity = std::numeric_limits<double>::infinity();
+
+void require_finite_point(const Eigen::Vector3d& p, const char* what)
+{
+    if (!p.allFinite())
+        throw Error(str("obstacle: the ", what, " must be finite, got (", p.x(), ", ", p.y(), ", ", p.z(), ")"));
+}
+
+}  // namespace
+
+Obstacle::Obstacle(const Eigen::Vector3d& velocity, double friction) : velocity_(velocity), friction_(friction)
+{
+    require_finite_point(velocity, "velocity [m/s]");
+    if (!(std::isfinite(friction) && friction >= 0.0))
+        throw Error(str("obstacle: the friction coefficient mu must be a finite number >= 0, got ", friction));
+}
+
+// --- Half-space ------------------------------------------------------------------------------------
+
+HalfSpace::HalfSpace(const Eigen::Vector3d& point, const Eigen::Vector3d& normal, double friction,
+                     const Eigen::Vector3d& velocity)
+    : Obstacle(velocity, friction), point_(point)
+{
+    require_finite_point(point, "point of the plane");
+    require_finite_point(normal, "normal of the plane");
+    if (!(normal.norm() > 0.0))
+        throw Error("half-space: the normal of the plane must not be zero");
+    normal_ = normal.normalized();
+}
+
+double HalfSpace::local_distance(const Eigen::Vector3d& p) const
+{
+    return normal_.dot(p - point_);
+}
+
+Eigen::Vector3d HalfSpace::local_gradient(const Eigen::Vector3d&) const
+{
+    return normal_;
+}
+
+Eigen::Matrix3d HalfSpace::local_hessian(const Eigen::Vector3d&) const
+{
+    return Eigen::Matrix3d::Zero();
+}
+
+double HalfSpace::local_time_of_impact(const Eigen::Vector3d& p, const Eigen::Vector3d& dp) const
+{
+    double s = infinity;
+    // BEGIN EXERCISE 14.2 plane_time_of_impact #continuous-collision-detection
+    // HINT: d(p + s dp) = d(p) + s n·dp is linear in s: it reaches 0 at s = d(p)/(−n·dp) when the
+    // HINT: path approaches the plane (n·dp < 0), never otherwise (s stays +∞).
+    const double rate = normal_.dot(dp);
+    if (rate < 0.0)
+        s = local_distance(p) / -rate;
+    // END EXERCISE
+    return s;
+}
+
+// --- Sphere ----------------------------------------------------------------------------------------
+
+Sphere::Sphere(const Eigen::Vector3d& centre, double radius, double friction, const Eigen::Vector3d& velocity)
+    : Obstacle(velocity, friction), centre_(centre), radius_(radius)
+{
+    require_finite_point(centre, "centre of the sphere");
+    require_positive(radius, "sphere radius [m]");
+}
+
+double Sphere::local_distance(const Eigen::Vector3d& p) const
+{
+    return (p - centre_).norm() - radius_;
+}
+
+Eigen::Vector3d Sphere::local_gradient(const Eigen::Vector3d& p) const
+{
+    const Eigen::Vector3d r = p - centre_;
+    const double length = r.norm();
+    return length > 0.0 ? Eigen::Vector3d(r / length) : Eigen::Vector3d::UnitZ();
+}
+
+Eigen::Matrix3d Sphere::local_hessian(const Eigen::Vector3d& p) const
+{
+    const double length = (p - centre_).norm();
+    if (!(length > 0.0))
+        return Eigen::Matrix3d::Zero();
+    const Eigen::Vector3d n = local_gradient(p);
+    return (Eigen::Matrix3d::Identity() - n * n.transpose()) / length;
+}
+
+double Sphere::local_time_of_impact(const Eigen::Vector3d& p, const Eigen::Vector3d& dp) const
+{
+    double s = infinity;
+    // BEGIN EXERCISE 14.3 sphere_time_of_impact #continuous-collision-detection
+    // HINT: |p + s dp − c|² = r² is a s² + b s + k = 0 with a = dp·dp, b = 2 dp·(p − c),
+    // HINT: k = |p − c|² − r² > 0 (outside). The path hits when it approaches (b < 0) and the
+    // HINT: discriminant b² − 4ak ≥ 0; the first root is s = 2k / (−b + √(b² − 4ak)) (no cancellation).
+    const Eigen::Vector3d r = p - centre_;
+    const double a = dp.squaredNorm(), b = 2.0 * dp.dot(r), k = r.squaredNorm() - radius_ * radius_;
+    const double discriminant = b * b - 4.0 * a * k;
+    if (b < 0.0 && discriminant >= 0.0)
+        s = 2.0 * k / (-b + std::sqrt(discriminant));
+    // END EXERCISE
+    return s;
+}
+
+// --- Box -------------------------------------------------------------------------------------------
+
+Box::Box(const Eigen::Vector3d& centre, const Eigen::Vector3d& half_extents, const Eigen::Matrix3d& rotation,
+         double friction, const Eigen::Vector3d& velocity)
+    : Obstacle(velocity, friction), centre_(centre), half_(half_extents), rotation_(rotation)
+{
+    require_finite_point(centre, "centre of the box");
+    for (int axis = 0; axis < 3; ++axis)
+        require_positive(half_extents[axis], "box half extent [m]");
+    if (!rotation.allFinite() || (rotation.transpose() * rotation - Eigen::Matrix3d::Identity()).norm() > 1e-9 ||
+        std::abs(rotation.determinant() - 1.0) > 1e-9)
+        throw Error("box: the rotation must be orthonormal with determinant +1 (to 1e-9)");
+}
+
+double Box::local_distance(const Eigen::Vector3d& p) const
+{
+    const Eigen::Vector3d excess = (rotation_.transpose() * (p - centre_)).cwiseAbs() - half_;
+    const double outside = excess.cwiseMax(0.0).norm();
+    return outside > 0.0 ? outside : excess.maxCoeff();
+}
+
+Eigen::Vector3d Box::local_gradient(const Eigen::Vector3d& p) const
+{
+    const Eigen::Vector3d q = rotation_.transpose() * (p - centre_);
+    const Eigen::Vector3d excess = q.cwiseAbs() - half_;
+    const Eigen::Vector3d sign = q.unaryExpr([](double x) { return x < 0.0 ? -1.0 : 1.0; });
+    const Eigen::Vector3d outside = excess.cwiseMax(0.0);
+    const double length = outside.norm();
+    if (length > 0.0)
+        return rotation_ * sign.cwiseProduct(outside) / length;
+    Eigen::Index axis = 0;
+    excess.maxCoeff(&axis);
+    return rotation_.col(axis) * sign[axis];
+}
+
+Eigen::Matrix3d Box::local_hessian(const Eigen::Vector3d& p) const
+{
+    const Eigen::Vector3d q = rotation_.transpose() * (p - centre_);
+    const Eigen::Vector3d outside = (q.cwiseAbs() - half_).cwiseMax(0.0);
+    const double length = outside.norm();
+    if (!(length > 0.0))
+        return Eigen::Matrix3d::Zero();  // inside: d is piecewise linear
+    const Eigen::Vector3d sign = q.unaryExpr([](double x) { return x < 0.0 ? -1.0 : 1.0; });
+    const Eigen::Vector3d n = sign.cwiseProduct(outside) / length;
+    const Eigen::Vector3d active = outside.unaryExpr([](double x) { return x > 0.0 ? 1.0 : 0.0; });
+    const Eigen::Matrix3d local = (Eigen::Matrix3d(active.asDiagonal()) - n * n.transpose()) / length;
+    return rotation_ * local * rotation_.transpose();
+}
+
+double Box::local_time_of_impact(const Eigen::Vector3d& p, const Eigen::Vector3d& dp) const
+{
+    // Conservative advancement: from s, the path cannot reach the box before s + d(p + s dp)/|dp|.
+    const double start = local_distance(p), length = dp.norm();
+    if (!(start > 0.0))
+        return 0.0;
+    if (!(length > 0.0))
+        return infinity;
+    constexpr double far = 2.0;  // callers step at most s = 1: beyond this, no impact that matters
+    double s = 0.0;
+    for (int iteration = 0; iteration < 100; ++iteration) {
+        const double d = local_distance(p + s * dp);
+        if (d <= 0.05 * start)
+            return s;
+        s += d / length;
+        if (s > far)
+            return infinity;
+    }
+    return s;
+}
+
+}  // namespace fem::contact

@@ -1,0 +1,258 @@
+// Chapter 14: the barrier and the friction mollifier, the obstacles' distances and times of impact,
+// and the contact potential's gradient and Hessian, against central differences and exact roots.
+// docs/14_contact.md
+#include "14_contact/barrier.hpp"
+#include "14_contact/contact.hpp"
+#include "14_contact/contact_scenes.hpp"
+#include "14_contact/obstacles.hpp"
+
+#include "12_hyperelastic_newton/materials.hpp"
+
+#include "common/error.hpp"
+#include "common/random.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <memory>
+#include <vector>
+
+using namespace fem;
+using namespace fem::contact;
+
+namespace {
+
+/// The central difference (f(x + h) − f(x − h))/(2h).
+template <class F>
+double central(const F& f, double x, double h)
+{
+    return (f(x + h) - f(x - h)) / (2.0 * h);
+}
+
+/// Obstacles of every kind, at rest, for the checks of distances and times of impact.
+std::vector<std::shared_ptr<const Obstacle>> every_obstacle()
+{
+    const Eigen::Matrix3d rotation =
+        Eigen::AngleAxisd(0.4, Eigen::Vector3d(1.0, 2.0, 0.5).normalized()).toRotationMatrix();
+    return {std::make_shared<HalfSpace>(Eigen::Vector3d(0.1, -0.2, 0.05), Eigen::Vector3d(0.3, -0.2, 1.0)),
+            std::make_shared<Sphere>(Eigen::Vector3d(0.2, 0.1, -0.3), 0.25),
+            std::make_shared<Box>(Eigen::Vector3d(-0.1, 0.2, 0.0), Eigen::Vector3d(0.2, 0.1, 0.15), rotation)};
+}
+
+}  // namespace
+
+TEST_CASE("barrier: b, b' and b'' against central differences, zero from dhat on, C2 there, infinite at d <= 0",
+          "[ex14.1]")
+{
+    const double dhat = 1e-3;
+    for (double d : {1e-6, 1e-5, 1e-4, 3e-4, 5e-4, 9e-4, 9.99e-4}) {
+        const BarrierValue b = barrier(d, dhat);
+        const double h = 1e-4 * std::min(d, dhat - d);  // small against the distance to either end
+        INFO("d = " << d);
+        const auto value = [&](double x) { return barrier(x, dhat).value; };
+        const auto first = [&](double x) { return barrier(x, dhat).first; };
+        CHECK(b.value > 0.0);
+        CHECK(b.first < 0.0);   // it pushes outward
+        CHECK(b.second > 0.0);  // convex on (0, d̂)
+        CHECK(std::abs(b.first - central(value, d, h)) <= 1e-6 * std::abs(b.first) + 1e-14);
+        CHECK(std::abs(b.second - central(first, d, h)) <= 1e-6 * std::abs(b.second) + 1e-12);
+    }
+    // C² at d̂: the three vanish as d → d̂ from below, and are exactly 0 from d̂ on.
+    const BarrierValue near = barrier(dhat * (1.0 - 1e-6), dhat);
+    CHECK(std::abs(near.value) < 1e-20);
+    CHECK(std::abs(near.first) < 1e-14);
+    CHECK(std::abs(near.second) < 1e-5);
+    CHECK(barrier(dhat, dhat).value == 0.0);
+    CHECK(barrier(2.0 * dhat, dhat).second == 0.0);
+    // The closed form at d = d̂/2: b = (d̂/2)² ln 2.
+    CHECK(barrier(0.5 * dhat, dhat).value == Approx(0.25 * dhat * dhat * std::log(2.0)).epsilon(1e-12));
+    CHECK(std::isinf(barrier(0.0, dhat).value));
+    CHECK(std::isinf(barrier(-1e-3, dhat).value));
+    CHECK_THROWS_AS(barrier(1e-4, 0.0), Error);
+}
+
+TEST_CASE("friction mollifier: f0' = f1 and f1' against central differences, f1 from 0 to 1, continuous at eps",
+          "[ex14.4]")
+{
+    const double epsilon = 1e-5;
+    for (double y : {1e-8, 1e-7, 2e-6, 5e-6, 9e-6, 2e-5}) {
+        const MollifierValue f = friction_mollifier(y, epsilon);
+        const double h = 1e-4 * y;
+        CHECK(std::abs(f.f1 - central([&](double x) { return friction_mollifier(x, epsilon).f0; }, y, h)) <= 1e-7);
+        CHECK(std::abs(f.f1_derivative - central([&](double x) { return friction_mollifier(x, epsilon).f1; }, y, h)) <=
+              1e-6 * std::abs(f.f1_derivative) + 1e-6);
+        CHECK(f.f1 > 0.0);
+        CHECK(f.f1 <= 1.0);
+    }
+    CHECK(friction_mollifier(0.0, epsilon).f1 == 0.0);
+    CHECK(friction_mollifier(0.0, epsilon).f0 == Approx(epsilon / 3.0).epsilon(1e-14));
+    const MollifierValue below = friction_mollifier(epsilon * (1.0 - 1e-9), epsilon);
+    CHECK(below.f0 == Approx(epsilon).epsilon(1e-8));
+    CHECK(below.f1 == Approx(1.0).epsilon(1e-8));
+    CHECK(std::abs(below.f1_derivative) < 1e-3 / epsilon);
+    CHECK_THROWS_AS(friction_mollifier(-1.0, epsilon), Error);
+}
+
+TEST_CASE("obstacles: the gradient and Hessian of every signed distance against central differences")
+{
+    const double h = 1e-6;
+    for (const auto& obstacle : every_obstacle())
+        for (unsigned seed = 1; seed <= 40; ++seed) {
+            const Eigen::Vector3d x = 0.6 * random_vector(3, seed);
+            const double d = obstacle->local_distance(x);
+            if (std::abs(d) < 1e-3)
+                continue;  // near the surface the box's distance has a kink inside
+            Eigen::Vector3d gradient;
+            Eigen::Matrix3d hessian;
+            for (int i = 0; i < 3; ++i) {
+                const Eigen::Vector3d e = h * Eigen::Vector3d::Unit(i);
+                gradient[i] = (obstacle->local_distance(x + e) - obstacle->local_distance(x - e)) / (2.0 * h);
+                hessian.col(i) = (obstacle->local_gradient(x + e) - obstacle->local_gradient(x - e)) / (2.0 * h);
+            }
+            INFO(obstacle->name() << " at " << x.transpose() << ", d = " << d);
+            CHECK((obstacle->local_gradient(x) - gradient).norm() < 1e-7);
+            if (d > 0.0)  // outside, where the barrier uses it
+                CHECK((obstacle->local_hessian(x) - hessian).norm() < 1e-4 * (1.0 + hessian.norm()));
+        }
+}
+
+TEST_CASE("half-space time of impact: exact, where the path crosses the plane, infinite when it moves away",
+          "[ex14.2]")
+{
+    const HalfSpace floor(Eigen::Vector3d(0.0, 0.0, 0.1), Eigen::Vector3d(0.0, 0.0, 2.0));
+    const Eigen::Vector3d x(0.3, -0.2, 0.5);
+    const double s = floor.local_time_of_impact(x, Eigen::Vector3d(0.1, 0.2, -0.8));
+    CHECK(s == Approx(0.5).epsilon(1e-14));
+    CHECK(std::abs(floor.local_distance(x + s * Eigen::Vector3d(0.1, 0.2, -0.8))) < 1e-15);
+    CHECK(std::isinf(floor.local_time_of_impact(x, Eigen::Vector3d(1.0, 0.0, 0.2))));
+    CHECK(std::isinf(floor.local_time_of_impact(x, Eigen::Vector3d(1.0, 0.0, 0.0))));
+    // A moving floor: rising at 1 m/s, at t = 0.2 s its plane is at z = 0.3.
+    const HalfSpace rising(Eigen::Vector3d(0.0, 0.0, 0.1), Eigen::Vector3d::UnitZ(), 0.0, Eigen::Vector3d(0.0, 0.0, 1.0));
+    CHECK(rising.distance(x, 0.2) == Approx(0.2).epsilon(1e-14));
+    CHECK(rising.time_of_impact(x, Eigen::Vector3d(0.0, 0.0, -0.4), 0.2) == Approx(0.5).epsilon(1e-14));
+}
+
+TEST_CASE("sphere time of impact: the first root, on the sphere, none for a path that misses or leaves", "[ex14.3]")
+{
+    const Sphere ball(Eigen::Vector3d(0.0, 0.0, 0.0), 1.0);
+    // Head on from x = 3 at speed 4: hits at x = 1, s = 0.5.
+    CHECK(ball.local_time_of_impact(Eigen::Vector3d(3.0, 0.0, 0.0), Eigen::Vector3d(-4.0, 0.0, 0.0)) ==
+          Approx(0.5).epsilon(1e-14));
+    CHECK(std::isinf(ball.local_time_of_impact(Eigen::Vector3d(3.0, 0.0, 0.0), Eigen::Vector3d(1.0, 0.0, 0.0))));
+    CHECK(std::isinf(ball.local_time_of_impact(Eigen::Vector3d(3.0, 1.5, 0.0), Eigen::Vector3d(-6.0, 0.0, 0.0))));
+    for (unsigned seed = 1; seed <= 200; ++seed) {
+        const Eigen::Vector3d p = 2.5 * random_vector(3, seed);
+        if (ball.local_distance(p) <= 1e-3)
+            continue;
+        const Eigen::Vector3d dp = 5.0 * random_vector(3, 1000 + seed);
+        const double s = ball.local_time_of_impact(p, dp);
+        if (std::isinf(s))
+            continue;
+        INFO("seed " << seed);
+        CHECK(std::abs(ball.local_distance(p + s * dp)) < 1e-12);
+        for (double fraction : {0.1, 0.5, 0.9, 0.999})  // nothing earlier on the path reaches it
+            CHECK(ball.local_distance(p + fraction * s * dp) > 0.0);
+    }
+}
+
+TEST_CASE("continuous collision: no point of a randomised safe step is inside any obstacle (fuzzed)", "[ex14.3]")
+{
+    BlockSettings settings;
+    settings.height = 0.0;
+    BlockScene block = block_scene(settings);
+    // Around the block [0, 0.1]³ moved by up to 0.2: a tilted floor below, a ball and a turned box
+    // beside it, which random steps of up to 2 m cross.
+    const Eigen::Matrix3d rotation = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1.0, -1.0, 2.0).normalized()).toRotationMatrix();
+    const std::vector<std::shared_ptr<const Obstacle>> obstacles{
+        std::make_shared<HalfSpace>(Eigen::Vector3d(0.0, 0.0, -0.3), Eigen::Vector3d(0.2, 0.1, 1.0)),
+        std::make_shared<Sphere>(Eigen::Vector3d(0.55, 0.05, 0.05), 0.2),
+        std::make_shared<Box>(Eigen::Vector3d(-0.5, 0.05, 0.05), Eigen::Vector3d(0.15, 0.2, 0.1), rotation)};
+    ContactPotential contact(*block.body, obstacles);
+    const Eigen::Index n = block.state.u.size();
+    int checked = 0, cut = 0;
+    for (unsigned seed = 1; seed <= 300; ++seed) {
+        const Eigen::VectorXd u = 0.2 * random_vector(n, seed);
+        if (!std::isfinite(contact.energy(u)) || contact.smallest_distance(u) <= 0.0)
+            continue;
+        const Eigen::VectorXd du = 2.0 * random_vector(n, 5000 + seed);
+        const double alpha = contact.largest_safe_step(u, du);
+        REQUIRE(alpha > 0.0);
+        REQUIRE(alpha <= 1.0);
+        cut += alpha < 1.0;
+        for (int k = 1; k <= 50; ++k) {  // along the whole segment, not only at its end
+            const Eigen::VectorXd trial = u + (alpha * k / 50.0) * du;
+            INFO("seed " << seed << ", alpha " << alpha << ", k " << k);
+            CHECK(contact.smallest_distance(trial) > 0.0);
+        }
+        ++checked;
+    }
+    CHECK(checked > 50);
+    CHECK(cut > 20);  // the fuzz reaches the cut, not only free steps
+}
+
+TEST_CASE("contact potential: gradient and Hessian of barrier and friction against central differences", "[ex14.4]")
+{
+    BlockSettings settings;
+    settings.height = 2e-4;
+    settings.friction = 0.4;
+    settings.contact.stiffness = 50.0;
+    const double dt = settings.time_step;
+    for (bool sphere : {false, true}) {
+        BlockScene block = block_scene(settings);
+        std::vector<std::shared_ptr<const Obstacle>> obstacles{
+            std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.4)};
+        if (sphere)  // touching the top face's corner (0.1, 0.1, 0.1002) from above
+            obstacles = {std::make_shared<Sphere>(Eigen::Vector3d(0.2, 0.2, 0.2), (Eigen::Vector3d(0.1, 0.1, 0.1002) -
+                              Eigen::Vector3d(0.2, 0.2, 0.2)).norm() - 4e-4, 0.4)};
+        ContactPotential contact(*block.body, obstacles, settings.contact);
+        // The state at t: sliding sideways, friction pairs from it; then u displaced a little.
+        dynamics::State state = block.state;
+        contact.begin_step(*block.body, state, dt);
+        REQUIRE(!contact.friction_pairs().empty());
+        const Eigen::Index n = state.u.size();
+        for (double scale : {1e-7, 3e-6, 1e-4}) {  // inside ε_v Δt = 1e-5, near it, beyond it (sliding)
+            Eigen::VectorXd u = scale * random_vector(n, 7);
+            for (Eigen::Index i = 2; i < n; i += 3)
+                u[i] = 1e-5 * random_vector(n, 8)[i];  // keep within d̂
+            REQUIRE(std::isfinite(contact.energy(u)));
+            const Eigen::VectorXd g = contact.gradient(u);
+            const Eigen::MatrixXd H = Eigen::MatrixXd(contact.hessian(u));
+            Eigen::VectorXd g_fd(n);
+            Eigen::MatrixXd H_fd(n, n);
+            const double h = 1e-9;
+            for (Eigen::Index i = 0; i < n; ++i) {
+                Eigen::VectorXd e = Eigen::VectorXd::Zero(n);
+                e[i] = h;
+                g_fd[i] = (contact.energy(u + e) - contact.energy(u - e)) / (2.0 * h);
+                H_fd.col(i) = (contact.gradient(u + e) - contact.gradient(u - e)) / (2.0 * h);
+            }
+            INFO((sphere ? "sphere" : "floor") << ", scale " << scale);
+            CHECK((g - g_fd).norm() <= 1e-6 * g.norm());
+            // Per vertex block: the Hessian is the PSD projection of the exact one (for the floor and
+            // for friction the exact block is PSD already; a sphere's b'∇²d is negative).
+            for (Eigen::Index v = 0; v < n / 3; ++v) {
+                const Eigen::Matrix3d exact = H_fd.block<3, 3>(3 * v, 3 * v);
+                const Eigen::Matrix3d projected = hyper::project_to_psd<3>(exact, hyper::Projection::clamp);
+                CHECK((H.block<3, 3>(3 * v, 3 * v) - projected).norm() <= 1e-5 * (1.0 + exact.norm()));
+            }
+            CHECK(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(H).eigenvalues().minCoeff() >= -1e-8 * H.norm());
+        }
+    }
+}
+
+TEST_CASE("adaptive kappa: the balancing stiffness minimises the norm of g + kappa h, kappa_min ties the barrier to the mass",
+          "[ex14.1]")
+{
+    const Eigen::VectorXd g = random_vector(12, 3), h = random_vector(12, 4);
+    const double kappa = balancing_stiffness(g, h);
+    const double best = (g + kappa * h).norm();
+    CHECK(best <= (g + (kappa * 1.001) * h).norm());
+    CHECK(best <= (g + (kappa * 0.999) * h).norm());
+    CHECK(balancing_stiffness(g, Eigen::VectorXd::Zero(12)) == 0.0);
+    // κ_min Δt² b''(d̂/2) = m̄
+    const double low = smallest_stiffness(0.125, 0.01, 1e-3);
+    CHECK(low * 1e-4 * barrier(5e-4, 1e-3).second == Approx(0.125).epsilon(1e-14));
+}

@@ -1,0 +1,213 @@
+// Chapter 14: the checks of the issue on a one-cube block — at rest its contact forces carry its
+// weight, on a slope it sticks or slides as Coulomb says, dropped it lands at √(2gh) and never
+// rebounds higher, fired at the floor or a sphere at 100 times a drop's speed it never gets inside.
+// docs/14_contact.md#checks
+#include "14_contact/contact.hpp"
+#include "14_contact/contact_scenes.hpp"
+#include "14_contact/obstacles.hpp"
+
+#include "12_hyperelastic_newton/newton.hpp"
+
+#include "common/error.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+using namespace fem;
+using namespace fem::contact;
+
+namespace {
+
+constexpr double degree = std::numbers::pi / 180.0;
+
+/// A contact potential that records the smallest distance of every configuration the line search
+/// and the step start evaluate: none of them may be inside an obstacle.
+class WatchedContact final : public hyper::StepPotential {
+public:
+    explicit WatchedContact(ContactPotential& contact) : contact_(contact) {}
+    void begin_step(dynamics::Body& body, const dynamics::State& state, double time_step) override
+    {
+        contact_.begin_step(body, state, time_step);
+    }
+    double energy(const Eigen::VectorXd& u) const override
+    {
+        smallest = std::min(smallest, contact_.smallest_distance(u));
+        ++evaluations;
+        return contact_.energy(u);
+    }
+    Eigen::VectorXd gradient(const Eigen::VectorXd& u) const override { return contact_.gradient(u); }
+    dynamics::SparseMatrix hessian(const Eigen::VectorXd& u) const override { return contact_.hessian(u); }
+    double largest_safe_step(const Eigen::VectorXd& u, const Eigen::VectorXd& du) const override
+    {
+        return contact_.largest_safe_step(u, du);
+    }
+    mutable double smallest = std::numeric_limits<double>::infinity();
+    mutable int evaluations = 0;
+
+private:
+    ContactPotential& contact_;
+};
+
+}  // namespace
+
+TEST_CASE("a cube at rest on the floor: its contact forces sum to its weight at equilibrium, none below",
+          "[ex14.1]")
+{
+    BlockSettings settings;
+    settings.height = 0.5 * settings.contact.activation_distance;
+    settings.time_step = 0.05;  // backward Euler's damping brings the block to rest in a few steps
+    settings.newton.relative_tolerance = 1e-10;
+    BlockScene block = block_scene(settings);
+    for (int step = 0; step < 40; ++step) {
+        block.step();
+        REQUIRE(lowest_height(*block.body, block.state.u) > 0.0);
+    }
+    const dynamics::State start = block.state;
+    const double scale = hyper::momentum_scale(*block.body, start, settings.time_step);
+    block.step();
+    const Eigen::VectorXd forces = block.contact->barrier_forces(block.state.u);
+    const Eigen::VectorXd& m = block.body->dof_masses();
+    Eigen::Vector3d total = Eigen::Vector3d::Zero(), momentum_change = Eigen::Vector3d::Zero();
+    for (Eigen::Index v = 0; v < forces.size() / 3; ++v) {
+        total += forces.segment<3>(3 * v);
+        momentum_change += m[3 * v] * (block.state.v - start.v).segment<3>(3 * v);
+    }
+    const double weight = m.sum() / 3.0 * settings.gravity;
+    // The step's gradient r = M(v − vᵗ) − Δt (f + f_ext + F_contact) has ‖r‖ ≤ tol · scale, and the
+    // internal forces f sum to 0 (a translation stores no energy), so summed over the vertices
+    // Σ F_contact − W = (Σ m Δv − Σ r)/Δt, with |Σ r_z| ≤ √#V ‖r‖ (Cauchy–Schwarz). At rest Σ m Δv ≈ 0.
+    const double vertices = double(forces.size() / 3);
+    const double bound = (std::abs(momentum_change.z()) + std::sqrt(vertices) * settings.newton.relative_tolerance * scale) /
+                         settings.time_step + 1e-12 * weight;
+    INFO("sum of contact forces " << total.transpose() << " N, weight " << weight << " N, bound " << bound << " N");
+    CHECK(std::abs(total.z() - weight) <= bound);
+    CHECK(bound <= 1e-6 * weight);  // equilibrium: the momentum no longer changes
+    CHECK(std::abs(total.x()) + std::abs(total.y()) <= 1e-9 * weight);
+    CHECK(lowest_height(*block.body, block.state.u) > 0.0);
+    CHECK(lowest_height(*block.body, block.state.u) < settings.contact.activation_distance);
+}
+
+TEST_CASE("a cube on a slope with tan(theta) < mu sticks: it creeps at most eps_v dt a step, as the mollifier says",
+          "[ex14.4]")
+{
+    BlockSettings settings;
+    settings.slope = 20.0 * degree;
+    settings.friction = 0.5;
+    settings.height = 0.5 * settings.contact.activation_distance;
+    BlockScene block = block_scene(settings);
+    const double epsilon = settings.contact.friction_velocity * settings.time_step;
+    double creep = 0.0;
+    for (int step = 0; step < 40; ++step) {
+        block.step();
+        REQUIRE(lowest_height(*block.body, block.state.u) > 0.0);
+        creep = mean_velocity(*block.body, block.state.v).x() * settings.time_step;  // the step's move
+        if (step >= 5)  // the lagged normal force settles from the start's gap to the weight's share
+            CHECK(std::abs(creep) <= epsilon);
+    }
+    // Steady creep: the friction μλ f₁(y) holds the tangential load, f₁(y) = tan θ/μ, so
+    // y = ε (1 − √(1 − tan θ/μ)) (the root of 2y/ε − y²/ε² = tan θ/μ below ε).
+    const double expected = epsilon * (1.0 - std::sqrt(1.0 - std::tan(settings.slope) / settings.friction));
+    INFO("creep per step " << creep << " m, expected " << expected << " m, eps_v dt = " << epsilon << " m");
+    CHECK(std::abs(creep - expected) <= 0.01 * expected);
+}
+
+TEST_CASE("a cube on a slope with tan(theta) > mu slides with acceleration g (sin theta - mu cos theta)", "[ex14.4]")
+{
+    BlockSettings settings;
+    settings.slope = 30.0 * degree;
+    settings.friction = 0.3;
+    settings.height = 0.5 * settings.contact.activation_distance;
+    BlockScene block = block_scene(settings);
+    double speed_then = 0.0, time_then = 0.0;
+    for (int step = 0; step < 40; ++step) {
+        block.step();
+        REQUIRE(lowest_height(*block.body, block.state.u) > 0.0);
+        if (step + 1 == 20) {
+            speed_then = mean_velocity(*block.body, block.state.v).x();
+            time_then = block.state.time;
+        }
+    }
+    const double acceleration =
+        (mean_velocity(*block.body, block.state.v).x() - speed_then) / (block.state.time - time_then);
+    const double expected = slope_acceleration(settings.gravity, settings.slope, settings.friction);
+    // Sliding faster than eps_v, the mollifier is 1: full Coulomb. What is left is the lag of the
+    // normal force (from the step's start) while the block's contact settles: 1 % of g.
+    INFO("acceleration " << acceleration << ", closed form " << expected);
+    CHECK(std::abs(acceleration - expected) <= 1e-2 * settings.gravity);
+    CHECK(slope_acceleration(settings.gravity, 20.0 * degree, 0.5) == 0.0);
+}
+
+TEST_CASE("a cube dropped from h lands at sqrt(2gh) within backward Euler's lag and never rebounds above h",
+          "[ex14.2]")
+{
+    BlockSettings settings;
+    const double h = 0.05, dt = settings.time_step, g = settings.gravity;
+    settings.height = h;
+    BlockScene block = block_scene(settings);
+    double fastest = 0.0, rebound = 0.0;
+    bool bounced = false;
+    for (int step = 0; step < 40; ++step) {
+        block.step();
+        const double falling = -mean_velocity(*block.body, block.state.v).z();
+        fastest = std::max(fastest, falling);
+        bounced = bounced || falling < 0.0;
+        const double low = lowest_height(*block.body, block.state.u);
+        REQUIRE(low > 0.0);
+        if (bounced)
+            rebound = std::max(rebound, low);
+    }
+    // Backward Euler's free fall: v_n = g t_n exactly, the fall H_n = v_n²/(2g) + Δt v_n/2 ≥ v_n²/(2g),
+    // so v ≤ √(2gh); at the step the barrier acts the fall is ≥ h − d̂: v ≥ √(2g(h − d̂)) − Δt g/2,
+    // and the fastest step is at most one step before it: v_max ≥ √(2g(h − d̂)) − 3 g Δt / 2.
+    const double dhat = settings.contact.activation_distance;
+    INFO("fastest " << fastest << " m/s, sqrt(2gh) = " << drop_speed(g, h) << " m/s, rebound " << rebound << " m");
+    CHECK(fastest <= drop_speed(g, h) * (1.0 + 1e-9));
+    CHECK(fastest >= drop_speed(g, h - dhat) - 1.5 * g * dt);
+    CHECK(bounced);
+    CHECK(rebound <= h);
+}
+
+namespace {
+
+/// Fires the block at 100 m/s (100 × a drop's ~1 m/s: one step of 1/100 s would carry it 1 m) at
+/// the obstacle, 0.1 m below it, and watches every configuration Newton evaluates for 10 steps.
+void fire_at(std::shared_ptr<const Obstacle> obstacle)
+{
+    BlockSettings settings;
+    settings.height = 0.2;
+    settings.gravity = 0.0;
+    settings.newton.max_iterations = 500;
+    BlockScene block = block_scene(settings);
+    ContactPotential contact(*block.body, {std::move(obstacle)}, settings.contact);
+    WatchedContact watched(contact);
+    block.integrator->set_potential(&watched);
+    Eigen::VectorXd v = Eigen::VectorXd::Zero(block.state.u.size());
+    for (Eigen::Index i = 2; i < v.size(); i += 3)
+        v[i] = -100.0;
+    block.state = dynamics::initial_state(*block.body, {}, v);
+    for (int step = 0; step < 10; ++step) {
+        block.step();
+        INFO("step " << step);
+        REQUIRE(contact.smallest_distance(block.state.u) > 0.0);
+    }
+    INFO(watched.evaluations << " evaluations");
+    CHECK(watched.smallest > 0.0);
+    CHECK(watched.smallest < settings.contact.activation_distance);  // it did reach the obstacle
+}
+
+}  // namespace
+
+TEST_CASE("fired at the floor at 100 times a drop's speed, no vertex ever gets inside", "[ex14.2]")
+{
+    fire_at(std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ()));
+}
+
+TEST_CASE("fired at a ball at 100 times a drop's speed, no vertex gets inside or jumps across", "[ex14.3]")
+{
+    // Under the block's four lower corners; one unchecked step would carry them 1 m past it.
+    fire_at(std::make_shared<Sphere>(Eigen::Vector3d(0.05, 0.05, 0.0), 0.08));
+}
