@@ -87,12 +87,16 @@ Eigen::VectorXd backward_euler_gradient(dynamics::Body& body, const dynamics::St
 double momentum_scale(dynamics::Body& body, const dynamics::State& state, double time_step)
 {
     const dynamics::FreeDofs& dofs = body.dofs();
-    double scale = dofs.gather(body.mass_matrix() * state.v).norm() +
-                   time_step * dofs.gather(body.external_forces()).norm() + time_step * dofs.gather(state.forces).norm();
+    // stableNorm: a plain norm squares the entries and overflows past 1e154 (a density of 1e160
+    // gives momenta that large), and an infinite scale would pass any gradient as converged.
+    double scale = dofs.gather(body.mass_matrix() * state.v).stableNorm() +
+                   time_step * dofs.gather(body.external_forces()).stableNorm() +
+                   time_step * dofs.gather(state.forces).stableNorm();
     if (body.pins_move()) {  // what the pins' step pushes into the free dofs
         Eigen::VectorXd forces;
         body.model().evaluate(state.u + time_step * body.pin_velocity(), forces);
-        scale += dofs.gather(body.mass_matrix() * body.pin_velocity()).norm() + time_step * dofs.gather(forces).norm();
+        scale += dofs.gather(body.mass_matrix() * body.pin_velocity()).stableNorm() +
+                 time_step * dofs.gather(forces).stableNorm();
     }
     return scale;
 }
@@ -156,7 +160,11 @@ NewtonResult newton_minimize(const NewtonProblem& problem, Eigen::VectorXd x0, c
     double objective = std::numeric_limits<double>::quiet_NaN(), magnitude = 0.0;
     for (int iteration = 0;; ++iteration) {
         const Eigen::VectorXd gradient = problem.gradient(x);
-        const double norm = gradient.norm();
+        const double norm = gradient.stableNorm();  // no overflow for entries up to 1e308
+        if (!std::isfinite(norm) || !std::isfinite(problem.scale))
+            throw Error(str("Newton: ", problem.what, ": |gradient| = ", norm, " and its scale ", problem.scale,
+                            " must be finite: the scene's values (density, Young's modulus, speeds, sizes) ",
+                            "give forces beyond the range of a double"));
         const double relative = problem.scale > 0.0 ? norm / problem.scale : norm;
         result.gradient_history.push_back(relative);
         if (norm <= options.relative_tolerance * problem.scale || norm <= smallest_measurable_norm)
@@ -232,7 +240,7 @@ Eigen::VectorXd solve_static(dynamics::Body& body, const NewtonOptions& options)
         hessian = dofs.reduce(definite ? model.definite_stiffness(u) : model.stiffness(u));
         return hessian;
     };
-    problem.scale = dofs.gather(load).norm();
+    problem.scale = dofs.gather(load).stableNorm();
     problem.what = "the static solve";
     const std::unique_ptr<cg::LinearSolver> solver = cg::make_solver(options.solver);
     return full(newton_minimize(problem, Eigen::VectorXd::Zero(dofs.size()), options, *solver).x);

@@ -25,6 +25,7 @@
 #include <cmath>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 using namespace fem;
@@ -555,6 +556,40 @@ TEST_CASE("hard cases: Y = 1e7 at dt = 1/24 s stays stable, nu up to 0.499 conve
         CHECK(simulation.state().u.allFinite());
         CHECK(most_iterations <= 10);
     }
+}
+
+TEST_CASE("extreme density: a free body of rho = 1e200 falls as one of rho = 1000 does, never frozen by an overflowed norm",
+          "[ex12.9]")
+{
+    // Nothing pinned, uniform gravity: the exact motion is a rigid fall whatever the density, and
+    // backward Euler's discrete parabola is the same for both. At rho = 1e200 the momenta reach 1e194:
+    // a plain |gradient| overflowed to inf, passed "inf <= tolerance * inf" and froze the body at
+    // u = 0 with 0 Newton iterations (issue 23, row 6).
+    const auto fall = [](double density) {
+        dynamics::Scene scene;
+        scene.mesh = beam_mesh(0.2, 0.02, 0.02, 4);
+        scene.material = {1e5, 0.3, density};
+        scene.time_step = 1.0 / 60.0;
+        dynamics::Body body(scene, std::make_unique<HyperelasticElasticity>(
+                                       scene.mesh, make_material("stable-neo-hookean", 1e5, 0.3)));
+        NewtonBackwardEuler newton;
+        dynamics::Simulation simulation(body, newton, dynamics::initial_state(body));
+        int iterations = 0;
+        simulation.run(10, [&](const dynamics::State&, const dynamics::StepRecord& record) {
+            iterations += record.newton_iterations;
+        });
+        return std::pair{simulation.state().u, iterations};
+    };
+    const auto [light, light_iterations] = fall(1000.0);
+    const auto [heavy, heavy_iterations] = fall(1e200);
+    CAPTURE(light_iterations, heavy_iterations);
+    CHECK(heavy_iterations >= 10);  // at least one iteration per step: the body moved
+    REQUIRE(heavy.allFinite());
+    // z after 10 steps of backward Euler from rest: -g dt^2 (1 + 2 + ... + 10) at every vertex.
+    const double dt = 1.0 / 60.0, expected = -9.81 * dt * dt * 55.0;
+    for (Eigen::Index v = 0; v < heavy.size() / 3; ++v)
+        CHECK(heavy[3 * v + 2] == Approx(expected).epsilon(1e-9));
+    CHECK((heavy - light).norm() <= 1e-9 * light.norm());
 }
 
 TEST_CASE("Newton backward Euler: bad options are refused", "[ch12]")
