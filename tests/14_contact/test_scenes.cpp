@@ -55,7 +55,7 @@ private:
 }  // namespace
 
 TEST_CASE("a cube at rest on the floor: its contact forces sum to its weight at equilibrium, none below",
-          "[ex14.1]")
+          "[ex14.2]")
 {
     BlockSettings settings;
     settings.height = 0.5 * settings.contact.activation_distance;
