@@ -2,12 +2,12 @@
 // Chapter 14: the scalar pieces of incremental potential contact (Li et al. 2020): the log barrier
 // of a distance and the smoothed Coulomb friction's mollifier. docs/14_contact.md#the-barrier
 //
-//   b(d) = −(d − d̂)² ln(d/d̂)  for 0 < d < d̂,   0 for d ≥ d̂,   +∞ for d ≤ 0     (IPC §4, eq. 6)
+//   b(d) = −(d − d̂)² ln(d/d̂)  for 0 < d < d̂,   0 for d ≥ d̂,   +∞ for d ≤ 0     (IPC: the barrier)
 //
 // (the barrier of unit stiffness: the contact energy is κ b(d), κ [N/m]). b is C² at d̂ (b, b', b''
 // all vanish there), b → +∞ as d → 0⁺, so no minimiser ever has d ≤ 0.
 //
-//   f₁(y) = 2y/ε − y²/ε²  for 0 ≤ y < ε,   1 for y ≥ ε        (IPC §5.2, eq. 12; ε = ε_v Δt)
+//   f₁(y) = 2y/ε − y²/ε²  for 0 ≤ y < ε,   1 for y ≥ ε        (IPC: the friction mollifier; ε = ε_v Δt)
 //   f₀(y) = ∫ f₁ = y²/ε − y³/(3ε²) + ε/3  for y < ε,   y for y ≥ ε
 //
 // f₁ smooths the jump of Coulomb's law: a tangential displacement y over a step feels the friction

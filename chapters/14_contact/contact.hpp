@@ -10,7 +10,7 @@
 //
 // the barrier (b of barrier.hpp, active where d < d̂) and the friction of every pair k = (v, o) that
 // was within d̂ at the step's start: λ_k = κ |b'(d_o(x_vᵗ))| its lagged normal force [N], T_k (3×2)
-// an orthonormal basis of the tangent plane ⟂ ∇d_o(x_vᵗ), w_o the obstacle's velocity (IPC §5).
+// an orthonormal basis of the tangent plane ⟂ ∇d_o(x_vᵗ), w_o the obstacle's velocity (IPC: lagged friction).
 
 #include "14_contact/obstacles.hpp"
 
@@ -29,12 +29,12 @@ namespace fem::contact {
 /// The constants of contact, named once (docs/14_contact.md#the-constants).
 struct ContactOptions {
     double activation_distance = 1e-3;  ///< d̂ [m]: the barrier acts where d < d̂
-    /// κ [N/m]: > 0 fixed; 0 adaptive (the rule of adapt_stiffness, IPC §4.3).
+    /// κ [N/m]: > 0 fixed; 0 adaptive (the rule of ContactPotential::begin_step, after IPC's).
     double stiffness = 0.0;
     double safety = 0.8;                ///< the line search starts at safety × the time of impact, in (0, 1)
     double friction_velocity = 1e-3;    ///< ε_v [m/s]: slower tangential motion is sticking (f₁ < 1)
     /// ε_d as a fraction of the body's bounding-box diagonal: κ doubles when the smallest distance
-    /// is below it and still falling (IPC §4.3: 10⁻⁹).
+    /// is below it and still falling (IPC's value: 10⁻⁹).
     double doubling_distance = 1e-9;
 };
 
@@ -49,7 +49,7 @@ struct FrictionPair {
 };
 
 /// The minimiser of ‖g + κ h‖ over κ: κ = −gᵀh/‖h‖² (g, h of one size), the κ whose barrier force
-/// best balances the body's force (IPC §4.3); 0 when h = 0. fem::Error on sizes.
+/// best balances the body's force (IPC's initial κ); 0 when h = 0. fem::Error on sizes.
 double balancing_stiffness(const Eigen::VectorXd& g, const Eigen::VectorXd& h);
 
 /// κ_min = m̄ / (Δt² b''(d̂/2)): the barrier's stiffness at d = d̂/2 equals the inertia m̄/Δt² of

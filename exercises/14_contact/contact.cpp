@@ -113,7 +113,7 @@ void ContactPotential::begin_step(dynamics::Body& body, const dynamics::State& s
     require_positive(time_step, "time step dt [s]");
     time_ = state.time + time_step;
     friction_step_ = options_.friction_velocity * time_step;
-    // κ (IPC §4.3): balanced at the first contact, doubled while the distance keeps falling below ε_d.
+    // κ (after IPC): balanced at the first contact, doubled while the distance keeps falling below ε_d.
     if (options_.stiffness == 0.0) {
         const double low = smallest_stiffness(average_mass_, time_step, options_.activation_distance);
         const double high = 100.0 * low;
@@ -130,7 +130,7 @@ void ContactPotential::begin_step(dynamics::Body& body, const dynamics::State& s
         stiffness_ = std::clamp(stiffness_, low, high);
         last_smallest_ = smallest;
     }
-    // The friction pairs, lagged at the step's start (IPC §5.1).
+    // The friction pairs, lagged at the step's start (IPC).
     pairs_.clear();
     for (int v : surface_)
         for (int o = 0; o < static_cast<int>(obstacles_.size()); ++o) {

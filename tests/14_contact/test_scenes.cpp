@@ -211,3 +211,45 @@ TEST_CASE("fired at a ball at 100 times a drop's speed, no vertex gets inside or
     // Under the block's four lower corners; one unchecked step would carry them 1 m past it.
     fire_at(std::make_shared<Sphere>(Eigen::Vector3d(0.05, 0.05, 0.0), 0.08));
 }
+
+TEST_CASE("a conveyor floor (moving along x) drags a resting block up to its speed by friction", "[ex14.4]")
+{
+    BlockSettings settings;
+    settings.height = 1e-4;
+    BlockScene block = block_scene(settings);
+    const double belt = 0.1, mu = 0.5;
+    ContactPotential contact(*block.body,
+                             {std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), mu,
+                                                          Eigen::Vector3d(belt, 0.0, 0.0))},
+                             settings.contact);
+    block.integrator->set_potential(&contact);
+    // Coulomb: it slides with a = μ g until it moves with the belt, after t = w/(μ g) ≈ 0.02 s.
+    for (int step = 0; step < 30; ++step) {
+        block.step();
+        REQUIRE(lowest_height(*block.body, block.state.u) > 0.0);
+    }
+    const double speed = mean_velocity(*block.body, block.state.v).x();
+    INFO("block speed " << speed << " m/s, belt " << belt << " m/s");
+    // Sticking to the belt it lags by less than ε_v (the mollifier's threshold).
+    CHECK(std::abs(speed - belt) <= settings.contact.friction_velocity);
+}
+
+TEST_CASE("a rising floor lifts the block resting on it, never reaching into it", "[ex14.2]")
+{
+    BlockSettings settings;
+    settings.height = 1e-4;
+    BlockScene block = block_scene(settings);
+    const double rise = 2e-3;  // [m/s]: 2·10⁻⁵ m a step, less than the resting gap (the limit of a kinematic obstacle)
+    const auto floor = std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.0,
+                                                   Eigen::Vector3d(0.0, 0.0, rise));
+    ContactPotential contact(*block.body, {floor}, settings.contact);
+    block.integrator->set_potential(&contact);
+    for (int step = 0; step < 100; ++step) {
+        block.step();
+        REQUIRE(contact.smallest_distance(block.state.u) > 0.0);
+        REQUIRE(lowest_height(*block.body, block.state.u) > rise * block.state.time);
+    }
+    const double speed = mean_velocity(*block.body, block.state.v).z();
+    INFO("block speed " << speed << " m/s, floor " << rise << " m/s");
+    CHECK(std::abs(speed - rise) <= 1e-2 * rise);
+}
