@@ -3,6 +3,7 @@
 #include "common/error.hpp"
 #include "common/files.hpp"
 #include "common/memory.hpp"
+#include "common/parallel.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -227,6 +228,7 @@ void ChapterCli::check_command_line()
 
 int ChapterCli::run(int argc, char** argv, const std::function<void(const RunContext&)>& body)
 {
+    wait_passively(argv);  // may start the program again, with OMP_WAIT_POLICY=passive
     // Every exception ends here, as one line: none reaches std::terminate.
     try {
         try {

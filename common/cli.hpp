@@ -91,7 +91,9 @@ public:
     /// did not write (its .fem-run-files does not list it): it is someone else's.
     void writes_entry(const std::string& name);
 
-    /// Parses argv (running every option's check), runs the check of check_options(), and calls
+    /// First calls wait_passively(argv) (common/parallel.hpp: the program may start again, with
+    /// OMP_WAIT_POLICY=passive). Parses argv (running every option's check), runs the check of
+    /// check_options(), and calls
     /// body, which writes into a staging folder (fem::StagedFiles) inside --out. Only when body
     /// returns do its files appear in --out, together, replacing the previous run's (whose files
     /// this run did not write again are removed; other files are left alone), and run() prints

@@ -50,6 +50,18 @@ inline void set_thread_count(int threads)
 #endif
 }
 
+/// Makes OpenMP's threads wait for the next loop asleep instead of spinning, unless the user chose
+/// (OMP_WAIT_POLICY set): sets OMP_WAIT_POLICY=passive and starts the program again, the same
+/// process (execv of /proc/self/exe with the same argv), since libgomp reads the variable once,
+/// when it is loaded, before main(). Why: between two loops a spinning thread keeps its core busy;
+/// beside another busy process it competes with it for that core and waits its turn for every loop
+/// (chapter 12's element loops on 2 threads took 2.5-30x as long as on 1 beside a spinning process,
+/// and 0.6-1.06x with passive waiting; README, "Threads on a busy machine"). On a quiet machine
+/// waking a sleeping thread costs a few microseconds per loop. ChapterCli::run calls it first; it
+/// returns at once without OpenMP, when the variable is set, or if execv fails (nothing is lost
+/// but speed). argv: main's, ending with nullptr.
+void wait_passively(char** argv);
+
 /// Calls body(i) for every i in [0, n), split among thread_count() threads (a static schedule).
 /// Each body(i) must write only what belongs to i. An exception thrown by body(i) is rethrown
 /// after the loop: the one of the smallest such i, so that a run fails with the same message on

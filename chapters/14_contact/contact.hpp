@@ -91,7 +91,12 @@ public:
     /// The smallest d_o(x_v) over surface vertices and obstacles at the step's end time [m].
     double smallest_distance(const Eigen::VectorXd& u) const;
 
-    /// Sets the time the obstacles are held at (begin_step sets t + Δt), for a static solve.
+    /// Lags the next step's friction at u (3n) instead of the step's start: λ and T of each pair
+    /// from the vertex at u (the obstacles at the step's end), the sticking point still x_vᵗ + Δt w_o.
+    /// Used once, by the next begin_step (step_with_friction_updates). fem::Error on u's size.
+    void lag_friction_at(const Eigen::VectorXd& u);
+
+    /// Sets the time the obstacles are held at (begin_step sets t + Δt).
     void set_time(double time) { time_ = time; }
     /// Sets κ [N/m] (> 0; begin_step re-adapts it when the options' stiffness is 0).
     void set_stiffness(double stiffness);
@@ -114,7 +119,18 @@ private:
     double last_smallest_ = 0.0;
     bool stiffness_set_ = false;
     std::vector<FrictionPair> pairs_;
+    Eigen::VectorXd lag_u_;  // empty: lag at the step's start
 };
+
+/// One backward Euler step with contact whose friction is lagged `updates` times (≥ 1): the step
+/// is solved with λ, T from its start (IPC's one lagged update), then, updates − 1 times, solved
+/// again from the same start with λ, T from the last solution (lag_friction_at), which approaches
+/// friction that is implicit in λ and T. newton must have contact set as its potential. The
+/// StepInfo's Newton and solver iterations are summed over the solves. fem::Error for updates < 1.
+/// docs/14_contact.md#friction
+dynamics::StepInfo step_with_friction_updates(hyper::NewtonBackwardEuler& newton, ContactPotential& contact,
+                                              dynamics::Body& body, double time_step, dynamics::State& state,
+                                              int updates);
 
 /// The tangent-plane basis of a unit normal n: T (3×2) with orthonormal columns ⟂ n.
 Eigen::Matrix<double, 3, 2> tangent_basis(const Eigen::Vector3d& normal);

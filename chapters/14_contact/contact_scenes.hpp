@@ -35,6 +35,7 @@ struct BlockSettings {
     std::string model = "stable-neo-hookean";
     hyper::NewtonOptions newton;        ///< chapter 12's Newton
     ContactOptions contact;             ///< d̂, κ, ε_v, …
+    int friction_updates = 1;           ///< lagged friction updates per step (step_with_friction_updates)
 };
 
 /// A block of settings.model on the floor z = 0 (a HalfSpace with μ), its Newton
@@ -46,9 +47,10 @@ struct BlockScene {
     std::unique_ptr<hyper::NewtonBackwardEuler> integrator;
     dynamics::State state;
 
-    /// One backward Euler step with contact (Δt of the settings).
-    void step();
+    /// One backward Euler step with contact (Δt and friction updates of the settings).
+    dynamics::StepInfo step();
     double time_step = 0.0;
+    int friction_updates = 1;
 };
 
 /// The block of settings. fem::Error for an edge ≤ 0, cells < 1, a height < 0, θ outside [0, π/2),

@@ -7,7 +7,8 @@
 //      rebounds, the smallest distance ever seen, Newton iterations and time per step, swept over
 //      d̂, κ, Δt and the Newton tolerance; a .pvd of the drop;
 //   2. the slope: a cube on a slope that slides (tan θ > μ) against a = g (sin θ − μ cos θ), and one
-//      that sticks (tan θ < μ), its creep per step against ε_v Δt, over the same sweep.
+//      that sticks (tan θ < μ), its creep per step against ε_v Δt, over the same sweep and with the
+//      friction lagged once a step or updated within it.
 //
 // Sample runs:
 //   ch14_contact                                   full run
@@ -42,6 +43,9 @@ int main(int argc, char** argv)
         ->check(check::real(0.0, 0.05, check::Ends::open_closed))->capture_default_str();
     cli.app.add_option("--tolerance", settings.tolerances, "Newton's relative tolerances swept")
         ->check(check::real(0.0, 0.1, check::Ends::open_closed))->capture_default_str();
+    cli.app.add_option("--friction-updates", settings.friction_updates,
+                       "Lagged friction updates per step swept on the slope (1: IPC's one lag)")
+        ->check(check::integer(1, 20))->capture_default_str();
     cli.app.add_option("--height", settings.drop_height, "Drop height h [m]")
         ->check(check::real(0.0, 1.0, check::Ends::open_closed))->capture_default_str();
     cli.app.add_option("--duration", settings.duration, "Length of each run [s]")

@@ -60,9 +60,9 @@ void drop_study(const RunContext& run, const Settings& settings)
         bool bounced = false;
         for (int step = 0; step < steps; ++step) {
             Timer timer;
-            block.step();
+            const dynamics::StepInfo info = block.step();
             seconds += timer.seconds();
-            iterations += block.integrator->last().iterations;
+            iterations += info.newton_iterations;
             const double falling = -mean_velocity(*block.body, block.state.v).z();
             fastest = std::max(fastest, falling);
             smallest = std::min(smallest, block.contact->smallest_distance(block.state.u));

@@ -12,9 +12,9 @@
 
 namespace fem::contact {
 
-void BlockScene::step()
+dynamics::StepInfo BlockScene::step()
 {
-    integrator->step(*body, time_step, state);
+    return step_with_friction_updates(*integrator, *contact, *body, time_step, state, friction_updates);
 }
 
 BlockScene block_scene(const BlockSettings& settings)
@@ -34,6 +34,7 @@ BlockScene block_scene(const BlockSettings& settings)
     scene.time_step = settings.time_step;
     BlockScene block;
     block.time_step = settings.time_step;
+    block.friction_updates = settings.friction_updates;
     block.body = std::make_unique<dynamics::Body>(scene, hyper::make_force_model(settings.model, scene.mesh, scene.material));
     std::vector<std::shared_ptr<const Obstacle>> floor{
         std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), settings.friction)};

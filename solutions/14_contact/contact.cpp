@@ -128,15 +128,18 @@ void ContactPotential::begin_step(dynamics::Body& body, const dynamics::State& s
         stiffness_ = std::clamp(stiffness_, low, high);
         last_smallest_ = smallest;
     }
-    // The friction pairs, lagged at the step's start (IPC).
+    // The friction pairs, lagged at the step's start (IPC), or where lag_friction_at said.
+    const bool at_start = lag_u_.size() == 0;
+    const Eigen::VectorXd& lag = at_start ? state.u : lag_u_;
+    const double lag_time = at_start ? state.time : time_;
     pairs_.clear();
     for (int v : surface_)
         for (int o = 0; o < static_cast<int>(obstacles_.size()); ++o) {
             const Obstacle& obstacle = *obstacles_[static_cast<std::size_t>(o)];
             if (obstacle.friction() == 0.0)
                 continue;
-            const Eigen::Vector3d x = position(state.u, v);
-            const double d = obstacle.distance(x, state.time);
+            const Eigen::Vector3d x = position(lag, v);
+            const double d = obstacle.distance(x, lag_time);
             if (!(d > 0.0 && d < options_.activation_distance))
                 continue;
             FrictionPair pair;
@@ -144,10 +147,39 @@ void ContactPotential::begin_step(dynamics::Body& body, const dynamics::State& s
             pair.obstacle = o;
             pair.normal_force = stiffness_ * std::abs(barrier(d, options_.activation_distance).first);
             pair.coefficient = obstacle.friction();
-            pair.tangent = tangent_basis(obstacle.gradient(x, state.time));
-            pair.start = x + time_step * obstacle.velocity();
+            pair.tangent = tangent_basis(obstacle.gradient(x, lag_time));
+            pair.start = position(state.u, v) + time_step * obstacle.velocity();
             pairs_.push_back(pair);
         }
+    lag_u_.resize(0);
+}
+
+void ContactPotential::lag_friction_at(const Eigen::VectorXd& u)
+{
+    if (u.size() != 3 * rest_.rows())
+        throw Error(str("contact: the friction lag needs u with 3n = ", 3 * rest_.rows(), " entries, got ", u.size()));
+    lag_u_ = u;
+}
+
+dynamics::StepInfo step_with_friction_updates(hyper::NewtonBackwardEuler& newton, ContactPotential& contact,
+                                              dynamics::Body& body, double time_step, dynamics::State& state,
+                                              int updates)
+{
+    if (updates < 1)
+        throw Error(str("contact: friction updates per step must be >= 1, got ", updates));
+    dynamics::State solution = state;
+    dynamics::StepInfo info = newton.step(body, time_step, solution);
+    for (int update = 1; update < updates; ++update) {
+        contact.lag_friction_at(solution.u);
+        solution = state;
+        const dynamics::StepInfo again = newton.step(body, time_step, solution);
+        info.newton_iterations += again.newton_iterations;
+        info.solver_iterations += again.solver_iterations;
+        info.damping_work = again.damping_work;
+        info.boundary_work = again.boundary_work;
+    }
+    state = std::move(solution);
+    return info;
 }
 
 double ContactPotential::energy(const Eigen::VectorXd& u) const
