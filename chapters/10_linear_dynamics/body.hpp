@@ -66,7 +66,8 @@ struct Scene {
 /// fem::Error, naming the field and what is allowed, unless: the mesh is valid (indices, no
 /// zero-volume or inverted tet: fem::validate with Inverted::reject), Y > 0, −1 < ν < 0.5, ρ > 0,
 /// g finite, 0 ≤ α, β ≤ 0.02, Δt > 0, duration ≥ 0 and a whole number of steps, and every pinned
-/// vertex lies in [0, #V) and is listed once. Nothing pinned is allowed (the body falls freely).
+/// vertex lies in [0, #V) and is listed once, and some vertex is free. Nothing pinned is allowed
+/// (the body falls freely).
 /// docs/10_linear_dynamics.md#scenes
 void validate(const Scene& scene);
 

@@ -168,6 +168,14 @@ constexpr int max_nesting = 32;
 /// The largest scene file read [bytes].
 constexpr long long max_scene_bytes = 16ll << 20;
 
+/// A body's size (its bounding box's longest edge) [m]: from a micrometre to a thousand kilometres.
+/// Beyond, volumes (products of three edges) and stiffnesses (divided by their squares) leave the
+/// range where a double keeps its digits. docs/scenes.md#limits
+constexpr double smallest_body_extent = 1e-6, largest_body_extent = 1e6;
+/// The stiffest material a scene may have [Pa]: a thousand diamonds (1.2e12 Pa). Beyond, the Lamé
+/// parameters near ν = ½ and the stresses of large strains overflow. docs/scenes.md#limits
+constexpr double largest_youngs_modulus = 1e15;
+
 /// What reading a scene may do and use; the defaults are those of a run.
 struct ReadLimits {
     bool tetgen = true;             ///< tetrahedralise a surface mesh file with TetGen (else an error)

@@ -40,6 +40,8 @@ void validate(const Scene& scene)
         if (i > 0 && sorted[i] == sorted[i - 1])
             throw Error(str("pinned vertex ", sorted[i], " is listed twice"));
     }
+    if (vertices > 0 && sorted.size() == static_cast<std::size_t>(vertices))
+        throw Error(str("every one of the mesh's ", vertices, " vertices is pinned: nothing is left to move"));
 }
 
 int step_count(double duration, double time_step)

@@ -639,6 +639,16 @@ TetMesh build_mesh(const Fields& fields, const std::filesystem::path& scene_file
     }
     if (mesh.T.rows() == 0)
         fields.fail(*fields.get(file ? "file" : "generator"), file ? "file" : "generator", "the mesh has no tets");
+    // The body's size within what the arithmetic holds: a tet's volume is a product of three edges,
+    // its stiffness divides by their squares, so edges of 1e±103 m and beyond leave a double's range
+    // (a 1e300 m box read as "zero volume"). The course's bodies are millimetres to metres.
+    const double extent = (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).maxCoeff();
+    if (!(extent >= smallest_body_extent && extent <= largest_body_extent)) {
+        const std::string key = generator ? "size" : (fields.has("scale") ? "scale" : "file");
+        fields.fail(fields.has(key) ? *fields.get(key) : *fields.get(file ? "file" : "generator"), key,
+                    str("the body is ", extent, " m across; allowed: ", smallest_body_extent, " m to ",
+                        largest_body_extent, " m (change ", generator ? "size" : "scale", ")"));
+    }
     // A vertex no tet uses has neither mass nor stiffness: the step's matrix would be singular.
     std::vector<bool> used(static_cast<std::size_t>(mesh.V.rows()), false);
     for (Eigen::Index t = 0; t < mesh.T.rows(); ++t)
@@ -654,7 +664,7 @@ TetMesh build_mesh(const Fields& fields, const std::filesystem::path& scene_file
 }
 
 BodySpec read_body(const toml::table& table, const std::string& name, const Source& file,
-                   const std::filesystem::path& scene_file, double duration, int index)
+                   const std::filesystem::path& scene_file, double duration, double time_step, int index)
 {
     const Fields fields(table, name, file,
                         {"name", "mesh", "material", "mass", "damping", "pin", "load", "initial_velocity"});
@@ -681,7 +691,10 @@ BodySpec read_body(const toml::table& table, const std::string& name, const Sour
     const Fields material(*material_table, fields.field("material"), file,
                           {"model", "youngs_modulus", "poisson_ratio", "density"});
     body.model = material.text("model", "linear", model_names());
-    body.material.youngs_modulus = material.positive("youngs_modulus", body.material.youngs_modulus);
+    body.material.youngs_modulus = material.number(
+        "youngs_modulus", body.material.youngs_modulus, [](double Y) { return Y > 0.0 && Y <= largest_youngs_modulus; },
+        str("a number in (0, ", largest_youngs_modulus, "] Pa (diamond is 1.2e12 Pa; beyond the bound the stresses "
+            "of a large strain and the Lame parameters near nu = 0.5 leave a double's range)"));
     body.material.poisson_ratio = material.number(
         "poisson_ratio", body.material.poisson_ratio, [](double nu) { return nu > -1.0 && nu < 0.5; },
         "a number in (-1, 0.5) (0.5 is incompressible, which a displacement model cannot represent)");
@@ -695,6 +708,14 @@ BodySpec read_body(const toml::table& table, const std::string& name, const Sour
         body.damping.beta = damping.number("beta", 0.0, in_range, "a number in [0, 0.02] (s)");
     }
     body.initial_velocity = fields.vector("initial_velocity", Eigen::Vector3d::Zero());
+    // A body that moves farther than its own size in one step leaves the pins' neighbours strained
+    // beyond any model's range at the first step (1e6 m/s read as "not positive definite").
+    const double extent = (body.mesh.V.colwise().maxCoeff() - body.mesh.V.colwise().minCoeff()).maxCoeff();
+    if (body.initial_velocity.norm() * time_step > extent)
+        fields.fail(*fields.get("initial_velocity"), "initial_velocity",
+                    str("moves the body ", body.initial_velocity.norm() * time_step, " m in one step of ", time_step,
+                        " s, more than its size ", extent, " m; allowed: a speed up to size / dt = ", extent / time_step,
+                        " m/s"));
 
     const auto each = [&](const std::string& key, const auto& read) {
         const toml::node* node = fields.get(key);
@@ -723,6 +744,9 @@ BodySpec read_body(const toml::table& table, const std::string& name, const Sour
         body.pins.push_back(std::move(p));
     });
     body.pinned.assign(pinned.begin(), pinned.end());
+    if (!body.pinned.empty() && body.pinned.size() == static_cast<std::size_t>(body.mesh.V.rows()))
+        fields.fail(*fields.get("pin"), "pin", str("pins every one of the body's ", body.mesh.V.rows(),
+                                                   " vertices: nothing is left to move; pin fewer"));
     each("load", [&](const Fields& load) {
         Load l;
         const std::string type = load.text("type", "point", {"point", "surface"});
@@ -995,7 +1019,8 @@ SceneSpec read_scene(const std::filesystem::path& path, const std::vector<std::s
     for (std::size_t i = 0; i < items.size(); ++i) {
         const std::string name = str("body[", i, "]");
         scene.bodies.push_back(
-            read_body(table_in_array(top, *items.get(i), "body"), name, source, path, scene.duration, static_cast<int>(i)));
+            read_body(table_in_array(top, *items.get(i), "body"), name, source, path, scene.duration, scene.time_step,
+                      static_cast<int>(i)));
         if (!names.insert(scene.bodies.back().name).second)
             top.fail(*items.get(i), name + ".name", str("'", scene.bodies.back().name, "' is the name of an earlier body"));
     }

@@ -10,6 +10,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <numeric>
 
 using namespace fem::dynamics;
 using fem::test::cantilever_scene;
@@ -102,6 +103,10 @@ TEST_CASE("scenes: every bad field is refused with its name and what is allowed"
     refused([](Scene& s) { s.pinned.push_back(static_cast<int>(s.mesh.V.rows())); }, "outside the mesh");
     refused([](Scene& s) { s.pinned.push_back(-1); }, "outside the mesh");
     refused([](Scene& s) { s.pinned.push_back(s.pinned.front()); }, "listed twice");
+    refused([](Scene& s) {  // every vertex pinned: the step's system would be 0x0
+        s.pinned.resize(static_cast<std::size_t>(s.mesh.V.rows()));
+        std::iota(s.pinned.begin(), s.pinned.end(), 0);
+    }, "nothing is left to move");
     refused([](Scene& s) { std::swap(s.mesh.T(0, 2), s.mesh.T(0, 3)); }, "scene mesh");
     refused([](Scene& s) { s.mesh.V(0, 0) = std::nan(""); }, "mesh");
 
