@@ -12,6 +12,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -256,4 +258,26 @@ TEST_CASE("a rising floor lifts the block resting on it, never reaching into it"
     const double speed = mean_velocity(*block.body, block.state.v).z();
     INFO("block speed " << speed << " m/s, floor " << rise << " m/s");
     CHECK(std::abs(speed - rise) <= 1e-2 * rise);
+}
+
+TEST_CASE("a block dropped on a turned box comes to rest on its top face, never inside", "[ex14.1]")
+{
+    BlockSettings settings;
+    settings.height = 0.01;
+    BlockScene block = block_scene(settings);
+    // A slab under the block, turned 0.3 rad about z: its top face is z = 0, its time of impact
+    // conservative advancement.
+    const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    ContactPotential contact(*block.body,
+                             {std::make_shared<Box>(Eigen::Vector3d(0.05, 0.05, -0.05), Eigen::Vector3d(0.2, 0.2, 0.05), turn)},
+                             settings.contact);
+    block.integrator->set_potential(&contact);
+    for (int step = 0; step < 60; ++step) {
+        block.step();
+        REQUIRE(contact.smallest_distance(block.state.u) > 0.0);
+    }
+    INFO("lowest vertex " << lowest_height(*block.body, block.state.u) << " m");
+    CHECK(lowest_height(*block.body, block.state.u) > 0.0);
+    CHECK(lowest_height(*block.body, block.state.u) < settings.contact.activation_distance);
+    CHECK(mean_velocity(*block.body, block.state.v).norm() < 1e-3);
 }
