@@ -96,16 +96,10 @@ public:
     /// Used once, by the next begin_step (step_with_friction_updates). fem::Error on u's size.
     void lag_friction_at(const Eigen::VectorXd& u);
 
-    /// Sets the time the obstacles are held at (begin_step sets t + Δt).
-    void set_time(double time) { time_ = time; }
-    /// Sets κ [N/m] (> 0; begin_step re-adapts it when the options' stiffness is 0).
-    void set_stiffness(double stiffness);
-
+    /// κ [N/m] of the current step (the fixed one, or the adaptive rule's).
     double stiffness() const { return stiffness_; }
-    const std::vector<int>& surface_vertices() const { return surface_; }
+    /// The current step's lagged friction pairs (set by begin_step).
     const std::vector<FrictionPair>& friction_pairs() const { return pairs_; }
-    const ContactOptions& options() const { return options_; }
-    const std::vector<std::shared_ptr<const Obstacle>>& obstacles() const { return obstacles_; }
 
 private:
     Eigen::Vector3d position(const Eigen::VectorXd& u, int vertex) const;

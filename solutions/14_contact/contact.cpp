@@ -85,13 +85,6 @@ ContactPotential::ContactPotential(const dynamics::Body& body, std::vector<std::
     stiffness_set_ = options_.stiffness > 0.0;
 }
 
-void ContactPotential::set_stiffness(double stiffness)
-{
-    require_positive(stiffness, "barrier stiffness kappa [N/m]");
-    stiffness_ = stiffness;
-    stiffness_set_ = true;
-}
-
 Eigen::Vector3d ContactPotential::position(const Eigen::VectorXd& u, int vertex) const
 {
     return rest_.row(vertex).transpose() + u.segment<3>(3 * vertex);
