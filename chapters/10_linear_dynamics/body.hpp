@@ -63,6 +63,14 @@ struct Scene {
     double duration = 1.0;                       ///< [s], a whole number of steps (see step_count)
 };
 
+/// The materials the chapters' command lines accept (--youngs, --density): the real solids, from
+/// gels (about 10 Pa) to diamond (1.2e12 Pa) and from aerogels (about 1 kg/m³) to osmium (22,590
+/// kg/m³), with a margin. validate() itself takes any finite positive value; far outside these
+/// ranges the matrices' entries leave the range where their products stay normal doubles (Y = 1e-300
+/// failed inside the eigensolver, Y = 1e300 as a zero frequency). docs/10_linear_dynamics.md#scenes
+constexpr double lowest_youngs_modulus = 1e-2, highest_youngs_modulus = 1e13;  // [Pa]
+constexpr double lowest_density = 1e-2, highest_density = 1e6;                // [kg/m³]
+
 /// fem::Error, naming the field and what is allowed, unless: the mesh is valid (indices, no
 /// zero-volume or inverted tet: fem::validate with Inverted::reject), Y > 0, −1 < ν < 0.5, ρ > 0,
 /// g finite, 0 ≤ α, β ≤ 0.02, Δt > 0, duration ≥ 0 and a whole number of steps, and every pinned

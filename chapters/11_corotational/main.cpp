@@ -38,7 +38,8 @@ int main(int argc, char** argv)
                    "Chapter 11: corotational elements: best-fit rotations, warped stiffness, a step matrix that changes");
     study::Settings settings;
     cli.app.add_option("--youngs", settings.soft.youngs_modulus, "Young's modulus Y of the swinging beam [Pa]")
-        ->check(check::positive())->capture_default_str();
+        ->check(check::real(dynamics::lowest_youngs_modulus, dynamics::highest_youngs_modulus, check::Ends::closed))
+        ->capture_default_str();
     cli.app.add_option("--duration", settings.duration, "Length of the swing [s] (a multiple of 1/30)")
         ->check(check::real(0.0, 10.0, check::Ends::open_closed))->capture_default_str();
     cli.app.add_option("--swing-cells", settings.swing_cells, "Cells along the swinging beam")
