@@ -326,12 +326,20 @@ int main(int argc, char** argv)
     cli.app.add_option("--heat-time", settings.heat_time, "Final time of the heat demo on the surface")
         ->check(check::positive())->capture_default_str();
     cli.check_options([&] {  // the surface is read (and checked) once, before any study runs
+        const std::filesystem::path surface = settings.mesh.empty() ? data_path("bunny.obj")
+                                                                    : std::filesystem::path(settings.mesh);
         try {
-            settings.surface = io::read_tri_mesh(settings.mesh.empty() ? data_path("bunny.obj")
-                                                              : std::filesystem::path(settings.mesh));
+            settings.surface = io::read_tri_mesh(surface);
         } catch (const Error& e) {
             throw Error(str("--mesh: ", e.what()));
         }
+        // The demo keeps an open surface's rim at its start value: a surface that is all rim (loose
+        // triangles) would leave nothing to heat.
+        const auto vertices = static_cast<int>(settings.surface.V.rows());
+        if (boundary_vertices(settings.surface.F, vertices).size() == static_cast<std::size_t>(vertices))
+            throw Error(str("--mesh: ", surface.string(), ": every one of its ", vertices,
+                            " vertices lies on its boundary, which the heat demo holds fixed: nothing is left ",
+                            "to heat; give a surface with interior vertices (a closed one has no boundary)"));
     });
     return cli.run(argc, argv, [&](const RunContext& run) {
         mesh_study(run, settings);
