@@ -187,8 +187,8 @@ int validate(TetMesh& mesh, const MeshOrigin& origin, Inverted inverted)
                 throw Error(str(element_place(origin, t), ": tetrahedron ", t, " (vertices ",
                                 mesh.T(t, 0), ", ", mesh.T(t, 1), ", ", mesh.T(t, 2), ", ", mesh.T(t, 3),
                                 ") is inverted (negative volume ", volume6 / 6.0,
-                                "); list its vertices so that (b−a)·((c−a)×(d−a)) > 0, or ask for "
-                                "reorientation"));
+                                "); list its vertices so that (b−a)·((c−a)×(d−a)) > 0 (the mesh readers reorient "
+                                "what they read; in code, validate with Inverted::reorient)"));
             std::swap(mesh.T(t, 2), mesh.T(t, 3));
             ++reoriented;
         }

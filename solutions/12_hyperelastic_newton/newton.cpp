@@ -177,7 +177,8 @@ NewtonResult newton_minimize(const NewtonProblem& problem, Eigen::VectorXd x0, c
         if (iteration == options.max_iterations)
             throw Error(str("Newton: ", problem.what, " did not converge in ", options.max_iterations,
                             " iterations: |gradient| / scale = ", norm / problem.scale, " (tolerance ",
-                            options.relative_tolerance, "); use a smaller dt or raise the cap"));
+                            options.relative_tolerance, "); use a smaller dt (a scene's time.step), or in code raise ",
+                            "NewtonOptions::max_iterations"));
         Eigen::VectorXd direction;
         double slope = 0.0;
         bool found = newton_direction(problem, solver, x, options.hessian == HessianChoice::definite, gradient, direction,
