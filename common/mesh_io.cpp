@@ -68,7 +68,12 @@ public:
         if (descriptor < 0)
             throw Error(str("cannot open '", name_, "' for reading: ", std::strerror(errno)));
         struct stat status {};
-        if (::fstat(descriptor, &status) == 0 && status.st_size > 0) {
+        if (::fstat(descriptor, &status) != 0) {
+            const int reason = errno;
+            ::close(descriptor);
+            throw Error(str("cannot read '", name_, "': ", std::strerror(reason)));
+        }
+        if (status.st_size > 0) {
             size_ = static_cast<std::size_t>(status.st_size);
             void* mapped = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE, descriptor, 0);
             if (mapped == MAP_FAILED) {

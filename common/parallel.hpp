@@ -58,8 +58,8 @@ inline void set_thread_count(int threads)
 /// (chapter 12's element loops on 2 threads took 2.5-30x as long as on 1 beside a spinning process,
 /// and 0.6-1.06x with passive waiting; README, "Threads on a busy machine"). On a quiet machine
 /// waking a sleeping thread costs a few microseconds per loop. ChapterCli::run calls it first; it
-/// returns at once without OpenMP, when the variable is set, or if execv fails (nothing is lost
-/// but speed). argv: main's, ending with nullptr.
+/// returns at once without OpenMP, when the variable is set, for an argv that is not main()'s own
+/// (a test calling ChapterCli::run), or if execv fails (nothing is lost but speed).
 void wait_passively(char** argv);
 
 /// Calls body(i) for every i in [0, n), split among thread_count() threads (a static schedule).
