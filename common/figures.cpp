@@ -20,6 +20,7 @@
 #include <vtkDataSetSurfaceFilter.h>
 #include <vtkDoubleArray.h>
 #include <vtkImageData.h>
+#include <vtkGL2PSExporter.h>
 #include <vtkLightKit.h>
 #include <vtkLookupTable.h>
 #include <vtkNew.h>
@@ -29,6 +30,7 @@
 #include <vtkPlot.h>
 #include <vtkPlotPoints.h>
 #include <vtkPointData.h>
+#include <vtkPolyDataNormals.h>
 #include <vtkPolyDataMapper.h>
 #include <vtkProperty.h>
 #include <vtkCallbackCommand.h>
@@ -46,7 +48,12 @@
 #include <vtkVariant.h>
 #include <vtkWindowToImageFilter.h>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <fstream>
+#include <iterator>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -58,6 +65,9 @@
 #include <thread>
 
 namespace fem::fig {
+
+const int figure_code_version = 4;  // bump it when a figure's look changes (figures.hpp)
+
 namespace {
 
 /// The process's one connection to the X server, or nullptr when there is no display.
@@ -108,6 +118,7 @@ void write_png(vtkRenderWindow* window, const std::filesystem::path& path)
     vtkNew<vtkPNGWriter> writer;
     writer->WriteToMemoryOn();
     writer->SetInputConnection(capture->GetOutputPort());
+    writer->AddText(figure_version_key, std::to_string(figure_code_version).c_str());
     const io::detail::VtkErrors errors(writer);
     writer->Write();
     vtkUnsignedCharArray* png = writer->GetResult();
@@ -117,10 +128,65 @@ void write_png(vtkRenderWindow* window, const std::filesystem::path& path)
                                       static_cast<std::size_t>(png->GetNumberOfValues())));
 }
 
+/// Writes what window shows as a vector picture, path (.svg), through VTK's GL2PS exporter: lines,
+/// markers and texts as SVG elements, so a chart scales to any slide. GL2PS cannot embed the
+/// window's (white) background image and says so on stderr, which is silenced for the export; the
+/// file is read back and written by write_file, so a failed export leaves no half-written SVG.
+void write_svg(vtkRenderWindow* window, const std::filesystem::path& path)
+{
+    const std::filesystem::path prefix = std::filesystem::path(path).replace_extension(".gl2ps-partial");
+    std::filesystem::path written = prefix;
+    written += ".svg";
+    vtkNew<vtkGL2PSExporter> exporter;
+    exporter->SetRenderWindow(window);
+    exporter->SetFileFormatToSVG();
+    exporter->CompressOff();
+    exporter->SetFilePrefix(prefix.c_str());
+    exporter->SetTitle("fem-course figure");
+    std::fflush(stderr);
+    const int saved = dup(STDERR_FILENO);
+    const int null = open("/dev/null", O_WRONLY);
+    if (saved >= 0 && null >= 0)
+        dup2(null, STDERR_FILENO);
+    exporter->Write();
+    std::fflush(stderr);
+    if (saved >= 0 && null >= 0)
+        dup2(saved, STDERR_FILENO);
+    for (int fd : {saved, null})
+        if (fd >= 0)
+            close(fd);
+    std::ifstream in(written, std::ios::binary);
+    const std::string svg((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    in.close();
+    std::error_code ignored;
+    std::filesystem::remove(written, ignored);
+    if (svg.find("</svg>") == std::string::npos)
+        throw Error(str("VTK's GL2PS exporter could not write the SVG '", path.string(), "'"));
+    write_file(path, svg);
+}
+
 // Line colours of successive series (Tableau 10), as RGB bytes.
-constexpr std::array<std::array<unsigned char, 3>, 8> line_colours{{
-    {31, 119, 180}, {255, 127, 14}, {44, 160, 44}, {214, 39, 40},
-    {148, 103, 189}, {140, 86, 75}, {227, 119, 194}, {127, 127, 127}}};
+constexpr std::array<std::array<unsigned char, 3>, 10> line_colours{{
+    {31, 119, 180}, {255, 127, 14}, {44, 160, 44}, {214, 39, 40}, {148, 103, 189},
+    {140, 86, 75}, {227, 119, 194}, {127, 127, 127}, {188, 189, 34}, {23, 190, 207}}};
+
+/// The colour of a named series, the same in every chart of the process: the first chart naming a
+/// series gives it the next colour of line_colours that no series of that chart has taken yet.
+/// `taken` holds the colours of the chart's earlier series.
+std::size_t series_colour(const std::string& name, const std::vector<std::size_t>& taken)
+{
+    static std::vector<std::pair<std::string, std::size_t>> named;  // in the order first drawn
+    for (const auto& [known, colour] : named)
+        if (known == name && std::find(taken.begin(), taken.end(), colour) == taken.end())
+            return colour;
+    std::size_t colour = named.size() % line_colours.size();
+    for (std::size_t tries = 0; tries < line_colours.size() &&
+                                std::find(taken.begin(), taken.end(), colour) != taken.end(); ++tries)
+        colour = (colour + 1) % line_colours.size();
+    if (std::none_of(named.begin(), named.end(), [&](const auto& entry) { return entry.first == name; }))
+        named.emplace_back(name, colour);
+    return colour;
+}
 
 /// Sets a text's font, size and colour. The figures use DejaVu Sans (Debian's fonts-dejavu-core,
 /// which tools/setup.sh installs) when it is there: VTK's built-in Arial draws '|' so thin that
@@ -177,18 +243,81 @@ std::vector<double> log_ticks(double low, double high)
     return ticks;
 }
 
-/// A tick label as a person writes it: 0.002, 50000, 1e-6, 2e8.
-std::string tick_label(double value)
+/// Round values inside [low, high], for a colour bar's labels or a linear axis's ticks: the
+/// multiples of the smallest step 1, 2, 2.5 or 5 times a power of ten that gives at most `most` of
+/// them (the range's ends are not labelled unless they are such multiples).
+std::vector<double> round_ticks(double low, double high, int most = 6)
 {
-    const double magnitude = std::abs(value);
-    if (magnitude >= 1e-4 && magnitude < 1e6) {
-        std::ostringstream out;
-        out << std::setprecision(6) << value;
-        return out.str();
+    if (!(high > low) || !std::isfinite(low) || !std::isfinite(high))
+        return {low};
+    const double power = std::pow(10.0, std::floor(std::log10(high - low)) - 1.0);
+    for (double base : {1.0, 2.0, 2.5, 5.0, 10.0, 20.0, 25.0, 50.0, 100.0}) {
+        const double step = base * power;
+        const double first = std::ceil(low / step - 1e-9) * step;
+        const int count = static_cast<int>(std::floor((high - first) / step + 1e-9)) + 1;
+        if (count <= most) {
+            std::vector<double> ticks;
+            for (int i = 0; i < count; ++i) {
+                const double tick = first + i * step;
+                ticks.push_back(std::abs(tick) < 1e-12 * step ? 0.0 : tick);
+            }
+            return ticks;
+        }
     }
-    const int exponent = static_cast<int>(std::floor(std::log10(magnitude) + 1e-9));
-    const long mantissa = std::lround(value / std::pow(10.0, exponent));
-    return str(mantissa, "e", exponent);
+    return {low, high};
+}
+
+/// n written in superscript digits, e.g. ⁻¹².
+std::string superscript(int n)
+{
+    static const char* const digits[10] = {"\u2070", "\u00B9", "\u00B2", "\u00B3", "\u2074",
+                                           "\u2075", "\u2076", "\u2077", "\u2078", "\u2079"};
+    std::string out = n < 0 ? "\u207B" : "";
+    for (char c : std::to_string(std::abs(n)))
+        out += digits[c - '0'];
+    return out;
+}
+
+/// The labels of one axis's ticks (round values: a few significant digits), in one notation as a
+/// person writes them: plain (0.002, 50000) when every nonzero tick lies in [0.001, 100000), else
+/// powers of ten for all (10⁻⁶, 2·10⁻⁵, 1.5·10⁵), never a mix of the two.
+std::vector<std::string> tick_labels(const std::vector<double>& values)
+{
+    const bool plain = std::all_of(values.begin(), values.end(), [](double v) {
+        return v == 0.0 || (std::abs(v) >= 1e-3 * (1 - 1e-9) && std::abs(v) < 1e5);
+    });
+    const auto digits = [](double value, int significant) {  // no trailing zeros
+        std::ostringstream out;
+        out << std::setprecision(significant) << value;
+        return out.str();
+    };
+    std::vector<std::string> labels;
+    for (double value : values) {
+        if (plain || value == 0.0) {
+            labels.push_back(digits(value, 6));  // 6 digits: 10000 stays 10000, not 1e+04
+            continue;
+        }
+        const int exponent = static_cast<int>(std::floor(std::log10(std::abs(value)) + 1e-9));
+        const std::string mantissa = digits(value / std::pow(10.0, exponent), 4);
+        labels.push_back((mantissa == "1" ? std::string() : mantissa == "-1" ? std::string("\u2212") : mantissa + "\u00B7") +
+                         "10" + superscript(exponent));
+    }
+    return labels;
+}
+
+/// Ticks at round values over [low, high] on a linear axis: the multiples of the step 1, 2, 2.5 or
+/// 5 times a power of ten that gives at most 8 of them, labelled by tick_labels (VTK's own choice
+/// grows with the pixels: at slide resolution it crowded 28 labels on an axis).
+void set_linear_ticks(vtkAxis* axis, double low, double high)
+{
+    vtkNew<vtkDoubleArray> positions;
+    vtkNew<vtkStringArray> labels;
+    const std::vector<double> ticks = round_ticks(low, high, 8);
+    for (double tick : ticks)
+        positions->InsertNextValue(tick);
+    for (const std::string& label : tick_labels(ticks))
+        labels->InsertNextValue(label);
+    axis->SetCustomTickPositions(positions, labels);
 }
 
 /// The range [low, high] (in the axis's scale) that shows data from low to high with room around
@@ -223,16 +352,19 @@ std::pair<double, double> padded_range(double low, double high, bool log)
     return {low, high};
 }
 
-/// Gives a log axis the ticks of log_ticks, labelled by tick_label (VTK's own choice leaves some
+/// Gives a log axis the ticks of log_ticks, labelled by tick_labels (VTK's own choice leaves some
 /// axes with a single label).
 void set_log_ticks(vtkAxis* axis, double low, double high)
 {
     vtkNew<vtkDoubleArray> positions;
     vtkNew<vtkStringArray> labels;
+    std::vector<double> values;
     for (double tick : log_ticks(low, high)) {
         positions->InsertNextValue(tick);
-        labels->InsertNextValue(tick_label(std::pow(10.0, tick)));
+        values.push_back(std::pow(10.0, tick));
     }
+    for (const std::string& label : tick_labels(values))
+        labels->InsertNextValue(label);
     axis->SetCustomTickPositions(positions, labels);
 }
 
@@ -288,7 +420,7 @@ bool segment_meets(const PixelBox& box, double x0, double y0, double x1, double 
 struct ChartLayout {
     struct Curve {
         std::vector<double> x, y;  // in the axes' scales
-        bool markers = false;
+        bool markers = false;      // markers only, no line
     };
     std::vector<Curve> curves;
     Scale sx, sy;
@@ -318,7 +450,7 @@ struct ChartLayout {
     /// Whether any line or marker of the chart is drawn inside the box.
     bool covers(const PixelBox& box) const
     {
-        constexpr double marker_radius = 9.0;  // half a 14-pixel marker, and a little air
+        const double marker_radius = 9.0 * pixel_scale;  // half a 14-pixel marker, and a little air
         const PixelBox grown{box.left - marker_radius, box.bottom - marker_radius, box.right + marker_radius,
                              box.top + marker_radius};
         for (const Curve& c : curves)
@@ -470,8 +602,17 @@ void add_renderers(vtkRenderWindow* window, vtkDataSet* data, bool cell_field, b
     if (options.range)
         std::tie(range[0], range[1]) = *options.range;
 
+    const int s = options.scale;
     vtkNew<vtkPolyDataMapper> mapper;
-    mapper->SetInputConnection(surface->GetOutputPort());
+    vtkNew<vtkPolyDataNormals> normals;  // smooth shading: vertex normals averaged over the faces
+    if (options.smooth) {
+        normals->SetInputConnection(surface->GetOutputPort());
+        normals->SplittingOff();
+        normals->ConsistencyOn();
+        mapper->SetInputConnection(normals->GetOutputPort());
+    } else {
+        mapper->SetInputConnection(surface->GetOutputPort());
+    }
     if (cell_field)
         mapper->SetScalarModeToUseCellFieldData();
     else
@@ -505,7 +646,7 @@ void add_renderers(vtkRenderWindow* window, vtkDataSet* data, bool cell_field, b
         if (options.show_edges) {
             look->EdgeVisibilityOn();
             look->SetEdgeColor(0.25, 0.25, 0.25);
-            look->SetLineWidth(1.0);
+            look->SetLineWidth(1.0f * s);
         }
     } else {
         look->SetAmbient(1.0);
@@ -518,57 +659,87 @@ void add_renderers(vtkRenderWindow* window, vtkDataSet* data, bool cell_field, b
     // along the bottom instead.
     std::vector<vtkSmartPointer<vtkActor2D>> keys;
     if (options.categories.empty()) {
+        // Labels at round values (1, 2, 2.5 or 5 times a power of ten), printed as %g prints them:
+        // 2000, 0.0035, never "665." or "2.66e+03".
         auto bar = vtkSmartPointer<vtkScalarBarActor>::New();
         bar->SetLookupTable(colours);
-        bar->SetNumberOfLabels(5);
+        vtkNew<vtkDoubleArray> ticks;
+        for (double tick : round_ticks(range[0], range[1]))
+            ticks->InsertNextValue(tick);
+        bar->SetUseCustomLabels(true);
+        bar->SetCustomLabels(ticks);
+        bar->SetLabelFormat("%g");
         bar->SetWidth(0.09);
         bar->SetHeight(0.72);
         bar->SetPosition(0.88, 0.08);
         bar->UnconstrainedFontSizeOn();
-        set_font(bar->GetLabelTextProperty(), 15);
+        set_font(bar->GetLabelTextProperty(), 15 * s);
         keys.push_back(bar);
+        const std::string name = options.unit.empty() ? options.field : str(options.field, " [", options.unit, "]");
         auto bar_title = vtkSmartPointer<vtkTextActor>::New();
-        bar_title->SetInput(options.field.c_str());
-        set_font(bar_title->GetTextProperty(), 17, true);
+        bar_title->SetInput((options.range_note.empty() ? name : name + "\n" + options.range_note).c_str());
+        set_font(bar_title->GetTextProperty(), 17 * s, true);
         bar_title->GetTextProperty()->SetJustificationToRight();
-        bar_title->SetPosition(options.width - 16, 0.82 * options.height);
+        bar_title->GetTextProperty()->SetVerticalJustificationToBottom();
+        bar_title->SetPosition((options.width - 16) * s, 0.82 * options.height * s);
         keys.push_back(bar_title);
     } else {
-        double x = 20.0;
+        double x = 20.0 * s;
         for (const Category& c : options.categories) {
             // A filled square in the category's colour under an outlined one, then the name.
             for (const auto& [glyph, rgb] : {std::pair{"\u25A0", c.colour}, std::pair{"\u25A1", std::array{0.3, 0.3, 0.3}}}) {
                 auto swatch = vtkSmartPointer<vtkTextActor>::New();
                 swatch->SetInput(glyph);
-                set_font(swatch->GetTextProperty(), 24);
+                set_font(swatch->GetTextProperty(), 24 * s);
                 swatch->GetTextProperty()->SetColor(rgb[0], rgb[1], rgb[2]);
-                swatch->SetPosition(x, 14.0);
+                swatch->SetPosition(x, 14.0 * s);
                 keys.push_back(swatch);
             }
             auto name = vtkSmartPointer<vtkTextActor>::New();
             name->SetInput(c.name.c_str());
-            set_font(name->GetTextProperty(), 17);
-            name->SetPosition(x + 30.0, 18.0);
+            set_font(name->GetTextProperty(), 17 * s);
+            name->SetPosition(x + 30.0 * s, 18.0 * s);
             keys.push_back(name);
-            x += 30.0 + text_size(name->GetTextProperty(), c.name).first + 35.0;
+            x += 30.0 * s + text_size(name->GetTextProperty(), c.name).first + 35.0 * s;
         }
     }
 
     vtkNew<vtkTextActor> title;
     title->SetInput(options.title.c_str());
-    set_font(title->GetTextProperty(), 20);
+    set_font(title->GetTextProperty(), 20 * s);
     title->GetTextProperty()->SetVerticalJustificationToTop();  // a title of several lines grows downwards
-    title->SetPosition(20, options.height - 14);
+    title->SetPosition(20 * s, (options.height - 14) * s);
 
     // Three renderers: a white backdrop, the data (left of the colour bar's strip, so that neither
     // the bar nor its title ever covers it), and the texts over the whole window.
     const bool bar_strip = options.categories.empty();
-    vtkNew<vtkRenderer> backdrop, renderer, texts;
+    // An outline gets a renderer of its own under the data's (same viewport and camera): the body,
+    // drawn on the layer above, covers it wherever the two overlap, so it shows only around the body.
+    vtkNew<vtkRenderer> backdrop, beneath, renderer, texts;
     backdrop->SetBackground(1.0, 1.0, 1.0);
     renderer->SetBackground(1.0, 1.0, 1.0);
     renderer->SetViewport(0.0, 0.0, bar_strip ? 0.84 : 1.0, 1.0);
     renderer->AddActor(actor);
-    texts->SetLayer(1);
+    const int layers = options.outline ? 3 : 2;
+    if (options.outline) {  // light grey, lit softly, no edges
+        vtkNew<vtkDataSetSurfaceFilter> outline_surface;
+        outline_surface->SetInputData(io::detail::to_vtk(*options.outline));
+        vtkNew<vtkPolyDataMapper> outline_mapper;
+        outline_mapper->SetInputConnection(outline_surface->GetOutputPort());
+        outline_mapper->ScalarVisibilityOff();
+        vtkNew<vtkActor> outline_actor;
+        outline_actor->SetMapper(outline_mapper);
+        outline_actor->GetProperty()->SetColor(0.84, 0.84, 0.84);
+        outline_actor->GetProperty()->SetAmbient(0.7);
+        outline_actor->GetProperty()->SetDiffuse(0.3);
+        beneath->SetBackground(1.0, 1.0, 1.0);
+        beneath->SetViewport(renderer->GetViewport());
+        beneath->SetActiveCamera(renderer->GetActiveCamera());
+        beneath->InteractiveOff();
+        beneath->AddActor(outline_actor);
+        renderer->SetLayer(1);
+    }
+    texts->SetLayer(layers - 1);
     texts->InteractiveOff();
     for (const auto& key : keys)
         texts->AddActor2D(key);
@@ -591,8 +762,10 @@ void add_renderers(vtkRenderWindow* window, vtkDataSet* data, bool cell_field, b
     }
     camera->Zoom(1.1);
 
-    window->SetNumberOfLayers(2);
+    window->SetNumberOfLayers(layers);
     window->AddRenderer(backdrop);
+    if (options.outline)
+        window->AddRenderer(beneath);
     window->AddRenderer(renderer);
     window->AddRenderer(texts);
 }
@@ -604,7 +777,7 @@ bool render_dataset(const std::filesystem::path& path, vtkDataSet* data, bool ce
     vtkNew<vtkRenderWindow> window;
     window->SetDisplayId(shared_display());
     window->SetOffScreenRendering(1);
-    window->SetSize(options.width, options.height);
+    window->SetSize(options.width * options.scale, options.height * options.scale);
     add_renderers(window, data, cell_field, lit, options);
     window->Render();
     write_png(window, path);
@@ -654,7 +827,9 @@ bool save_chart(const LineChart& chart, const std::filesystem::path& stem, bool 
     vtkNew<vtkRenderWindow> window;
     window->SetDisplayId(shared_display());
     window->SetOffScreenRendering(1);
-    window->SetSize(chart.width, chart.height);
+    const int s = pixel_scale;
+    const int width = chart.width * s, height = chart.height * s;
+    window->SetSize(width, height);
     window->AddRenderer(renderer);
     vtkNew<vtkContextActor> context;
     context->GetScene()->SetRenderer(renderer);
@@ -665,16 +840,16 @@ bool save_chart(const LineChart& chart, const std::filesystem::path& stem, bool 
     // device draws a top-aligned string (those two) shifted by its descent, so its descenders
     // were cut and the top of its glyphs showed again under it. The chart gets the window less a
     // strip at the top and one at the bottom, where the two actors go.
-    constexpr double margin = 8.0;
-    auto title = text_actor(chart.title, 18, false);
-    auto x_title = text_actor(chart.x_label, 16, true);
+    const double margin = 8.0 * s;
+    auto title = text_actor(chart.title, 18 * s, false);
+    auto x_title = text_actor(chart.x_label, 16 * s, true);
     const double title_height = text_size(title->GetTextProperty(), chart.title).second;
     const double x_title_height = text_size(x_title->GetTextProperty(), chart.x_label).second;
     const double top_strip = chart.title.empty() ? 0.0 : title_height + margin;  // the chart adds its own border
     const double bottom_strip = chart.x_label.empty() ? margin : x_title_height + 2 * margin;
     xy->SetAutoSize(false);
-    xy->SetSize(vtkRectf(0.0f, float(bottom_strip), float(chart.width), float(chart.height - bottom_strip - top_strip)));
-    title->SetPosition(0.5 * chart.width, chart.height - margin);
+    xy->SetSize(vtkRectf(0.0f, float(bottom_strip), float(width), float(height - bottom_strip - top_strip)));
+    title->SetPosition(0.5 * width, height - margin);
     title->GetTextProperty()->SetVerticalJustificationToTop();
     renderer->AddActor2D(title);
     renderer->AddActor2D(x_title);
@@ -685,8 +860,11 @@ bool save_chart(const LineChart& chart, const std::filesystem::path& stem, bool 
     x_axis->SetLogScale(chart.log_x);
     y_axis->SetLogScale(chart.log_y);
     for (vtkAxis* axis : {x_axis, y_axis}) {
-        set_font(axis->GetTitleProperties(), 16, true);
-        set_font(axis->GetLabelProperties(), 13);
+        set_font(axis->GetTitleProperties(), 16 * s, true);
+        set_font(axis->GetLabelProperties(), 13 * s);
+        axis->GetPen()->SetWidth(1.0f * s);
+        axis->GetGridPen()->SetWidth(1.0f * s);
+        axis->SetTickLength(5.0f * s);
     }
     // The legend is placed by hand (CUSTOM): in the first corner the data leave free (see below).
     vtkChartLegend* legend = xy->GetLegend();
@@ -694,43 +872,56 @@ bool save_chart(const LineChart& chart, const std::filesystem::path& stem, bool 
     legend->SetInline(true);
     legend->SetHorizontalAlignment(vtkChartLegend::CUSTOM);
     legend->SetVerticalAlignment(vtkChartLegend::CUSTOM);
-    set_font(legend->GetLabelProperties(), 13);
+    set_font(legend->GetLabelProperties(), 13 * s);
 
     ChartLayout layout;
     layout.sx.log = chart.log_x;
     layout.sy.log = chart.log_y;
     std::vector<std::string> names;
     std::vector<vtkSmartPointer<vtkTable>> tables;  // the plots keep pointers into these
+    std::vector<std::size_t> colours_taken;
     for (std::size_t k = 0; k < chart.series.size(); ++k) {
-        const Series& s = chart.series[k];
+        const Series& series = chart.series[k];
         auto table = vtkSmartPointer<vtkTable>::New();
         vtkNew<vtkDoubleArray> xs, ys;
         xs->SetName(chart.x_label.c_str());
-        ys->SetName(s.name.c_str());
-        ChartLayout::Curve curve{{}, {}, s.markers_only};
-        for (std::size_t i = 0; i < s.x.size(); ++i)
-            if (plottable(s.x[i], s.y[i], chart)) {
-                xs->InsertNextValue(s.x[i]);
-                ys->InsertNextValue(s.y[i]);
-                curve.x.push_back(layout.sx.to(s.x[i]));
-                curve.y.push_back(layout.sy.to(s.y[i]));
+        ys->SetName(series.name.c_str());
+        ChartLayout::Curve curve{{}, {}, series.markers_only};
+        for (std::size_t i = 0; i < series.x.size(); ++i)
+            if (plottable(series.x[i], series.y[i], chart)) {
+                xs->InsertNextValue(series.x[i]);
+                ys->InsertNextValue(series.y[i]);
+                curve.x.push_back(layout.sx.to(series.x[i]));
+                curve.y.push_back(layout.sy.to(series.y[i]));
             }
         if (curve.x.empty())
             continue;
         layout.curves.push_back(curve);
-        names.push_back(s.name);
+        names.push_back(series.name);
         table->AddColumn(xs);
         table->AddColumn(ys);
         tables.push_back(table);
-        vtkPlot* line = xy->AddPlot(s.markers_only ? vtkChart::POINTS : vtkChart::LINE);
+        vtkPlot* line = xy->AddPlot(series.markers_only ? vtkChart::POINTS : vtkChart::LINE);
         line->SetInputData(table, 0, 1);
-        const auto& rgb = line_colours[k % line_colours.size()];
+        const std::size_t colour = series_colour(series.name, colours_taken);
+        colours_taken.push_back(colour);
+        const auto& rgb = line_colours[colour];
         line->SetColor(rgb[0], rgb[1], rgb[2], 255);
-        line->SetWidth(2.5);
-        line->SetLabel(s.name);
-        if (auto* points = vtkPlotPoints::SafeDownCast(line); points && s.markers_only) {
-            points->SetMarkerStyle(vtkPlotPoints::DIAMOND);
-            points->SetMarkerSize(14.0);
+        line->SetWidth(2.5f * s);
+        if (series.dashed)
+            line->GetPen()->SetLineType(vtkPen::DASH_LINE);
+        line->SetLabel(series.name);
+        constexpr std::size_t short_series = 12;  // this many points or fewer get markers on the line
+        if (auto* points = vtkPlotPoints::SafeDownCast(line)) {
+            if (series.markers_only) {
+                points->SetMarkerStyle(vtkPlotPoints::DIAMOND);
+                points->SetMarkerSize(14.0f * s);
+            } else if (curve.x.size() <= short_series) {
+                points->SetMarkerStyle(vtkPlotPoints::CIRCLE);
+                points->SetMarkerSize(7.0f * s);
+            } else {
+                points->SetMarkerStyle(vtkPlotPoints::NONE);
+            }
         }
     }
 
@@ -755,10 +946,14 @@ bool save_chart(const LineChart& chart, const std::filesystem::path& stem, bool 
             set_log_ticks(x_axis, layout.x_low, layout.x_high);
         else if (layout.whole_numbers_x())
             set_integer_ticks(x_axis, layout.x_low, layout.x_high);
+        else
+            set_linear_ticks(x_axis, layout.x_low, layout.x_high);
         if (chart.log_y)
             set_log_ticks(y_axis, layout.y_low, layout.y_high);
         else if (layout.whole_numbers_y())
             set_integer_ticks(y_axis, layout.y_low, layout.y_high);
+        else
+            set_linear_ticks(y_axis, layout.y_low, layout.y_high);
         window->Render();  // lays the chart out: the plot area is known after it
         layout.left = xy->GetPoint1()[0];
         layout.bottom = xy->GetPoint1()[1];
@@ -812,6 +1007,9 @@ bool save_chart(const LineChart& chart, const std::filesystem::path& stem, bool 
     std::filesystem::path png_path = stem;
     png_path += ".png";
     write_png(window, png_path);
+    std::filesystem::path svg_path = stem;
+    svg_path += ".svg";
+    write_svg(window, svg_path);
     return true;
 }
 
@@ -838,7 +1036,7 @@ MeshWindow::MeshWindow(const RenderOptions& options, const std::string& window_n
     if (!display_available())
         throw Error("no X display for a window (set DISPLAY, or run under xvfb-run -a)");
     impl_->window->SetDisplayId(shared_display());
-    impl_->window->SetSize(options.width, options.height);
+    impl_->window->SetSize(options.width * options.scale, options.height * options.scale);
     impl_->window->SetWindowName(window_name.c_str());
     impl_->interactor->SetRenderWindow(impl_->window);
     impl_->interactor->SetInteractorStyle(nullptr);  // the camera stays the PNGs' one

@@ -19,6 +19,15 @@
 
 namespace fem::fig {
 
+/// The version of the drawing code in figures.cpp (and motion.cpp's frames), defined in figures.cpp
+/// (so that a bump recompiles one file). Every PNG written here carries it as a PNG text chunk, key
+/// figure_version_key, value this number; bump it whenever a change alters what a figure looks
+/// like. tools/check_figures.py (ctest figures_current) fails for a figure under docs/figures with
+/// an older version or none: redraw it with the chapter's executable (tools/check_docs.py --update).
+extern const int figure_code_version;
+/// The key of the PNG text chunk that holds figure_code_version.
+inline constexpr const char* figure_version_key = "fem-figure-version";
+
 /// True when an X display can be opened (probed once per process).
 bool display_available();
 
@@ -28,7 +37,13 @@ struct Series {
     std::vector<double> x;
     std::vector<double> y;
     bool markers_only = false;  ///< draw the points as markers, not joined by a line (e.g. one point)
+    /// A dashed line: for a series that lies on another one (drawn after it), so both show.
+    bool dashed = false;
 };
+
+/// Slide resolution: a figure of width × height is drawn at pixel_scale times as many pixels each
+/// way, its texts, lines and markers scaled alike, so the layout the callers chose stays.
+inline constexpr int pixel_scale = 2;
 
 /// A corner of a chart's plot area, where its legend may go.
 enum class Corner { top_left, top_right, bottom_left, bottom_right };
@@ -40,7 +55,7 @@ struct LineChart {
     bool log_x = false;
     bool log_y = false;
     std::vector<Series> series;
-    int width = 900;
+    int width = 900;   ///< layout pixels (the PNG has pixel_scale times as many)
     int height = 650;
     /// The corner the legend goes to if no line or marker passes there; otherwise the first free
     /// one of top right, top left, bottom right, bottom left; if none is free, the y range grows
@@ -49,7 +64,9 @@ struct LineChart {
 };
 
 /// Writes <stem>.csv (columns: series, x_label, y_label; every point of every series) and, when figures is true
-/// and a display is available, <stem>.png. On a log axis, points with a value ≤ 0 or non-finite
+/// and a display is available, <stem>.png and <stem>.svg (the same chart as a vector picture). A series name keeps one colour for the whole process
+/// (the first chart that names it picks the next free colour), so a method has the same colour in
+/// every chart of a chapter; a series of at most 12 points gets markers on its line. On a log axis, points with a value ≤ 0 or non-finite
 /// values are left out of the PNG (they stay in the CSV). The axes span the data with 5% to spare
 /// on each side (a log axis at least two powers of ten, so that it has two labels), so no line or
 /// marker touches the frame. Returns whether the PNG was written.
@@ -72,6 +89,8 @@ struct CutPlane {
 struct RenderOptions {
     std::string title;                 ///< drawn at the top of the image
     std::string field;                 ///< name of a point or cell field of the mesh
+    std::string unit;                  ///< the field's unit, e.g. "m", "Pa": the colour bar reads "field [unit]"
+    std::string range_note;            ///< a line under the bar's title, e.g. "range of all 121 frames"
     int component = -1;                ///< -1: the magnitude for vectors, the value for scalars
     std::optional<std::pair<double, double>> range;  ///< colour range; default: the field's range
     std::array<double, 3> view_direction{0.0, 0.0, -1.0};  ///< camera looks along this direction
@@ -86,8 +105,15 @@ struct RenderOptions {
     /// The box (xmin, xmax, ymin, ymax, zmin, zmax) the camera frames; default: the mesh's own
     /// bounds. The frames of a motion share one box so that the camera stands still.
     std::optional<std::array<double, 6>> frame_bounds;
-    int width = 900;
+    /// A mesh only: this shape (its points as they are) drawn as a faint translucent grey surface
+    /// behind the coloured one, e.g. the rest shape under an exaggerated motion.
+    std::optional<io::MeshData> outline;
+    /// A mesh only: smooth shading (normals averaged at the vertices) instead of flat facets;
+    /// meant for render surfaces, which also hide their edges (show_edges = false).
+    bool smooth = false;
+    int width = 900;   ///< layout pixels; the PNG has scale times as many each way
     int height = 700;
+    int scale = pixel_scale;  ///< 1 for an on-screen window that must fit the screen
 };
 
 /// Renders the mesh's surface coloured by options.field, with a colour bar, to a PNG file: lit by a

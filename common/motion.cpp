@@ -3,10 +3,27 @@
 #include "common/error.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <limits>
+#include <sstream>
 
 namespace fem::io {
+
+std::string frame_title(const std::string& title, double time, double warp_scale)
+{
+    std::ostringstream rounded;
+    rounded.setf(std::ios::fixed);
+    rounded.precision(2);
+    rounded << time;
+    std::string t = rounded.str();
+    while (t.size() > 1 && t.find('.') != std::string::npos && (t.back() == '0' || t.back() == '.'))
+        t.pop_back();
+    std::string out = str(title, ", t = ", t == "-0" ? "0" : t, " s");
+    if (warp_scale != 1.0)
+        out += str("\ndisplacement drawn \u00D7", warp_scale, " (grey: the body at rest)");
+    return out;
+}
 
 MotionRecorder::MotionRecorder(std::filesystem::path pvd_path, int png_every, FrameFile file)
     : series_(std::move(pvd_path)), png_every_(png_every), file_(file)
@@ -25,6 +42,41 @@ void MotionRecorder::add(double time, const MeshData& frame)
     if (png_every_ > 0 && added_ % static_cast<std::size_t>(png_every_) == 0)
         kept_.emplace_back(time, frame);
     ++added_;
+    for (const auto* fields : {&frame.point_data, &frame.cell_data})
+        for (const Field& field : *fields) {
+            if (field.values.size() == 0)
+                continue;
+            const Eigen::VectorXd shown = field.values.cols() == 1 ? Eigen::VectorXd(field.values.col(0))
+                                                                   : Eigen::VectorXd(field.values.rowwise().norm());
+            auto [it, fresh] = field_ranges_.try_emplace(field.name, shown.minCoeff(), shown.maxCoeff());
+            if (!fresh)
+                it->second = {std::min(it->second.first, shown.minCoeff()), std::max(it->second.second, shown.maxCoeff())};
+        }
+    largest_displacement_ = std::max(largest_displacement_, frame.field(displacement_field).values.rowwise().norm().maxCoeff());
+    if (rest_size_ == 0.0 && frame.points.rows() > 0)
+        rest_size_ = (frame.points.colwise().maxCoeff() - frame.points.colwise().minCoeff()).norm();
+}
+
+std::pair<double, double> MotionRecorder::field_range(const std::string& field) const
+{
+    const auto found = field_ranges_.find(field);
+    if (found == field_ranges_.end())
+        throw Error(str("no frame of this motion has the field '", field, "'"));
+    return found->second;
+}
+
+double MotionRecorder::visible_warp(double fraction) const
+{
+    if (!(largest_displacement_ > 0.0) || !(rest_size_ > 0.0))
+        return 1.0;
+    const double wanted = fraction * rest_size_ / largest_displacement_;
+    if (wanted <= 1.0)
+        return 1.0;
+    const double power = std::pow(10.0, std::floor(std::log10(wanted)));
+    for (double m : {5.0, 2.0, 1.0})
+        if (m * power <= wanted)
+            return m * power;
+    return power;
 }
 
 int MotionRecorder::render_png_frames(const std::filesystem::path& stem, const fig::RenderOptions& options,
@@ -54,19 +106,32 @@ int MotionRecorder::render_png_frames(const std::filesystem::path& stem, const f
         low = std::min(low, values.cols() == 1 ? values.minCoeff() : shown.minCoeff());
         high = std::max(high, values.cols() == 1 ? values.maxCoeff() : shown.maxCoeff());
     }
+    if (!shared.range) {
+        const auto all = field_ranges_.find(options.field);
+        const bool whole_run = all != field_ranges_.end() &&
+                               (options.component < 0 || deformed.front().second.field(options.field).values.cols() == 1);
+        shared.range = whole_run ? all->second : std::make_pair(low, high);
+        if (whole_run && shared.range_note.empty() && added_ > kept_.size())
+            shared.range_note = str("range of all ", added_, " frames");
+    }
+    if (warp_scale != 1.0 && !shared.outline) {
+        shared.outline = kept_.front().second;  // its points are the rest positions
+        if (!options.frame_bounds)               // the camera frames the rest shape too
+            for (int axis = 0; axis < 3; ++axis) {
+                box[2 * axis] = std::min(box[2 * axis], shared.outline->points.col(axis).minCoeff());
+                box[2 * axis + 1] = std::max(box[2 * axis + 1], shared.outline->points.col(axis).maxCoeff());
+            }
+    }
     if (!shared.frame_bounds)  // a box the caller fixed (e.g. a live view's) is kept
         shared.frame_bounds = box;
-    if (!shared.range)
-        shared.range = std::make_pair(low, high);
     int written = 0;
-    const std::string scale = warp_scale == 1.0 ? std::string() : str(" (displacement x ", warp_scale, ")");
     for (const auto& [time, mesh] : deformed) {
         char suffix[32];
         std::snprintf(suffix, sizeof suffix, "_%04d.png", written);
         std::filesystem::path path = stem;
         path += suffix;
         fig::RenderOptions frame_options = shared;
-        frame_options.title = str(options.title, scale, ", t = ", time, " s");
+        frame_options.title = frame_title(options.title, time, warp_scale);
         written += fig::render_mesh_png(path, mesh, frame_options) ? 1 : 0;
     }
     return written;

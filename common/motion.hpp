@@ -8,6 +8,8 @@
 #include "common/vtk_io.hpp"
 
 #include <filesystem>
+#include <map>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -18,6 +20,11 @@ enum class FrameFile {
     volume,   ///< .vtu (unstructured grids: tets, or any cells)
     surface,  ///< .vtp (surfaces: triangles or lines), e.g. a skinned render surface
 };
+
+/// A motion frame's title: "<title>, t = 0.67 s" (the time rounded to 0.01 s), and when the
+/// displacement is drawn exaggerated (warp_scale ≠ 1) a second line saying by how much and that the
+/// grey shape is the body at rest.
+std::string frame_title(const std::string& title, double time, double warp_scale);
 
 /// Records the frames of one body's motion.
 class MotionRecorder {
@@ -34,11 +41,22 @@ public:
 
     std::size_t frames() const { return series_.frames(); }
 
+    /// The exaggeration that makes the largest displacement of all frames added so far about
+    /// `fraction` of the rest shape's size (the diagonal of its bounding box), rounded down to 1,
+    /// 2 or 5 times a power of ten and never below 1 (a large motion stays at true scale).
+    double visible_warp(double fraction = 0.25) const;
+
+    /// The range of a field over every frame added so far (a scalar's values, a vector's
+    /// magnitudes), e.g. to colour two series on one scale; fem::Error for a field no frame has.
+    std::pair<double, double> field_range(const std::string& field) const;
+
     /// Renders the kept frames, warped by warp_scale × their displacement (1: true scale), to
     /// <stem>_0000.png, …: one camera framing the union of the deformed bodies' bounds (unless
     /// options.frame_bounds is set), and one colour range for options.field over all kept frames
-    /// (unless options.range is set). The title
-    /// gets ", t = … s" appended (and "displacement × k" when warp_scale ≠ 1). Returns the number of
+    /// (unless options.range is set); the range of a scalar field or a vector's magnitude is taken
+    /// over every frame added, not only the kept ones, and the colour bar says so. The title is
+    /// frame_title's; when warp_scale ≠ 1 the rest shape is drawn faint behind the body (unless
+    /// options.outline is set). Returns the number of
     /// PNGs written (0 without a display, see figures.hpp). fem::Error if the field is missing from
     /// a frame or warp_scale is not finite.
     int render_png_frames(const std::filesystem::path& stem, const fig::RenderOptions& options,
@@ -50,6 +68,10 @@ private:
     FrameFile file_;
     std::size_t added_ = 0;
     std::vector<std::pair<double, MeshData>> kept_;  // frames for the PNGs
+    /// Over every frame added: each field's range (values of a scalar, magnitudes of a vector).
+    std::map<std::string, std::pair<double, double>> field_ranges_;
+    double largest_displacement_ = 0.0;  // of every frame added
+    double rest_size_ = 0.0;             // the first frame's bounding-box diagonal
 };
 
 }  // namespace fem::io

@@ -23,7 +23,8 @@ Checks:
   5. every image the page shows exists.
 
 --update reruns the executable, rewrites the tables and copies the figures named by
-<!-- fem:figure NAME.png --> into docs/figures/NN_name/ (run it under xvfb-run -a). It never
+<!-- fem:figure NAME.png --> into docs/figures/NN_name/, a chart's NAME.svg beside its PNG (run it
+under xvfb-run -a). It never
 rewrites a quoted number: a sentence around a number that changed needs a person, so --update
 lists those and fails.
 """
@@ -261,6 +262,9 @@ def update(doc, text, out, root, chapter):
         if source.is_file():
             figures.mkdir(parents=True, exist_ok=True)
             shutil.copy(source, figures / m["png"])
+            vector = source.with_suffix(".svg")  # a chart's vector twin, for slides
+            if vector.is_file():
+                shutil.copy(vector, figures / vector.name)
         else:
             print(f"warning: {m['png']} was not drawn (no display?); run under xvfb-run -a")
     doc.write_text(text)

@@ -195,6 +195,7 @@ void swing_study(const RunContext& run, const Settings& settings)
     fig::RenderOptions view;
     view.title = "Linear (left) and corotational (right) cantilever, backward Euler";
     view.field = "displacement";
+    view.unit = "m";
     view.view_direction = {0.0, 1.0, -0.2};
     view.view_up = {0.0, 0.0, 1.0};
     view.height = 560;

@@ -54,6 +54,15 @@ double lateral_stretch(const Material& material, double stretch)
 
 }  // namespace
 
+std::string model_in_words(const std::string& name)
+{
+    return name == "stvk"                       ? std::string("St. Venant-Kirchhoff")
+           : name == "neo-hookean"              ? std::string("neo-Hookean")
+           : name == "stable-neo-hookean"       ? std::string("stable neo-Hookean (course)")
+           : name == "stable-neo-hookean-paper" ? std::string("stable neo-Hookean (Smith et al.)")
+                                                : name;
+}
+
 void materials_study(const RunContext& run, const Settings& settings)
 {
     std::cout << "\n== 1. Energy densities: derivatives by finite differences, uniaxial stretch\n\n";
@@ -81,9 +90,9 @@ void materials_study(const RunContext& run, const Settings& settings)
     // Why: the materials agree for small strains and part ways for large ones; StVK softens under
     // compression (its force returns to zero as the bar flattens), neo-Hookean stiffens.
     fig::LineChart curves;
-    curves.title = str("Uniaxial stretch (Y = ", youngs, " Pa, nu = ", poisson, "): nominal stress P11, laterally free");
-    curves.x_label = "stretch";
-    curves.y_label = "P11 [Pa]";
+    curves.title = str("Uniaxial stretch (Y = ", youngs, " Pa, \u03BD = ", poisson, "): nominal stress P\u2081\u2081, laterally free");
+    curves.x_label = "stretch \u03BB = l / L";
+    curves.y_label = "P\u2081\u2081 [Pa]";
     std::vector<Column> columns{{"stretch", Format::fixed, 2}, {"linear (Pa)", Format::scientific, 4}};
     fig::Series linear{"linear", {}, {}};
     std::vector<fig::Series> series;
@@ -114,9 +123,14 @@ void materials_study(const RunContext& run, const Settings& settings)
             uniaxial.add_row(row);
         }
     }
+    // The legend names the materials in words; the two stable neo-Hookean variants are dashed, as
+    // neo-Hookean lies under them up to the largest stretches.
     curves.series.push_back(linear);
-    for (const fig::Series& s : series)
+    for (fig::Series s : series) {
+        s.dashed = s.name.rfind("stable-", 0) == 0;
+        s.name = model_in_words(s.name);
         curves.series.push_back(s);
+    }
     curves.legend = fig::Corner::top_left;
     uniaxial.print(std::cout);
     uniaxial.write_csv(run.file("uniaxial_table.csv"));

@@ -80,7 +80,7 @@ void newton_study(const RunContext& run, const Settings& settings)
     fig::LineChart history;
     history.title = "Newton on the swing (stable neo-Hookean, dt = 1/60 s): |grad E| per iteration";
     history.x_label = "Newton iteration";
-    history.y_label = "|grad E| / momentum scale";
+    history.y_label = "|grad E| / momentum scale [no unit]";
     history.log_y = true;
     {
         dynamics::Body body(swing, make_force_model("stable-neo-hookean", swing.mesh, swing.material));

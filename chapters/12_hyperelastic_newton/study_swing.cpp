@@ -90,7 +90,7 @@ void swing_study(const RunContext& run, const Settings& settings)
     pareto.y_label = "max tip error [m]";
     pareto.log_x = pareto.log_y = true;
     for (const std::string& model : force_model_names()) {
-        fig::Series series{model, {}, {}};
+        fig::Series series{model_in_words(model), {}, {}};
         for (const SwingRun& r : runs)
             if (r.model == model) {
                 series.x.push_back(r.seconds_per_step * double(r.path.times.size() - 1));
@@ -106,6 +106,7 @@ void swing_study(const RunContext& run, const Settings& settings)
     fig::RenderOptions view;
     view.title = "Stable neo-Hookean cantilever, backward Euler by Newton";
     view.field = "displacement";
+    view.unit = "m";
     view.view_direction = {0.0, 1.0, -0.2};
     view.view_up = {0.0, 0.0, 1.0};
     view.height = 560;

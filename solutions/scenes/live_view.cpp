@@ -3,6 +3,7 @@
 
 #include "common/error.hpp"
 #include "common/interrupt.hpp"
+#include "common/motion.hpp"
 
 #include <array>
 #include <chrono>
@@ -11,16 +12,28 @@
 
 namespace fem::scenes {
 
+namespace {
+
+/// The unit of a frame field (scene_file.hpp's OutputSpec::fields), for the colour bar.
+std::string unit_of(const std::string& field)
+{
+    return field == "displacement" ? "m" : field == "velocity" ? "m/s" : field == "von Mises stress" ? "Pa" : "";
+}
+
+}  // namespace
+
 fig::RenderOptions frame_view(const SceneSpec& scene)
 {
     const OutputSpec& out = scene.output;
     fig::RenderOptions view;
     view.title = scene.title;
     view.field = out.colour;
+    view.unit = unit_of(out.colour);
     view.view_direction = {out.view_direction.x(), out.view_direction.y(), out.view_direction.z()};
     view.view_up = {out.view_up.x(), out.view_up.y(), out.view_up.z()};
     view.width = out.width;
     view.height = out.height;
+    view.scale = 1;  // the scene file's pixels: the live window must fit the screen and match the PNGs
     view.frame_bounds = out.frame_box;
     view.range = out.colour_range;
     return view;
@@ -28,10 +41,7 @@ fig::RenderOptions frame_view(const SceneSpec& scene)
 
 std::string frame_title(const SceneSpec& scene, double time)
 {
-    // As io::MotionRecorder::render_png_frames titles a frame.
-    const double warp = scene.output.warp;
-    const std::string scale = warp == 1.0 ? std::string() : str(" (displacement x ", warp, ")");
-    return str(scene.title, scale, ", t = ", time, " s");
+    return io::frame_title(scene.title, time, scene.output.warp);  // as the PNG frames are titled
 }
 
 // --- LiveView -------------------------------------------------------------------------------------
@@ -54,9 +64,12 @@ void LiveView::frame(const io::MeshData& frame, int step, double time)
     const auto draw = [&] {
         fig::RenderOptions view = frame_view(scene_);
         view.field = fields_[field_];
+        view.unit = unit_of(view.field);
         if (field_ != 0)
             view.range.reset();  // the fixed range belongs to the scene's colour field
         view.title = frame_title(scene_, time);
+        if (scene_.output.warp != 1.0)
+            view.outline = frame;  // the rest shape, as the PNG frames draw it (its points are at rest)
         if (!view.frame_bounds) {  // no box fixed: the rest shape, grown by half its size each way
             std::array<double, 6> box{};
             for (int axis = 0; axis < 3; ++axis) {

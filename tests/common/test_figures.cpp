@@ -11,8 +11,10 @@
 #include <vtkPNGReader.h>
 #include <vtkPointData.h>
 
+#include <cctype>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <set>
 
 namespace {
@@ -52,6 +54,21 @@ PngSummary read_png(const std::filesystem::path& path)
     return summary;
 }
 
+/// The figure-code version a PNG's "fem-figure-version" text chunk holds, or -1 without one.
+int figure_version(const std::filesystem::path& path)
+{
+    std::ifstream file(path, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+    const std::string key = std::string("tEXt") + fem::fig::figure_version_key + '\0';
+    const std::size_t at = bytes.find(key);
+    if (at == std::string::npos)
+        return -1;
+    std::size_t end = at + key.size();
+    while (end < bytes.size() && std::isdigit(static_cast<unsigned char>(bytes[end])))
+        ++end;
+    return end > at + key.size() ? std::stoi(bytes.substr(at + key.size(), end - at - key.size())) : -1;
+}
+
 }  // namespace
 
 TEST_CASE("a log-log chart is saved as CSV always and as PNG when a display exists", "[common][figures]")
@@ -77,8 +94,13 @@ TEST_CASE("a log-log chart is saved as CSV always and as PNG when a display exis
     CHECK(std::filesystem::exists(dir / "errors.png") == drew);
     if (drew) {
         const auto png = read_png(dir / "errors.png");
-        CHECK(png.width == chart.width);
-        CHECK(png.height == chart.height);
+        CHECK(png.width == chart.width * fem::fig::pixel_scale);  // slide resolution
+        CHECK(png.height == chart.height * fem::fig::pixel_scale);
+        CHECK(figure_version(dir / "errors.png") == fem::fig::figure_code_version);
+        std::ifstream svg(dir / "errors.svg");  // the vector twin, with the series' names as text
+        const std::string text((std::istreambuf_iterator<char>(svg)), std::istreambuf_iterator<char>());
+        CHECK(text.find("</svg>") != std::string::npos);
+        CHECK(text.find("forward") != std::string::npos);
         CHECK(png.colours > 20);  // lines, labels and legend, not a blank canvas
         CHECK(png.marked_edge_pixels == 0);  // no text runs into the window's edge and is cut there
     }
@@ -119,7 +141,8 @@ TEST_CASE("a mesh coloured by a field renders with its scalar bar", "[common][fi
     CHECK(drew == fem::fig::display_available());
     if (drew) {
         const auto png = read_png(dir / "square.png");
-        CHECK(png.width == options.width);
+        CHECK(png.width == options.width * options.scale);
+        CHECK(figure_version(dir / "square.png") == fem::fig::figure_code_version);
         CHECK(png.colours > 50);  // a colour ramp, not a flat fill
     }
     options.field = "no_such_field";

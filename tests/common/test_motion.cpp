@@ -57,6 +57,31 @@ TEST_CASE("motion recorder: a .pvd of rest shapes with displacement, PNG frames 
     CHECK_THROWS_AS(recorder.render_png_frames(dir / "tet", options, std::nan("")), fem::Error);
 }
 
+TEST_CASE("motion recorder: the range and the exaggeration cover every frame, not only the kept ones", "[common][vtk]")
+{
+    const auto dir = fem::test::fresh_output_dir("motion_range");
+    fem::io::MotionRecorder recorder(dir / "tet.pvd", 3);  // keeps frames 0 and 3 of 0..4
+    for (int k = 0; k <= 4; ++k)
+        recorder.add(0.5 * k, moving_tet(0.5 * k));
+    // Frame 4 (t = 2) is not kept for the PNGs but holds the largest stress (20) and |u| (0.2).
+    CHECK(recorder.field_range("stress").first == 0.0);
+    CHECK(recorder.field_range("stress").second == Approx(20.0));
+    CHECK(recorder.field_range("displacement").second == Approx(0.2));
+    CHECK_THROWS_AS(recorder.field_range("no such field"), fem::Error);
+    // The rest tet's diagonal is √3: a quarter of it over 0.2 is 2.17, rounded down to 2.
+    CHECK(recorder.visible_warp() == 2.0);
+    CHECK(recorder.visible_warp(0.01) == 1.0);  // already visible: never shrunk below true scale
+    CHECK(recorder.visible_warp(2.0) == 10.0);  // 17.3 rounded down to 1, 2 or 5 times a power of ten
+}
+
+TEST_CASE("motion frame titles: the time rounded to 0.01 s, the exaggeration on a line of its own", "[common][vtk]")
+{
+    CHECK(fem::io::frame_title("beam", 2.0 / 3.0, 1.0) == "beam, t = 0.67 s");
+    CHECK(fem::io::frame_title("beam", 0.5, 1.0) == "beam, t = 0.5 s");
+    CHECK(fem::io::frame_title("beam", 0.0, 1.0) == "beam, t = 0 s");
+    CHECK(fem::io::frame_title("beam", 1.0, 5.0) == "beam, t = 1 s\ndisplacement drawn \u00D75 (grey: the body at rest)");
+}
+
 TEST_CASE("motion recorder: a frame without displacement is refused and nothing is written", "[common][vtk]")
 {
     const auto dir = fem::test::fresh_output_dir("motion_bad");
