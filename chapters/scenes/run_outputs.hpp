@@ -38,8 +38,15 @@ private:
     Table table_;
 };
 
-/// A video <stem>.mp4 or .gif of the PNG frames <stem>_NNNN.png (ffmpeg, at output.frame_rate);
-/// one line instead when ffmpeg is missing or fails (the frames are there either way).
+/// A video <stem>.mp4 or .gif of the PNG frames <stem>_NNNN.png (ffmpeg), one line instead when
+/// ffmpeg is missing or fails (the frames are there either way). A lecturer talks over it, so it
+/// lasts at least min_video_seconds: a shorter motion plays in slow motion (the frames at
+/// frame_count / min_video_seconds per second instead of output.frame_rate; the printed line says
+/// by how much). An MP4 is 1280×720 (16:9), each frame scaled to fit on white.
+void make_video(const RunContext& run, const std::string& stem, const OutputSpec& output);
+
+/// The shortest video make_video writes [s].
+inline constexpr double min_video_seconds = 5.0;
 void make_video(const RunContext& run, const std::string& stem, const OutputSpec& output);
 
 /// A one-line progress bar on stderr (only when it is a terminal): done, time left, steps per

@@ -6,6 +6,7 @@
 #include "common/figures.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
@@ -142,9 +143,22 @@ void make_video(const RunContext& run, const std::string& stem, const OutputSpec
     }
     const std::filesystem::path input = run.file(stem + "_%04d.png");
     const std::filesystem::path video = run.file(stem + "." + output.video);
-    const std::string filter = output.video == "mp4" ? "-pix_fmt yuv420p -vf 'scale=trunc(iw/2)*2:trunc(ih/2)*2'"
-                                                     : "-vf 'scale=iw/2:-1:flags=lanczos'";
-    const std::string command = str("ffmpeg -loglevel error -nostdin -y -framerate ", output.frame_rate, " -i '",
+    const auto frame_exists = [&](int k) {
+        char suffix[32];
+        std::snprintf(suffix, sizeof suffix, "_%04d.png", k);
+        return std::filesystem::exists(run.file(stem + suffix));
+    };
+    int frames = 0;
+    while (frame_exists(frames))
+        ++frames;
+    // Slow motion when the frames at their own rate would last less than min_video_seconds.
+    const double rate = frames > 0 ? std::min(output.frame_rate, frames / min_video_seconds) : output.frame_rate;
+    const std::string filter =
+        output.video == "mp4"
+            ? "-pix_fmt yuv420p -r 30 -vf 'scale=1280:720:force_original_aspect_ratio=decrease,"
+              "pad=1280:720:(ow-iw)/2:(oh-ih)/2:color=white'"
+            : "-vf 'scale=iw/2:-1:flags=lanczos'";
+    const std::string command = str("ffmpeg -loglevel error -nostdin -y -framerate ", rate, " -i '",
                                     input.string(), "' ", filter, " '", video.string(), "' >/dev/null 2>&1");
     if (std::system(command.c_str()) != 0) {
         // The frames are there; a failed video costs the run nothing else.
@@ -152,7 +166,11 @@ void make_video(const RunContext& run, const std::string& stem, const OutputSpec
         std::filesystem::remove(video);
         return;
     }
-    std::cout << "video: " << video.filename().string() << '\n';
+    std::cout << "video: " << video.filename().string() << " (" << frames << " frames, "
+              << std::lround(10.0 * frames / rate) / 10.0 << " s";
+    if (rate < output.frame_rate)
+        std::cout << ", slow motion x" << std::lround(10.0 * output.frame_rate / rate) / 10.0;
+    std::cout << ")\n";
 }
 
 Progress::Progress(int steps, bool enabled) : steps_(steps), enabled_(enabled && ::isatty(STDERR_FILENO)) {}
