@@ -548,6 +548,12 @@ void check_memory(const Fields& fields, const toml::node& node, const std::strin
     source.estimated_bytes += need.bytes;
 }
 
+/// A body's size: the longest edge of its vertices' bounding box [m].
+double body_size(const TetMesh& mesh)
+{
+    return (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).maxCoeff();
+}
+
 TetMesh build_mesh(const Fields& fields, const std::filesystem::path& scene_file, MeshSpec& spec)
 {
     const bool file = fields.has("file"), generator = fields.has("generator");
@@ -642,7 +648,7 @@ TetMesh build_mesh(const Fields& fields, const std::filesystem::path& scene_file
     // The body's size within what the arithmetic holds: a tet's volume is a product of three edges,
     // its stiffness divides by their squares, so edges of 1e±103 m and beyond leave a double's range
     // (a 1e300 m box read as "zero volume"). The course's bodies are millimetres to metres.
-    const double extent = (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).maxCoeff();
+    const double extent = body_size(mesh);
     if (!(extent >= smallest_body_extent && extent <= largest_body_extent)) {
         const std::string key = generator ? "size" : (fields.has("scale") ? "scale" : "file");
         fields.fail(fields.has(key) ? *fields.get(key) : *fields.get(file ? "file" : "generator"), key,
@@ -710,7 +716,7 @@ BodySpec read_body(const toml::table& table, const std::string& name, const Sour
     body.initial_velocity = fields.vector("initial_velocity", Eigen::Vector3d::Zero());
     // A body that moves farther than its own size in one step leaves the pins' neighbours strained
     // beyond any model's range at the first step (1e6 m/s read as "not positive definite").
-    const double extent = (body.mesh.V.colwise().maxCoeff() - body.mesh.V.colwise().minCoeff()).maxCoeff();
+    const double extent = body_size(body.mesh);
     if (body.initial_velocity.norm() * time_step > extent)
         fields.fail(*fields.get("initial_velocity"), "initial_velocity",
                     str("moves the body ", body.initial_velocity.norm() * time_step, " m in one step of ", time_step,
