@@ -91,6 +91,14 @@ public:
     /// The smallest d_o(x_v) over surface vertices and obstacles at the step's end time [m].
     double smallest_distance(const Eigen::VectorXd& u) const;
 
+    /// Whether the step from u at time t to u_end at t_end (3n each) is out of contact: every surface
+    /// vertex is at d ≥ d̂ from every obstacle at its start (the obstacle at t and at t_end) and at its
+    /// end (at t_end), and no straight path x_v + s (x_v⁺ − x_v), s ∈ [0, 1], meets an obstacle held
+    /// at t_end. Then P and ∇P are zero at u_end and no friction pair forms at u: the step solved
+    /// without the potential solves it with the potential too (the scenes runner's rule, docs/scenes.md#obstacles).
+    /// fem::Error on the sizes.
+    bool out_of_contact(const Eigen::VectorXd& u, double time, const Eigen::VectorXd& u_end, double end_time) const;
+
     /// Lags the next step's friction at u (3n) instead of the step's start: λ and T of each pair
     /// from the vertex at u (the obstacles at the step's end), the sticking point still x_vᵗ + Δt w_o.
     /// Used once, by the next begin_step (step_with_friction_updates). fem::Error on u's size.

@@ -7,6 +7,7 @@
 //     built by chapter 12's factory on first use; model_auto.hpp),
 //   - an integrator that follows it (chapter 10's θ-step for linear and corotational, chapter 12's
 //     Newton backward Euler for the hyperelastic models; each made by chapter 12's factory),
+//   - with obstacles, contact in the steps that need it (ContactIntegrator: scene_contact.hpp),
 //   - the scene's step hook (SceneConditions: loads, moving pins, auto's level; scene_conditions.hpp),
 // and steps the bodies together, one step each in turn. Chapter 10's loop books the energy the
 // hook and the moving pins put in, the damping and the integrator's own dissipation, and fails on
@@ -49,6 +50,8 @@ struct RunResult {
     double seconds = 0.0;              ///< wall time of the steps (outputs excluded)
     int newton_iterations = 0;         ///< summed over steps and bodies
     std::vector<std::vector<Segment>> segments;  ///< per body
+    /// per body: the steps that needed contact (scene_contact.hpp; 0 without obstacles)
+    std::vector<int> contact_steps;
     /// per body: positions x (#V×3) at each frame (only when RunOptions::keep_positions)
     std::vector<std::vector<MatrixX3d>> frames;
     /// per body: chapter 10's record of every step (step 0 first): energies, work in, dissipation

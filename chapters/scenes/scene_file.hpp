@@ -12,6 +12,8 @@
 // error, never ignored. --set key=value and the scene's own [quick] table edit the file's tree
 // before it is read, so an override is checked like the file itself.
 
+#include "14_contact/obstacles.hpp"
+
 #include "10_linear_dynamics/body.hpp"
 
 #include "common/mesh.hpp"
@@ -24,6 +26,7 @@
 
 #include <filesystem>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -145,6 +148,29 @@ struct SkinSpec {
     std::string body;                   ///< the body that carries it
 };
 
+/// A rigid obstacle every body must stay out of (chapter 14): a half-space (a floor, a slope), a
+/// sphere or a box, fixed or moving with a constant velocity, with Coulomb friction μ against every
+/// body. docs/scenes.md#obstacles
+struct ObstacleSpec {
+    enum class Kind { half_space, sphere, box };
+    Kind kind = Kind::half_space;
+    Eigen::Vector3d point = Eigen::Vector3d::Zero();    ///< half-space: a point on its plane [m]
+    Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< half-space: its outward normal (unit)
+    Eigen::Vector3d center = Eigen::Vector3d::Zero();   ///< sphere, box: the centre [m]
+    double radius = 1.0;                                ///< sphere [m]
+    Eigen::Vector3d size = Eigen::Vector3d::Ones();     ///< box: edge lengths along its own axes [m]
+    Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();    ///< box: its axes are the world's turned about this (unit)
+    double angle = 0.0;                                 ///< box: … by this angle [rad]
+    Eigen::Vector3d velocity = Eigen::Vector3d::Zero(); ///< w [m/s]; zero: fixed
+    double friction = 0.0;                              ///< Coulomb's μ ≥ 0
+};
+
+/// The constants of contact a scene may set (chapter 14's ContactOptions). docs/scenes.md#obstacles
+struct ContactSpec {
+    double activation_distance = 1e-3;  ///< d̂ [m]: the barrier acts where a vertex is closer than this
+    double friction_velocity = 1e-3;    ///< ε_v [m/s]: slower tangential motion sticks
+};
+
 /// A whole scene, as read from its file.
 struct SceneSpec {
     std::filesystem::path file;
@@ -159,6 +185,8 @@ struct SceneSpec {
     AutoThresholds thresholds;
     OutputSpec output;
     std::optional<SkinSpec> skin;
+    std::vector<ObstacleSpec> obstacles;  ///< none: the bodies float in empty space (no contact)
+    ContactSpec contact;
 };
 
 /// The deepest nesting a scene file (or a --set value) may have: tables of headers and dotted
@@ -219,6 +247,10 @@ std::vector<std::filesystem::path> input_files(const SceneSpec& scene);
 /// Chapter 10's Scene of one body of a scene: its mesh, material, pinned vertices, damping and mass,
 /// the scene's gravity, Δt and duration.
 dynamics::Scene dynamics_scene(const SceneSpec& scene, const BodySpec& body);
+
+/// Chapter 14's obstacle of a spec: HalfSpace(point, normal), Sphere(center, radius) or
+/// Box(center, size/2, R) with R the rotation by angle about axis; each with the spec's μ and velocity.
+std::shared_ptr<const contact::Obstacle> make_obstacle(const ObstacleSpec& spec);
 
 /// The vertices of mesh a selector selects, ascending. fem::Error (naming selector.where) if none.
 std::vector<int> select_vertices(const TetMesh& mesh, const Selector& selector);

@@ -99,6 +99,23 @@ double ContactPotential::smallest_distance(const Eigen::VectorXd& u) const
     return smallest;
 }
 
+bool ContactPotential::out_of_contact(const Eigen::VectorXd& u, double time, const Eigen::VectorXd& u_end,
+                                      double end_time) const
+{
+    if (u.size() != 3 * rest_.rows() || u_end.size() != u.size())
+        throw Error(str("contact: out_of_contact needs u and u_end with 3n = ", 3 * rest_.rows(), " entries, got ",
+                        u.size(), " and ", u_end.size()));
+    const double reach = options_.activation_distance;
+    for (int v : surface_) {
+        const Eigen::Vector3d x = position(u, v), x_end = position(u_end, v);
+        for (const auto& obstacle : obstacles_)
+            if (obstacle->distance(x, time) < reach || obstacle->distance(x, end_time) < reach ||
+                obstacle->distance(x_end, end_time) < reach || obstacle->time_of_impact(x, x_end - x, end_time) <= 1.0)
+                return false;
+    }
+    return true;
+}
+
 void ContactPotential::begin_step(dynamics::Body& body, const dynamics::State& state, double time_step)
 {
     require_positive(time_step, "time step dt [s]");

@@ -2,6 +2,7 @@
 #include "scenes/runner.hpp"
 
 #include "scenes/run_outputs.hpp"
+#include "scenes/scene_contact.hpp"
 #include "scenes/scene_conditions.hpp"
 
 #include "12_hyperelastic_newton/force_models.hpp"
@@ -67,6 +68,7 @@ struct BodyRun {
     SceneForces* forces = nullptr;  // owned by body
     std::unique_ptr<dynamics::Body> body;
     std::unique_ptr<LevelIntegrator> integrator;
+    std::unique_ptr<ContactIntegrator> contact;  // null: the scene has no obstacles
     std::unique_ptr<dynamics::Simulation> simulation;
     std::vector<Segment> segments;
     std::vector<dynamics::StepRecord> records;
@@ -74,7 +76,8 @@ struct BodyRun {
     const dynamics::State& state() const { return simulation->state(); }
 };
 
-BodyRun start_body(const BodySpec& spec, const SceneSpec& scene, const std::string& model)
+BodyRun start_body(const BodySpec& spec, const SceneSpec& scene, const std::string& model,
+                   const std::vector<std::shared_ptr<const contact::Obstacle>>& obstacles)
 {
     BodyRun b;
     b.spec = &spec;
@@ -85,7 +88,14 @@ BodyRun start_body(const BodySpec& spec, const SceneSpec& scene, const std::stri
                                                 automatic ? Level::linear : level_of(chosen));
     b.forces = forces.get();
     b.body = std::make_unique<dynamics::Body>(dynamics_scene(scene, spec), std::move(forces));
-    SceneConditions conditions(spec, scene, b.forces, automatic);
+    if (!obstacles.empty() && chosen == "linear")
+        throw Error(str("body '", spec.name, "': model linear cannot meet obstacles (its energy of a body at rest ",
+                        "far from where it started is round-off; docs/scenes.md#obstacles): use auto, corotational or a ",
+                        "hyperelastic model"));
+    b.integrator = std::make_unique<LevelIntegrator>(*b.forces, scene);
+    if (!obstacles.empty())
+        b.contact = std::make_unique<ContactIntegrator>(*b.integrator, *b.body, obstacles, scene);
+    SceneConditions conditions(spec, scene, b.forces, automatic, b.contact.get());
     b.body->set_applied_loads(conditions.initial_loads());
     Eigen::VectorXd v0 = Eigen::VectorXd::Zero(3 * spec.mesh.V.rows());
     if (spec.initial_velocity.norm() > 0.0) {
@@ -94,8 +104,8 @@ BodyRun start_body(const BodySpec& spec, const SceneSpec& scene, const std::stri
         for (int v : spec.pinned)
             v0.segment<3>(3 * v).setZero();  // pins start at rest: their motions ramp up from zero speed
     }
-    b.integrator = std::make_unique<LevelIntegrator>(*b.forces, scene);
-    b.simulation = std::make_unique<dynamics::Simulation>(*b.body, *b.integrator, dynamics::initial_state(*b.body, {}, v0));
+    dynamics::Integrator& integrator = b.contact ? static_cast<dynamics::Integrator&>(*b.contact) : *b.integrator;
+    b.simulation = std::make_unique<dynamics::Simulation>(*b.body, integrator, dynamics::initial_state(*b.body, {}, v0));
     b.simulation->set_before_step(std::move(conditions));
     b.segments.push_back({0, 0, b.forces->level(), b.forces->level_model()});
     return b;
@@ -142,8 +152,9 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
     if (scene.skin && !skin && run != nullptr && scene.output.pvd)
         skin = make_skin_observer(*scene.skin, scene.bodies[skinned]);
     std::vector<BodyRun> bodies;
+    const auto obstacles = scene_obstacles(scene);
     for (const BodySpec& spec : scene.bodies)
-        bodies.push_back(start_body(spec, scene, options.model));
+        bodies.push_back(start_body(spec, scene, options.model, obstacles));
 
     const int steps = dynamics::step_count(scene.duration, scene.time_step);
     const int frame_every = steps_per_frame(scene);
@@ -208,12 +219,15 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
         progress.finish();
     for (BodyRun& b : bodies) {
         result.segments.push_back(b.segments);
+        result.contact_steps.push_back(b.contact ? b.contact->contact_steps() : 0);
         result.records.push_back(std::move(b.records));
     }
 
     if (options.print_models)
         for (const BodyRun& b : bodies)
-            std::cout << "body " << b.spec->name << ": " << describe_segments(b.segments) << " (steps per model)\n";
+            std::cout << "body " << b.spec->name << ": " << describe_segments(b.segments) << " (steps per model)"
+                      << (b.contact ? str("; contact in ", b.contact->contact_steps(), " of ", result.steps, " steps") : "")
+                      << "\n";
     if (run == nullptr)
         return result;
     if (result.interrupted)

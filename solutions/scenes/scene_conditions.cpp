@@ -1,12 +1,15 @@
 // What a scene changes between steps: loads, moving pins, auto's model. docs/scenes.md#the-runner
 #include "scenes/scene_conditions.hpp"
 
+#include "scenes/scene_contact.hpp"
+
 #include "13_skinning/skinning.hpp"
 
 #include "common/error.hpp"
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -52,8 +55,9 @@ Eigen::VectorXd applied_loads(const BodySpec& body, const MatrixX3i& boundary, d
     return f;
 }
 
-SceneConditions::SceneConditions(const BodySpec& body, const SceneSpec& scene, SceneForces* forces, bool automatic)
-    : body_(&body), scene_(&scene), forces_(forces), automatic_(automatic && forces != nullptr)
+SceneConditions::SceneConditions(const BodySpec& body, const SceneSpec& scene, SceneForces* forces, bool automatic,
+                                 const ContactIntegrator* contact)
+    : body_(&body), scene_(&scene), forces_(forces), automatic_(automatic && forces != nullptr), contact_(contact)
 {
     for (const Pin& pin : body.pins)
         pins_move_ = pins_move_ || pin.motion.kind != Motion::Kind::fixed;
@@ -96,8 +100,10 @@ bool SceneConditions::operator()(dynamics::Body& body, const dynamics::State& st
         body.set_pin_velocity(velocity);
     }
     if (automatic_) {
-        const Level next = choose_level(deformation_measures(body_->mesh, body.positions(state.u), scene_->thresholds),
-                                        forces_->level(), scene_->thresholds);
+        Level next = choose_level(deformation_measures(body_->mesh, body.positions(state.u), scene_->thresholds),
+                                  forces_->level(), scene_->thresholds);
+        if (contact_ != nullptr && contact_->last_contact())
+            next = std::max(next, Level::corotational);
         if (next != forces_->level()) {
             forces_->set_level(next);
             changed = true;

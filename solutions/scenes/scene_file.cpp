@@ -479,6 +479,58 @@ Motion read_motion(const Fields& fields, double duration)
     return m;
 }
 
+/// One [[obstacle]]: its type's fields only (the others are refused, naming the type they belong to),
+/// μ, and a velocity that moves it (towards a vertex) less than d̂ per step: faster, it could reach
+/// a vertex from beyond d̂ within one step, where no barrier force has yet pushed back.
+ObstacleSpec read_obstacle(const toml::table& table, const std::string& name, const Source& source,
+                           double time_step, double activation_distance)
+{
+    const std::vector<std::string> types{"half-space", "sphere", "box"};
+    const std::vector<std::vector<std::string>> own{{"point", "normal"}, {"center", "radius"}, {"center", "size", "axis", "angle"}};
+    const Fields fields(table, name, source, {"type", "point", "normal", "center", "radius", "size", "axis", "angle",
+                                              "velocity", "friction"});
+    if (!fields.has("type"))
+        fields.missing("type", "one of half-space, sphere, box");
+    const std::string type = fields.text("type", "", types);
+    const std::size_t index = static_cast<std::size_t>(std::find(types.begin(), types.end(), type) - types.begin());
+    for (std::size_t other = 0; other < types.size(); ++other)
+        for (const std::string& key : own[other])
+            if (fields.has(key) && std::find(own[index].begin(), own[index].end(), key) == own[index].end())
+                fields.fail(*fields.get(key), key, str("belongs to type = \"", types[other], "\", not to type = \"", type, "\""));
+    ObstacleSpec o;
+    o.kind = static_cast<ObstacleSpec::Kind>(index);
+    if (o.kind == ObstacleSpec::Kind::half_space) {
+        o.point = fields.vector("point", o.point);
+        o.normal = fields.vector("normal", o.normal, true).normalized();
+    } else {
+        o.center = fields.vector("center", o.center);
+    }
+    if (o.kind == ObstacleSpec::Kind::sphere) {
+        if (!fields.has("radius"))
+            fields.missing("radius", "a sphere needs radius = r (m)");
+        o.radius = fields.positive("radius", o.radius);
+    }
+    if (o.kind == ObstacleSpec::Kind::box) {
+        if (!fields.has("size"))
+            fields.missing("size", "a box needs size = [x, y, z] (its edge lengths, m)");
+        o.size = fields.vector("size", o.size);
+        if ((o.size.array() <= 0.0).any())
+            fields.fail(*fields.get("size"), "size", "must be three edge lengths > 0 (m)");
+        o.axis = fields.vector("axis", o.axis, true).normalized();
+        o.angle = fields.finite("angle", 0.0) * std::acos(-1.0) / 180.0;
+    }
+    o.friction = fields.number("friction", 0.0, [](double mu) { return mu >= 0.0 && mu <= 10.0; }, "a number in [0, 10]");
+    o.velocity = fields.vector("velocity", o.velocity);
+    // A half-space moves towards the bodies only along its normal; a sphere or a box in every direction.
+    const double approach = o.kind == ObstacleSpec::Kind::half_space ? std::abs(o.normal.dot(o.velocity)) : o.velocity.norm();
+    if (approach * time_step >= activation_distance)
+        fields.fail(*fields.get("velocity"), "velocity",
+                    str("moves the obstacle ", approach * time_step, " m towards the bodies in one step of ", time_step,
+                        " s, not less than contact.activation_distance = ", activation_distance,
+                        " m; allowed: a speed below ", activation_distance / time_step, " m/s (or a smaller time.step)"));
+    return o;
+}
+
 const std::vector<std::string> selector_keys{"box", "plane", "vertices"};
 
 std::vector<std::string> with(std::vector<std::string> keys, const std::vector<std::string>& more)
@@ -924,7 +976,8 @@ SceneSpec read_scene(const std::filesystem::path& path, const std::vector<std::s
         source.overrides.emplace_back(setting.substr(0, setting.find('=')), "--set " + setting);
     }
 
-    const Fields top(root, "", source, {"title", "gravity", "body", "time", "solver", "auto", "output", "skin", "quick"});
+    const Fields top(root, "", source, {"title", "gravity", "body", "time", "solver", "auto", "output", "skin", "obstacle",
+                                        "contact", "quick"});
     SceneSpec scene;
     scene.file = path;
     scene.title = top.text("title", path.stem().string());
@@ -1031,6 +1084,37 @@ SceneSpec read_scene(const std::filesystem::path& path, const std::vector<std::s
             top.fail(*items.get(i), name + ".name", str("'", scene.bodies.back().name, "' is the name of an earlier body"));
     }
 
+    if (const toml::table* contact_table = top.subtable("contact")) {
+        const Fields c(*contact_table, "contact", source, {"activation_distance", "friction_velocity"});
+        scene.contact.activation_distance = c.positive("activation_distance", scene.contact.activation_distance);
+        scene.contact.friction_velocity = c.positive("friction_velocity", scene.contact.friction_velocity);
+    }
+    if (const toml::node* obstacles = top.get("obstacle")) {
+        if (!obstacles->is_array_of_tables())
+            top.fail(*obstacles, "obstacle", str("must be an array of tables ([[obstacle]]), got ", Fields::type_name(*obstacles)));
+        const toml::array& list = *obstacles->as_array();
+        for (std::size_t i = 0; i < list.size(); ++i) {
+            const std::string name = str("obstacle[", i, "]");
+            scene.obstacles.push_back(read_obstacle(table_in_array(top, *list.get(i), "obstacle"), name, source,
+                                                    scene.time_step, scene.contact.activation_distance));
+            // No vertex may start inside: its barrier energy would be infinite.
+            const auto obstacle = make_obstacle(scene.obstacles.back());
+            for (const BodySpec& body : scene.bodies)
+                for (Eigen::Index v = 0; v < body.mesh.V.rows(); ++v) {
+                    const double d = obstacle->distance(body.mesh.V.row(v).transpose(), 0.0);
+                    if (!(d > 0.0))
+                        top.fail(*list.get(i), name, str("body '", body.name, "' starts inside it (vertex ", v, " at ",
+                                                         d, " m from its surface): move the body or the obstacle"));
+                }
+        }
+        if (scene.integrator != "backward-euler") {
+            const toml::table& time_table = *top.subtable("time");  // where a non-default integrator was set
+            Fields(time_table, "time", source, {})
+                .fail(*time_table.get("integrator"), "integrator",
+                      str("'", scene.integrator, "' is not for a scene with obstacles, whose contact steps are ",
+                          "Newton backward Euler (chapter 14): use backward-euler"));
+        }
+    }
     if (const toml::table* skin_table = top.subtable("skin")) {
         const Fields s(*skin_table, "skin", source, {"file", "body"});
         SkinSpec skin;
@@ -1093,6 +1177,20 @@ dynamics::Scene dynamics_scene(const SceneSpec& scene, const BodySpec& body)
     return dynamics::Scene{.mesh = body.mesh, .material = body.material, .pinned = body.pinned,
                            .gravity = scene.gravity, .damping = body.damping, .mass = body.mass,
                            .time_step = scene.time_step, .duration = scene.duration};
+}
+
+std::shared_ptr<const contact::Obstacle> make_obstacle(const ObstacleSpec& spec)
+{
+    switch (spec.kind) {
+    case ObstacleSpec::Kind::half_space:
+        return std::make_shared<contact::HalfSpace>(spec.point, spec.normal, spec.friction, spec.velocity);
+    case ObstacleSpec::Kind::sphere:
+        return std::make_shared<contact::Sphere>(spec.center, spec.radius, spec.friction, spec.velocity);
+    case ObstacleSpec::Kind::box:
+        break;
+    }
+    const Eigen::Matrix3d rotation = Eigen::AngleAxisd(spec.angle, spec.axis).toRotationMatrix();
+    return std::make_shared<contact::Box>(spec.center, 0.5 * spec.size, rotation, spec.friction, spec.velocity);
 }
 
 std::vector<int> select_vertices(const TetMesh& mesh, const Selector& selector)

@@ -1,0 +1,60 @@
+#pragma once
+// The scenes capstone: a body of a scene with obstacles (chapter 14). docs/scenes.md#obstacles
+//
+// Contact is one more thing a scene may need, and like every other it is paid for only in the steps
+// that need it: each step is first taken by the body's own integrator (its model's, as without
+// obstacles) and kept when it is out of contact (ContactPotential::out_of_contact: every surface
+// vertex at least d̂ from every obstacle at the step's start and end, no path crossing one), where
+// the barrier and friction are zero and the step is the contact step's answer. Otherwise the step is
+// taken again from its start by chapter 12's Newton backward Euler with chapter 14's contact
+// potential (barrier, lagged friction, the line search cut by the continuous collision check), on
+// the force model of the body's current level.
+
+#include "scenes/scene_file.hpp"
+
+#include "14_contact/contact.hpp"
+
+#include "12_hyperelastic_newton/newton.hpp"
+
+#include "10_linear_dynamics/body.hpp"
+#include "10_linear_dynamics/time_integration.hpp"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace fem::scenes {
+
+/// Chapter 14's obstacles of a scene (make_obstacle of each spec).
+std::vector<std::shared_ptr<const contact::Obstacle>> scene_obstacles(const SceneSpec& scene);
+
+/// A body's integrator in a scene with obstacles (header comment): its own integrator while out of
+/// contact, Newton backward Euler with the contact potential in the steps that need it.
+class ContactIntegrator final : public dynamics::Integrator {
+public:
+    /// own: the body's integrator without contact (backward Euler; not owned, it must outlive this).
+    /// The contact potential is built for body against obstacles with the scene's d̂ and ε_v (κ
+    /// adaptive), Newton with the scene's solver and tolerance. fem::Error as ContactPotential.
+    ContactIntegrator(dynamics::Integrator& own, const dynamics::Body& body,
+                      std::vector<std::shared_ptr<const contact::Obstacle>> obstacles, const SceneSpec& scene);
+
+    std::string name() const override { return last_contact_ ? newton_.name() + " with contact" : own_.name(); }
+    int order() const override { return 1; }
+    /// One step from state (time t) to t + Δt (header comment). fem::Error when a step fails.
+    dynamics::StepInfo step(dynamics::Body& body, double time_step, dynamics::State& state) override;
+
+    /// The steps so far that needed contact.
+    int contact_steps() const { return contact_steps_; }
+    /// Whether the last step needed contact.
+    bool last_contact() const { return last_contact_; }
+    const contact::ContactPotential& potential() const { return *potential_; }
+
+private:
+    dynamics::Integrator& own_;
+    std::unique_ptr<contact::ContactPotential> potential_;
+    hyper::NewtonBackwardEuler newton_;
+    int contact_steps_ = 0;
+    bool last_contact_ = false;
+};
+
+}  // namespace fem::scenes

@@ -1,0 +1,62 @@
+// The scenes capstone: a body's steps with obstacles. docs/scenes.md#obstacles
+#include "scenes/scene_contact.hpp"
+
+namespace fem::scenes {
+
+std::vector<std::shared_ptr<const contact::Obstacle>> scene_obstacles(const SceneSpec& scene)
+{
+    std::vector<std::shared_ptr<const contact::Obstacle>> obstacles;
+    for (const ObstacleSpec& spec : scene.obstacles)
+        obstacles.push_back(make_obstacle(spec));
+    return obstacles;
+}
+
+namespace {
+
+hyper::NewtonOptions newton_options(const SceneSpec& scene)
+{
+    hyper::NewtonOptions options;
+    options.relative_tolerance = scene.newton_tolerance;
+    options.solver = scene.solver;
+    return options;
+}
+
+contact::ContactOptions contact_options(const SceneSpec& scene)
+{
+    contact::ContactOptions options;
+    options.activation_distance = scene.contact.activation_distance;
+    options.friction_velocity = scene.contact.friction_velocity;
+    return options;
+}
+
+}  // namespace
+
+ContactIntegrator::ContactIntegrator(dynamics::Integrator& own, const dynamics::Body& body,
+                                     std::vector<std::shared_ptr<const contact::Obstacle>> obstacles,
+                                     const SceneSpec& scene)
+    : own_(own),
+      potential_(std::make_unique<contact::ContactPotential>(body, std::move(obstacles), contact_options(scene))),
+      newton_(newton_options(scene))
+{
+    newton_.set_potential(potential_.get());
+}
+
+dynamics::StepInfo ContactIntegrator::step(dynamics::Body& body, double time_step, dynamics::State& state)
+{
+    const double end = state.time + time_step;
+    // Near an obstacle at the start already: contact at once, without trying the own step.
+    if (potential_->out_of_contact(state.u, state.time, state.u, end)) {
+        dynamics::State trial = state;
+        const dynamics::StepInfo info = own_.step(body, time_step, trial);
+        if (potential_->out_of_contact(state.u, state.time, trial.u, end)) {
+            state = std::move(trial);
+            last_contact_ = false;
+            return info;
+        }
+    }
+    last_contact_ = true;
+    ++contact_steps_;
+    return newton_.step(body, time_step, state);
+}
+
+}  // namespace fem::scenes

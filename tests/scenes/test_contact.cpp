@@ -1,0 +1,142 @@
+// Obstacles in a scene (chapter 14): the reader's fields, chapter 14's obstacles made from them, and
+// the rule that steps a body with contact only when it needs it. docs/scenes.md#obstacles
+#include "scenes/runner.hpp"
+
+#include "common/error.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+
+using namespace fem;
+using namespace fem::scenes;
+
+namespace {
+
+const std::filesystem::path gallery = FEM_SCENES_DIR;
+const std::filesystem::path output = FEM_TEST_OUTPUT_DIR;
+
+/// A 10 cm cube (2 cells) dropped from 2 cm onto the floor z = 0 (μ = 0.5), Δt = 1/100, a frame per
+/// step, model auto; obstacle lines replace the floor when given.
+std::filesystem::path drop_scene(const std::string& name, const std::string& obstacle = "")
+{
+    std::filesystem::create_directories(output);
+    const std::filesystem::path file = output / (name + ".toml");
+    std::ofstream out(file);
+    out << "[[body]]\n"
+           "name = \"block\"\n"
+           "mesh = { generator = \"box\", size = [0.1, 0.1, 0.1], cells = [2, 2, 2], translate = [0.0, 0.0, 0.02] }\n"
+           "material = { model = \"auto\", youngs_modulus = 1e5, poisson_ratio = 0.3, density = 1000.0 }\n"
+           "[[obstacle]]\n"
+        << (obstacle.empty() ? "type = \"half-space\"\nfriction = 0.5\n" : obstacle)
+        << "[time]\nstep = 0.01\nduration = 0.4\n"
+           "[output]\nframe_rate = 100\n";
+    return file;
+}
+
+double lowest(const MatrixX3d& x) { return x.col(2).minCoeff(); }
+
+}  // namespace
+
+TEST_CASE("obstacles in the scene file: each type's fields, and chapter 14's obstacle made from them", "[scenes][contact]")
+{
+    const std::filesystem::path file = drop_scene(
+        "obstacle_types", "type = \"box\"\ncenter = [0.05, 0.05, -1.0]\nsize = [4.0, 2.0, 1.0]\naxis = [0.0, 0.0, 1.0]\n"
+                          "angle = 90.0\nfriction = 0.25\nvelocity = [0.01, 0.0, 0.0]\n"
+                          "[[obstacle]]\ntype = \"sphere\"\ncenter = [0.0, 0.0, -3.0]\nradius = 0.5\n"
+                          "[[obstacle]]\ntype = \"half-space\"\npoint = [0.0, 0.0, -0.5]\nnormal = [0.0, 0.0, 2.0]\n"
+                          "[contact]\nactivation_distance = 0.002\nfriction_velocity = 0.01\n");
+    const SceneSpec scene = read_scene(file);
+    REQUIRE(scene.obstacles.size() == 3);
+    CHECK(scene.contact.activation_distance == 0.002);
+    CHECK(scene.contact.friction_velocity == 0.01);
+    const ObstacleSpec& box = scene.obstacles[0];
+    CHECK(box.kind == ObstacleSpec::Kind::box);
+    CHECK(box.angle == Approx(std::acos(-1.0) / 2.0).epsilon(1e-15));  // degrees in the file, radians read
+    CHECK(box.friction == 0.25);
+    // The box turned by 90° about z: its 4 m edge lies along y, its 2 m edge along x.
+    const auto made = make_obstacle(box);
+    CHECK(made->friction() == 0.25);
+    CHECK(made->velocity() == Eigen::Vector3d(0.01, 0.0, 0.0));
+    const Eigen::Vector3d centre(0.05, 0.05, -1.0);
+    CHECK(made->distance(centre + Eigen::Vector3d(1.5, 0.0, 0.0), 0.0) == Approx(0.5).epsilon(1e-14));
+    CHECK(made->distance(centre + Eigen::Vector3d(0.0, 1.5, 0.0), 0.0) == Approx(-0.5).epsilon(1e-14));
+    CHECK(made->distance(centre + Eigen::Vector3d(1.5, 0.0, 0.0), 10.0) == Approx(0.4).epsilon(1e-13));  // moved by 10 w
+    const auto sphere = make_obstacle(scene.obstacles[1]);
+    CHECK(sphere->distance(Eigen::Vector3d(0.0, 0.0, 0.0), 0.0) == Approx(2.5).epsilon(1e-15));
+    // The half-space's normal is normalised: d = n·(x − p) in metres.
+    CHECK(scene.obstacles[2].normal == Eigen::Vector3d::UnitZ());
+    CHECK(make_obstacle(scene.obstacles[2])->distance(Eigen::Vector3d(3.0, 1.0, 0.25), 0.0) == Approx(0.75).epsilon(1e-15));
+    // A scene without obstacles has none, and its runs meet none.
+    CHECK(read_scene(gallery / "cantilever.toml").obstacles.empty());
+}
+
+TEST_CASE("an obstacle override is checked like the file and named by its option", "[scenes][contact]")
+{
+    const std::filesystem::path file = drop_scene("obstacle_override");
+    try {
+        read_scene(file, {"obstacle.0.friction=-1"});
+        FAIL("no error");
+    } catch (const Error& e) {
+        CHECK_THAT(e.what(), Catch::Contains("--set obstacle.0.friction=-1") && Catch::Contains("obstacle[0].friction"));
+    }
+}
+
+TEST_CASE("contact only where needed: the run is the free run, bit for bit, until a vertex comes within d-hat",
+          "[scenes][contact]")
+{
+    const SceneSpec scene = read_scene(drop_scene("drop_floor"));
+    SceneSpec free = scene;
+    free.obstacles.clear();
+    const RunResult with = run_positions(scene), without = run_positions(free);
+    REQUIRE(with.frames[0].size() == without.frames[0].size());  // a frame per step, step 0 first
+    const double reach = scene.contact.activation_distance;
+    // The first step whose free end comes within d̂ of the floor (independently of the runner's rule).
+    int first = -1;
+    for (std::size_t k = 0; k < without.frames[0].size() && first < 0; ++k)
+        if (lowest(without.frames[0][k]) < reach)
+            first = static_cast<int>(k);
+    REQUIRE(first > 1);
+    for (int k = 0; k < first; ++k)
+        CHECK((with.frames[0][static_cast<std::size_t>(k)].array() == without.frames[0][static_cast<std::size_t>(k)].array()).all());
+    // From there on the block stays within d̂ (it lands and rests): every later step needs contact.
+    CHECK(with.contact_steps[0] == with.steps - first + 1);
+    CHECK(without.contact_steps[0] == 0);
+    // Never a penetration, and at the end at rest on the floor, within d̂ of it.
+    for (const MatrixX3d& x : with.frames[0])
+        CHECK(lowest(x) > 0.0);
+    CHECK(lowest(with.frames[0].back()) < reach);
+    CHECK(lowest(without.frames[0].back()) < -0.1);  // the free block fell through where the floor would be
+    // auto: linear until the first contact step, at least corotational after it.
+    for (const Segment& s : with.segments[0]) {
+        CAPTURE(s.first_step, s.last_step, s.model);
+        if (s.first_step > first)
+            CHECK(s.level != Level::linear);
+    }
+    CHECK(with.segments[0].front().level == Level::linear);
+}
+
+TEST_CASE("an obstacle no vertex comes near adds nothing: the run is the free run, bit for bit", "[scenes][contact]")
+{
+    const SceneSpec scene = read_scene(drop_scene("drop_far", "type = \"sphere\"\ncenter = [5.0, 0.0, 0.0]\nradius = 1.0\n"));
+    SceneSpec free = scene;
+    free.obstacles.clear();
+    const RunResult with = run_positions(scene), without = run_positions(free);
+    CHECK(with.contact_steps[0] == 0);
+    REQUIRE(with.frames[0].size() == without.frames[0].size());
+    for (std::size_t k = 0; k < with.frames[0].size(); ++k)
+        CHECK((with.frames[0][k].array() == without.frames[0][k].array()).all());
+}
+
+TEST_CASE("a linear body cannot meet obstacles: the run refuses it before any step", "[scenes][contact]")
+{
+    const SceneSpec scene = read_scene(drop_scene("drop_linear"), {"body.material.model=\"linear\""});
+    CHECK_THROWS_WITH(run_positions(scene), Catch::Contains("model linear cannot meet obstacles"));
+    CHECK_THROWS_WITH(run_positions(read_scene(drop_scene("drop_linear_option")), "linear"),
+                      Catch::Contains("model linear cannot meet obstacles"));
+}
