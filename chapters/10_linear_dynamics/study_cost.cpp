@@ -119,7 +119,7 @@ void cost_study(const RunContext& run, const Settings& settings)
     Table goal("SOFA's beam (1,664 vertices): our prefactored backward Euler step, exact solve, one core",
                {{"vertices", Format::integer}, {"free dofs", Format::integer}, {"factorization [s]", Format::scientific, 2},
                 {"our step [ms]", Format::fixed, 3}, {"SOFA's step (published) (ms)", Format::fixed, 1},
-                {"speed-up [measured]", Format::fixed, 1}});
+                {"published / our time (other machine, other model) [measured]", Format::fixed, 1}});
     goal.add_row({double(sofa.mesh.V.rows()), double(body.dofs().size()), first - ours, 1e3 * ours, sofa_ms,
                   sofa_ms / (1e3 * ours)});
     goal.print(std::cout);

@@ -103,7 +103,7 @@ void cost_study(const RunContext& run, const Settings& settings)
                {{"vertices", Format::integer}, {"free dofs", Format::integer}, {"Newton solver", Format::text},
                 {"Newton iterations per step", Format::fixed, 1}, {"CG iterations per step", Format::fixed, 1},
                 {"factorizations per step", Format::fixed, 2}, {"our step [s]", Format::scientific, 2},
-                {"Vega's StVK step (published) (s)", Format::fixed, 2}, {"speed-up [measured]", Format::fixed, 1}});
+                {"Vega's StVK step (published) (s)", Format::fixed, 2}, {"published / our time (other machine, StVK) [measured]", Format::fixed, 1}});
     // Why: each Newton iteration's matrix changes. Refactoring it every iteration is the plain way;
     // chapter 11's frozen factor (single precision, refreshed when CG needs more than 10
     // iterations) as CG's preconditioner, solved only as tightly as the gradient needs (inexact
