@@ -92,21 +92,6 @@ Display* shared_display()
     return display;
 }
 
-/// Returns whether PNGs can be drawn; says once per process why not.
-bool can_draw(bool figures_wanted)
-{
-    if (!figures_wanted)
-        return false;
-    if (display_available())
-        return true;
-    static bool told = false;
-    if (!told) {
-        told = true;
-        std::cout << "note: no X display, so the PNG figures were skipped (VTK files and CSVs are "
-                     "written); run under `xvfb-run -a` to get them\n";
-    }
-    return false;
-}
 
 void write_png(vtkRenderWindow* window, const std::filesystem::path& path)
 {
@@ -800,6 +785,21 @@ std::pair<vtkSmartPointer<vtkUnstructuredGrid>, bool> drawable(const io::MeshDat
 bool display_available()
 {
     return shared_display() != nullptr;
+}
+
+bool can_draw(bool figures_wanted)
+{
+    if (!figures_wanted)
+        return false;
+    if (display_available())
+        return true;
+    static bool told = false;
+    if (!told) {
+        told = true;
+        std::cout << "note: no X display, so the PNG figures were skipped (VTK files and CSVs are "
+                     "written); run under `xvfb-run -a` to get them\n";
+    }
+    return false;
 }
 
 bool save_chart(const LineChart& chart, const std::filesystem::path& stem, bool figures)

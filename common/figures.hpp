@@ -31,6 +31,11 @@ inline constexpr const char* figure_version_key = "fem-figure-version";
 /// True when an X display can be opened (probed once per process).
 bool display_available();
 
+/// True when PNGs are wanted (figures_wanted) and an X display can be opened. When they are wanted
+/// but there is no display it prints, once per process, a note saying the PNGs were skipped and
+/// how to get them (run under `xvfb-run -a`), so a missing picture is never silent.
+bool can_draw(bool figures_wanted);
+
 /// One line of a chart.
 struct Series {
     std::string name;

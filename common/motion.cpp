@@ -85,7 +85,7 @@ int MotionRecorder::render_png_frames(const std::filesystem::path& stem, const f
     std::vector<std::pair<double, MeshData>> deformed;
     for (const auto& [time, mesh] : kept_)
         deformed.emplace_back(time, warped(mesh, warp_scale));
-    if (deformed.empty() || !fig::display_available())
+    if (deformed.empty() || !fig::can_draw(true))
         return 0;
     fig::RenderOptions shared = options;
     std::array<double, 6> box{};

@@ -57,7 +57,7 @@ public:
     /// over every frame added, not only the kept ones, and the colour bar says so. The title is
     /// frame_title's; when warp_scale ≠ 1 the rest shape is drawn faint behind the body (unless
     /// options.outline is set). Returns the number of
-    /// PNGs written (0 without a display, see figures.hpp). fem::Error if the field is missing from
+    /// PNGs written (0 without a display, after can_draw's note, see figures.hpp). fem::Error if the field is missing from
     /// a frame or warp_scale is not finite.
     int render_png_frames(const std::filesystem::path& stem, const fig::RenderOptions& options,
                           double warp_scale = 1.0) const;

@@ -278,6 +278,23 @@ TEST_CASE("the live view without a display: one line says so and the run goes on
     CHECK(std::filesystem::exists(out / "hanging_cube.pvd"));
 }
 
+TEST_CASE("PNG frames without a display: one note says they were skipped, even with no charts asked for", "[scenes]")
+{
+    // The frames are the only PNGs this run wants (charts = false): before, no chart asked whether it
+    // could draw, so nothing said that the frames were skipped.
+    const std::filesystem::path out = output / "no_display_frames";
+    std::filesystem::remove_all(out);
+    const std::filesystem::path log = output / "no_display_frames.log";
+    const std::string command = "env -u DISPLAY '" FEM_SCENE_EXE "' '" + (gallery / "hanging_cube.toml").string() +
+                                "' --quick --no-progress --set output.png=true --set output.charts=false --out '" +
+                                out.string() + "' >'" + log.string() + "' 2>&1";
+    CHECK(std::system(command.c_str()) == 0);
+    const std::string printed = read_text(log);
+    CHECK(printed.find("note: no X display, so the PNG figures were skipped") != std::string::npos);
+    CHECK(std::filesystem::exists(out / "hanging_cube.pvd"));
+    CHECK_FALSE(std::filesystem::exists(out / "hanging_cube_0000.png"));
+}
+
 TEST_CASE("the video: ffmpeg makes it from the PNG frames, or one line says it is missing", "[scenes]")
 {
     if (std::getenv("DISPLAY") == nullptr) {
