@@ -86,6 +86,10 @@ public:
     /// min(1, safety × the earliest time of impact of any surface vertex's path x_v + s·Δx_v).
     double largest_safe_step(const Eigen::VectorXd& u, const Eigen::VectorXd& du) const override;
 
+    /// The barrier's part of P: Σ_v Σ_o κ b(d_o(x_v, time)) with the current step's κ [J] (+∞ when
+    /// some surface vertex has d ≤ 0). Its change over a step, with the obstacles at the step's start
+    /// and end times, is the work the obstacles did on the body (the scenes runner books it).
+    double barrier_energy(const Eigen::VectorXd& u, double time) const;
     /// The barrier's force on every vertex, −κ b'(d) ∇d summed over obstacles (3n) [N].
     Eigen::VectorXd barrier_forces(const Eigen::VectorXd& u) const;
     /// The smallest d_o(x_v) over surface vertices and obstacles at the step's end time [m].

@@ -40,7 +40,11 @@ public:
 
     std::string name() const override { return last_contact_ ? newton_.name() + " with contact" : own_.name(); }
     int order() const override { return 1; }
-    /// One step from state (time t) to t + Δt (header comment). fem::Error when a step fails.
+    /// One step from state (time t) to t + Δt (header comment). A contact step books the obstacles'
+    /// work on the body, −(B(u⁺, t + Δt) − B(uᵗ, t)) with B the step's barrier energy
+    /// (ContactPotential::barrier_energy), in StepInfo::boundary_work: chapter 10's loop counts it as
+    /// work put in, so the energy the barrier stores and gives back is not mistaken for dissipation
+    /// or divergence (friction's work stays the integrator's dissipation). fem::Error when a step fails.
     dynamics::StepInfo step(dynamics::Body& body, double time_step, dynamics::State& state) override;
 
     /// The steps so far that needed contact.

@@ -192,17 +192,25 @@ dynamics::StepInfo step_with_friction_updates(hyper::NewtonBackwardEuler& newton
     return info;
 }
 
-double ContactPotential::energy(const Eigen::VectorXd& u) const
+double ContactPotential::barrier_energy(const Eigen::VectorXd& u, double time) const
 {
     double total = 0.0;
     for (int v : surface_)
         for (const auto& obstacle : obstacles_) {
-            const double d = obstacle->distance(position(u, v), time_);
+            const double d = obstacle->distance(position(u, v), time);
             if (!(d > 0.0))
                 return infinity;
             if (d < options_.activation_distance)
                 total += stiffness_ * barrier(d, options_.activation_distance).value;
         }
+    return total;
+}
+
+double ContactPotential::energy(const Eigen::VectorXd& u) const
+{
+    double total = barrier_energy(u, time_);
+    if (!std::isfinite(total))
+        return total;
     for (const FrictionPair& pair : pairs_) {
         const double y = (pair.tangent.transpose() * (position(u, pair.vertex) - pair.start)).norm();
         total += pair.coefficient * pair.normal_force * friction_mollifier(y, friction_step_).f0;

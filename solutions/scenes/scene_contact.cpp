@@ -56,7 +56,12 @@ dynamics::StepInfo ContactIntegrator::step(dynamics::Body& body, double time_ste
     }
     last_contact_ = true;
     ++contact_steps_;
-    return newton_.step(body, time_step, state);
+    const Eigen::VectorXd start = state.u;
+    const double start_time = state.time;
+    dynamics::StepInfo info = newton_.step(body, time_step, state);
+    // κ is the step's now (begin_step set it): B at the start with it, against B at the end.
+    info.boundary_work += potential_->barrier_energy(start, start_time) - potential_->barrier_energy(state.u, state.time);
+    return info;
 }
 
 }  // namespace fem::scenes
