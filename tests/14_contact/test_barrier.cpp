@@ -256,3 +256,47 @@ TEST_CASE("adaptive kappa: the balancing stiffness minimises the norm of g + kap
     const double low = smallest_stiffness(0.125, 0.01, 1e-3);
     CHECK(low * 1e-4 * barrier(5e-4, 1e-3).second == Approx(0.125).epsilon(1e-14));
 }
+
+TEST_CASE("adaptive kappa doubles while the smallest distance is below eps_d and still falling, up to 100 kappa_min",
+          "[ex14.1]")
+{
+    // A one-cube block (edge 0.1 m, diagonal 0.173 m) over the floor; ε_d = 10⁻³ × diagonal = 1.73·10⁻⁴ m.
+    BlockSettings settings;
+    settings.height = 5e-4;
+    settings.contact.doubling_distance = 1e-3;
+    BlockScene block = block_scene(settings);
+    dynamics::Body& body = *block.body;
+    const double dt = settings.time_step, dhat = settings.contact.activation_distance;
+    const double mass = body.dof_masses().sum() / static_cast<double>(body.dof_masses().size());  // every vertex is on the surface
+    const double low = smallest_stiffness(mass, dt, dhat), high = 100.0 * low;
+    const double threshold = 1e-3 * std::sqrt(3.0) * settings.edge;
+    // The block lowered so that its bottom face is at distance d from the floor.
+    const auto at = [&](double d) {
+        Eigen::VectorXd u = Eigen::VectorXd::Zero(3 * body.mesh().V.rows());
+        for (Eigen::Index v = 0; v < body.mesh().V.rows(); ++v)
+            u[3 * v + 2] = d - settings.height;
+        return dynamics::initial_state(body, u);
+    };
+    const auto kappa_at = [&](double d) {
+        block.contact->begin_step(body, at(d), dt);
+        return block.contact->stiffness();
+    };
+    const double first = kappa_at(4e-4);  // the balancing κ, clamped to [κ_min, κ_max]
+    CHECK(first >= low * (1.0 - 1e-12));
+    REQUIRE(first <= 0.25 * high);          // room to double twice
+    CHECK(kappa_at(3e-4) == first);         // falling, but above ε_d: kept
+    CHECK(kappa_at(1e-4) == 2.0 * first);   // below ε_d and falling: doubled
+    CHECK(kappa_at(5e-5) == 4.0 * first);   // again
+    CHECK(kappa_at(8e-5) == 4.0 * first);   // below ε_d but rising: kept
+    CHECK(kappa_at(8e-5) == 4.0 * first);   // not falling: kept
+    REQUIRE(threshold > 1e-4);
+    // Falling on and on: κ doubles each time until κ_max, never beyond.
+    double d = 5e-5, kappa = 4.0 * first;
+    for (int k = 0; k < 12; ++k) {
+        d *= 0.5;
+        const double expected = std::min(high, 2.0 * kappa);
+        kappa = kappa_at(d);
+        CHECK(kappa == Approx(expected).epsilon(1e-15));
+    }
+    CHECK(kappa == Approx(high).epsilon(1e-15));
+}
