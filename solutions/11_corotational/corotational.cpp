@@ -1,20 +1,17 @@
+// The corotational element and model: the rotated stiffness and force of a tet (exercises 11.4,
+// 11.5), the shape-gradient form, and CorotationalElasticity, whose warped stiffness K_R is
+// exercise 11.6. The rotations are rotations.cpp's (and polar_newton.cpp's, the fast ones).
+// docs/11_corotational.md#forces-and-warped-stiffness
 #include "11_corotational/corotational.hpp"
 
 #include "common/error.hpp"
 #include "common/parallel.hpp"
-#include "common/simd.hpp"
 #include "common/vtk_io.hpp"
 
-#include <Eigen/Geometry>
 #include <Eigen/LU>
-#include <Eigen/SVD>
 
 #include <algorithm>
 #include <cmath>
-
-#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
-#include <immintrin.h>
-#endif
 
 namespace fem::corot {
 namespace {
@@ -28,209 +25,7 @@ Vector12d element_vector(const TetMesh& mesh, const MatrixX3d& positions, Eigen:
     return q;
 }
 
-// --- Newton's polar iteration, one matrix or four at a time -------------------------------------
-//
-// The arithmetic of a step is written once, for lanes T: a double, or four doubles in an AVX2
-// register (GCC's vector extension). Entry by entry, in the same order, so four matrices at a time
-// give the bits of one at a time. X is held as its 9 entries, column-major (X(i, j) = x[3 j + i]).
-
-// (Results come back through references: a function returning an AVX2 register by value would
-// have another calling convention when compiled for baseline x86-64.)
-
-/// The cofactors of X (column c: the cross product of columns c + 1 and c + 2, so that
-/// cofactors / det X = X⁻ᵀ) into cof, and det X = column 0 · cof column 0.
-template <class T>
-[[gnu::always_inline]] inline void cofactors_and_determinant(const T (&x)[9], T (&cof)[9], T& det)
-{
-    for (int c = 0; c < 3; ++c) {
-        const T* a = x + 3 * ((c + 1) % 3);
-        const T* b = x + 3 * ((c + 2) % 3);
-        cof[3 * c + 0] = a[1] * b[2] - a[2] * b[1];
-        cof[3 * c + 1] = a[2] * b[0] - a[0] * b[2];
-        cof[3 * c + 2] = a[0] * b[1] - a[1] * b[0];
-    }
-    det = x[0] * cof[0] + x[1] * cof[1] + x[2] * cof[2];
-}
-
-/// sum = ‖X‖² (the entries' squares summed in order).
-template <class T>
-[[gnu::always_inline]] inline void squared_norm(const T (&x)[9], T& sum)
-{
-    sum = x[0] * x[0];
-    for (int e = 1; e < 9; ++e)
-        sum += x[e] * x[e];
-}
-
-/// One Newton step: x ← ½(ζ X + s cof) with s = 1/(ζ det X) (one division for all nine entries),
-/// and change_squared = ‖X_{k+1} − X_k‖² (no square root: it is compared with squared thresholds).
-template <class T>
-[[gnu::always_inline]] inline void newton_polar_step(T (&x)[9], const T (&cof)[9], const T& zeta, const T& scale,
-                                                     T& change_squared)
-{
-    T next = 0.5 * (zeta * x[0] + scale * cof[0]);
-    change_squared = (next - x[0]) * (next - x[0]);
-    x[0] = next;
-    for (int e = 1; e < 9; ++e) {
-        next = 0.5 * (zeta * x[e] + scale * cof[e]);
-        change_squared += (next - x[e]) * (next - x[e]);
-        x[e] = next;
-    }
-}
-
-// The thresholds of polar_rotation_newton (see its comment in the header).
-constexpr double flat_fraction = 1e-6;      // det F ≤ this · ‖F‖³: the SVD instead
-constexpr double scaling_window = 1e-2;     // ζ = |det X|^(−1/3) while |det X − 1| exceeds this ...
-constexpr double scaled_change = 1e-4;      // ... and no step has changed X by less than 1e-2 (squared)
-constexpr double converged_change = 1e-16;  // a step's change below 1e-8 (squared): converged
-constexpr int newton_step_cap = 40;
-
-#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
-#define FEM_AVX2_POLAR 1
-using Lanes = double __attribute__((vector_size(32)));     // four doubles in an AVX2 register
-using LaneMask = long long __attribute__((vector_size(32)));  // what comparing two Lanes gives
-
-__attribute__((target("avx2,fma"))) bool any_lane(LaneMask mask)
-{
-    return (mask[0] | mask[1] | mask[2] | mask[3]) != 0;
-}
-
-/// polar_rotation_newton of four finite F at once (lane l: F[l]), each step of each lane the same
-/// operations as polar_rotation_newton's: the same R, bit for bit. Returns false, leaving the four to
-/// the caller, when a lane needs what the lanes do not do: the SVD (det F ≤ 10⁻⁶ ‖F‖³, or 40 steps)
-/// or a scaled step (a cube root).
-__attribute__((target("avx2,fma"))) bool polar_rotations_newton_avx2(const Eigen::Matrix3d* F, Eigen::Matrix3d* R)
-{
-    Lanes x[9], cof[9];
-    for (int e = 0; e < 9; ++e)
-        x[e] = Lanes{F[0].data()[e], F[1].data()[e], F[2].data()[e], F[3].data()[e]};
-    Lanes det, size_squared, change_squared;
-    cofactors_and_determinant(x, cof, det);
-    squared_norm(x, size_squared);
-    if (any_lane(!(det > flat_fraction * size_squared * Lanes(_mm256_sqrt_pd(__m256d(size_squared))))))
-        return false;
-    const Lanes one = {1.0, 1.0, 1.0, 1.0};
-    LaneMask scaled = {-1, -1, -1, -1}, done = {0, 0, 0, 0};
-    for (int step = 0; step < newton_step_cap; ++step) {
-        if (step > 0)
-            cofactors_and_determinant(x, cof, det);
-        if (any_lane(scaled & ~done & ((det - 1.0 > scaling_window) | (det - 1.0 < -scaling_window))))
-            return false;
-        const Lanes scale = 1.0 / (one * det);
-        newton_polar_step(x, cof, one, scale, change_squared);
-        scaled &= !(change_squared < scaled_change);
-        const LaneMask converged = (change_squared < converged_change) & ~done;
-        for (int l = 0; l < 4; ++l)
-            if (converged[l])
-                for (int e = 0; e < 9; ++e)
-                    R[l].data()[e] = x[e][l];
-        done |= converged;
-        if (!any_lane(~done))
-            return true;
-    }
-    return false;
-}
-#endif
-
 }  // namespace
-
-Eigen::Matrix3d proper_rotation(Eigen::Matrix3d A, const Eigen::Matrix3d& B)
-{
-    // BEGIN EXERCISE 11.1 proper_rotation #reflections
-    // HINT: If det(A Bᵀ) < 0, negate A's last column (the smallest singular value's); return A Bᵀ.
-    if ((A * B.transpose()).determinant() < 0.0)
-        A.col(2) = -A.col(2);
-    return A * B.transpose();
-    // END EXERCISE
-}
-
-Eigen::Matrix3d edge_covariance(const tet::TetVertices& X, const tet::TetVertices& x)
-{
-    Eigen::Matrix3d P, Q;
-    for (int i = 0; i < 3; ++i) {
-        P.row(i) = X.row(i + 1) - X.row(0);
-        Q.row(i) = x.row(i + 1) - x.row(0);
-    }
-    return P.transpose() * Q;
-}
-
-Eigen::Matrix3d centroid_covariance(const tet::TetVertices& X, const tet::TetVertices& x)
-{
-    const Eigen::RowVector3d X_mean = X.colwise().mean(), x_mean = x.colwise().mean();
-    return (X.rowwise() - X_mean).transpose() * (x.rowwise() - x_mean);
-}
-
-Eigen::Matrix3d best_fit_rotation(const Eigen::Matrix3d& S)
-{
-    if (!S.allFinite())
-        throw Error("best-fit rotation: the edge covariance S has a non-finite entry");
-    if (S.isZero(0.0))
-        return Eigen::Matrix3d::Identity();
-    const Eigen::JacobiSVD<Eigen::Matrix3d> svd(S, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    // BEGIN EXERCISE 11.2 best_fit_rotation #the-best-fit-rotation
-    // HINT: S = U Σ Vᵀ. The rotation from rest to deformed is R = V Uᵀ (not the slide's U Vᵀ):
-    // HINT: proper_rotation of V and U, which also fixes a reflection.
-    return proper_rotation(svd.matrixV(), svd.matrixU());
-    // END EXERCISE
-}
-
-Eigen::Matrix3d polar_rotation(const Eigen::Matrix3d& F)
-{
-    if (!F.allFinite())
-        throw Error("polar rotation: F has a non-finite entry");
-    if (F.isZero(0.0))
-        return Eigen::Matrix3d::Identity();
-    const Eigen::JacobiSVD<Eigen::Matrix3d> svd(F, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    // BEGIN EXERCISE 11.3 polar_rotation #edges-centroid-or-polar-decomposition
-    // HINT: F = U Σ Vᵀ = (U Vᵀ)(V Σ Vᵀ): the rotation is U Vᵀ, made proper by proper_rotation.
-    return proper_rotation(svd.matrixU(), svd.matrixV());
-    // END EXERCISE
-}
-
-Eigen::Matrix3d polar_rotation_newton(const Eigen::Matrix3d& F)
-{
-    if (!F.allFinite())
-        throw Error("polar rotation: F has a non-finite entry");
-    double x[9], cof[9], det = 0.0, size_squared = 0.0, change_squared = 0.0;
-    std::copy(F.data(), F.data() + 9, x);
-    cofactors_and_determinant(x, cof, det);
-    squared_norm(x, size_squared);
-    if (!(det > flat_fraction * size_squared * std::sqrt(size_squared)))
-        return polar_rotation(F);  // inverted, flat or zero: the SVD and its reflection fix
-    bool scaled = true;
-    for (int step = 0; step < newton_step_cap; ++step) {
-        if (step > 0)
-            cofactors_and_determinant(x, cof, det);
-        // Scaling pays where the singular values are far from 1; near det = 1 it would only cost a
-        // cube root. One division a step: X⁻ᵀ/ζ = cofactors · (1/(ζ det)).
-        const double zeta =
-            scaled && std::abs(det - 1.0) > scaling_window ? std::cbrt(1.0 / std::abs(det)) : 1.0;
-        newton_polar_step(x, cof, zeta, 1.0 / (zeta * det), change_squared);
-        if (change_squared < scaled_change)
-            scaled = false;  // a change below 1e-2, near orthogonal: plain Newton converges quadratically
-        if (change_squared < converged_change)
-            return Eigen::Map<const Eigen::Matrix3d>(x);  // X's error is about change² / 2: round-off
-    }
-    return polar_rotation(F);
-}
-
-void polar_rotations_newton(const Eigen::Matrix3d* F, Eigen::Matrix3d* R, std::size_t count)
-{
-    for (std::size_t k = 0; k < count; ++k)
-        if (!F[k].allFinite())
-            throw Error(str("polar rotations: F[", k, "] of ", count, " has a non-finite entry (every entry must be finite)"));
-    std::size_t first = 0;
-#ifdef FEM_AVX2_POLAR
-    if (avx2_enabled())
-        for (; first + 4 <= count; first += 4) {
-            if (polar_rotations_newton_avx2(F + first, R + first))
-                continue;
-            for (std::size_t k = first; k < first + 4; ++k)
-                R[k] = polar_rotation_newton(F[k]);
-        }
-#endif
-    for (; first < count; ++first)
-        R[first] = polar_rotation_newton(F[first]);
-}
 
 Matrix12d rotated_stiffness(const Matrix12d& K_e, const Eigen::Matrix3d& R)
 {
@@ -438,19 +233,19 @@ const dynamics::SparseMatrix& CorotationalElasticity::stiffness(const Eigen::Vec
     // the two layouts coincide, so the pattern's offsets address K_R_'s values directly.
     double* values = K_R_.valuePtr();
     std::fill(values, values + K_R_.nonZeros(), 0.0);
-    // BEGIN EXERCISE 11.6 warped_stiffness #forces-and-warped-stiffness
-    // HINT: parallel_for_then_add of common/parallel.hpp over the tets, with the slots
-    // HINT: element_matrices_: compute each tet's slot = rotated_stiffness(K_e_[t], R[t]) (on every
-    // HINT: core), then add it with pattern_.add_element(t, slot, values) (chapter 06's route c into
-    // HINT: the fixed pattern; in tet order, so the sums do not depend on the threads).
+    // Each tet's 12×12 block into its own slot on every core, then the slots added into the fixed
+    // pattern one tet after another (common/parallel.hpp: the same sums on any number of threads).
     parallel_for_then_add(
         mesh_.T.rows(), element_matrices_,
         [&](Eigen::Index t, Matrix12d& slot) {
             const auto e = static_cast<std::size_t>(t);
+            // BEGIN EXERCISE 11.6 warped_stiffness #forces-and-warped-stiffness
+            // HINT: tet e's block of K_R = Σ_e R̂_e K_e R̂_eᵀ: its rest stiffness K_e_[e] turned by its
+            // HINT: rotation R[e] (exercise 11.4).
             slot = rotated_stiffness(K_e_[e], R[e]);
+            // END EXERCISE
         },
         [&](Eigen::Index t, const Matrix12d& slot) { pattern_.add_element(t, slot, values); });
-    // END EXERCISE
     return K_R_;
 }
 
