@@ -37,15 +37,20 @@ TriMesh bunny_surface();
 /// data/bunny_coarse.node/.ele: TetGen's tets of the bunny, its surface kept exactly.
 TetMesh bunny_tets();
 
+/// The ground the bunny stands on: y = low + 0.05 (high − low), its lowest 5 % (y range of surface).
+double ground_height(const TriMesh& surface);
+
 /// A body of the rubber bunny on mesh (already in metres), standing on the ground of the bunny
-/// surface (its lowest 5 %), with the force model settings.model and the integrator that model
-/// needs (hyper::make_force_model, hyper::make_integrator_for: fem::Error for an unknown name). The body keeps the returned integrator's model alive.
+/// surface (every vertex with y ≤ ground_height pinned, or the vertices `pinned` when given), with
+/// the force model settings.model and the integrator that model needs (hyper::make_force_model,
+/// hyper::make_integrator_for: fem::Error for an unknown name). The body keeps the returned integrator's model alive.
 struct Run {
     std::unique_ptr<dynamics::Body> body;
     std::unique_ptr<dynamics::Integrator> integrator;
     Eigen::VectorXd push;  ///< the initial velocity: chapter 10's sideways push
 };
-Run bunny_run(const TetMesh& mesh, const TriMesh& surface, const Settings& settings);
+Run bunny_run(const TetMesh& mesh, const TriMesh& surface, const Settings& settings,
+              const std::vector<int>* pinned = nullptr);
 
 void location_study(const RunContext& run, const Settings& settings);
 void outside_study(const RunContext& run, const Settings& settings);

@@ -24,10 +24,20 @@ TetMesh bunny_tets()
     return io::read_tet_mesh(data_path("bunny_coarse.node"));
 }
 
-Run bunny_run(const TetMesh& mesh, const TriMesh& surface, const Settings& settings)
+double ground_height(const TriMesh& surface)
 {
     const double low = surface.V.col(1).minCoeff(), high = surface.V.col(1).maxCoeff();
-    const dynamics::Scene scene = dynamics::standing_scene(mesh, settings.rubber, low + 0.05 * (high - low), settings.duration);
+    return low + 0.05 * (high - low);
+}
+
+Run bunny_run(const TetMesh& mesh, const TriMesh& surface, const Settings& settings, const std::vector<int>* pinned)
+{
+    const double low = surface.V.col(1).minCoeff(), high = surface.V.col(1).maxCoeff();
+    dynamics::Scene scene = dynamics::standing_scene(mesh, settings.rubber, ground_height(surface), settings.duration);
+    if (pinned != nullptr) {
+        scene.pinned = *pinned;
+        dynamics::validate(scene);
+    }
     Run run;
     run.body = std::make_unique<dynamics::Body>(scene, hyper::make_force_model(settings.model, scene.mesh, scene.material));
     run.integrator = hyper::make_integrator_for(settings.model);
