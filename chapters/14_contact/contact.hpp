@@ -108,6 +108,8 @@ public:
     /// Used once, by the next begin_step (step_with_friction_updates). fem::Error on u's size.
     void lag_friction_at(const Eigen::VectorXd& u);
 
+    /// The constants it was made with.
+    const ContactOptions& options() const { return options_; }
     /// κ [N/m] of the current step (the fixed one, or the adaptive rule's).
     double stiffness() const { return stiffness_; }
     /// The current step's lagged friction pairs (set by begin_step).
@@ -128,15 +130,23 @@ private:
     Eigen::VectorXd lag_u_;  // empty: lag at the step's start
 };
 
-/// One backward Euler step with contact whose friction is lagged `updates` times (≥ 1): the step
-/// is solved with λ, T from its start (IPC's one lagged update), then, updates − 1 times, solved
-/// again from the same start with λ, T from the last solution (lag_friction_at), which approaches
-/// friction that is implicit in λ and T. newton must have contact set as its potential. The
-/// StepInfo's Newton and solver iterations are summed over the solves. fem::Error for updates < 1.
-/// docs/14_contact.md#friction
+/// The friction lag iterated to convergence (step_with_friction_updates with updates = 0) stops when
+/// no vertex moved more than this × ε_v Δt between two solves (ε_v Δt: the creep of a sticking vertex).
+inline constexpr double friction_lag_tolerance = 1e-2;
+/// … or fails (fem::Error) after this many solves of one step.
+inline constexpr int most_friction_updates = 20;
+
+/// One backward Euler step with contact whose friction is lagged `updates` times: the step is
+/// solved with λ, T from its start (IPC's one lagged update), then, updates − 1 times, solved again
+/// from the same start with λ, T from the last solution (lag_friction_at), which approaches friction
+/// that is implicit in λ and T. updates = 0: until converged, solved again until no vertex moves
+/// more than friction_lag_tolerance ε_v Δt between two solves (fem::Error after
+/// most_friction_updates solves). newton must have contact set as its potential. The StepInfo's
+/// Newton and solver iterations are summed over the solves; solves (when set) receives their number.
+/// fem::Error for updates < 0. docs/14_contact.md#friction
 dynamics::StepInfo step_with_friction_updates(hyper::NewtonBackwardEuler& newton, ContactPotential& contact,
                                               dynamics::Body& body, double time_step, dynamics::State& state,
-                                              int updates);
+                                              int updates, int* solves = nullptr);
 
 /// The tangent-plane basis of a unit normal n: T (3×2) with orthonormal columns ⟂ n.
 Eigen::Matrix<double, 3, 2> tangent_basis(const Eigen::Vector3d& normal);

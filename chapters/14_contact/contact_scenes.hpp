@@ -35,7 +35,7 @@ struct BlockSettings {
     std::string model = "stable-neo-hookean";
     hyper::NewtonOptions newton;        ///< chapter 12's Newton
     ContactOptions contact;             ///< d̂, κ, ε_v, …
-    int friction_updates = 1;           ///< lagged friction updates per step (step_with_friction_updates)
+    int friction_updates = 1;           ///< lagged friction updates per step, 0: until converged (step_with_friction_updates)
 };
 
 /// A block of settings.model on the floor z = 0 (a HalfSpace with μ), its Newton
@@ -47,8 +47,9 @@ struct BlockScene {
     std::unique_ptr<hyper::NewtonBackwardEuler> integrator;
     dynamics::State state;
 
-    /// One backward Euler step with contact (Δt and friction updates of the settings).
-    dynamics::StepInfo step();
+    /// One backward Euler step with contact (Δt and friction updates of the settings); solves (when
+    /// set) receives the number of solves it took.
+    dynamics::StepInfo step(int* solves = nullptr);
     double time_step = 0.0;
     int friction_updates = 1;
 };

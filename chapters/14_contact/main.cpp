@@ -44,8 +44,8 @@ int main(int argc, char** argv)
     cli.app.add_option("--tolerance", settings.tolerances, "Newton's relative tolerances swept")
         ->check(check::real(0.0, 0.1, check::Ends::open_closed))->capture_default_str();
     cli.app.add_option("--friction-updates", settings.friction_updates,
-                       "Lagged friction updates per step swept on the slope (1: IPC's one lag)")
-        ->check(check::integer(1, 20))->capture_default_str();
+                       "Lagged friction updates per step swept on the slope (1: IPC's one lag; 0: until converged)")
+        ->check(check::integer(0, 20))->capture_default_str();
     cli.app.add_option("--height", settings.drop_height, "Drop height h [m]")
         ->check(check::real(0.0, 1.0, check::Ends::open_closed))->capture_default_str();
     cli.app.add_option("--duration", settings.duration, "Length of each run [s]")

@@ -16,7 +16,7 @@ struct Settings {
     std::vector<double> stiffnesses{0.0, 1e4};             ///< κ [N/m] swept (0: adaptive)
     std::vector<double> time_steps{1.0 / 100.0, 1.0 / 400.0, 1.0 / 1600.0};  ///< Δt [s] swept
     std::vector<double> tolerances{1e-4, 1e-7};            ///< Newton's relative tolerance swept
-    std::vector<int> friction_updates{1, 3};               ///< lagged friction updates per step swept (slope)
+    std::vector<int> friction_updates{1, 3, 0};            ///< lagged friction updates per step swept (slope; 0: until converged)
     double drop_height = 0.05;                             ///< h [m]
     double duration = 0.5;                                 ///< length of each run [s]
 };

@@ -25,7 +25,8 @@ void slope_study(const RunContext& run, const Settings& settings)
     std::cout << "\n== 2. The slope: a 0.1 m cube on a slope of 30 deg with mu = 0.3 (slides) and 20 deg with mu = 0.5 (sticks)\n\n";
     Table table("Slope: acceleration against g (sin theta - mu cos theta), creep per step against eps_v dt",
                 {{"slope", Format::text}, {"dhat [m]", Format::scientific, 1}, {"kappa", Format::text},
-                 {"dt", Format::text}, {"tolerance", Format::scientific, 0}, {"friction updates", Format::integer},
+                 {"dt", Format::text}, {"tolerance", Format::scientific, 0}, {"friction updates", Format::text},
+                 {"solves per step", Format::fixed, 2},
                  {"acceleration [m/s^2]", Format::scientific, 4}, {"closed form [m/s^2]", Format::scientific, 4},
                  {"acceleration error / g", Format::scientific, 3}, {"largest move per step / (eps_v dt)", Format::scientific, 3},
                  {"Newton iterations per step", Format::fixed, 2}, {"time per step [ms]", Format::fixed, 3}});
@@ -42,13 +43,15 @@ void slope_study(const RunContext& run, const Settings& settings)
             // The acceleration over the run's second half (the first settles the normal force).
             const int half = steps / 2;
             double seconds = 0.0, creep = 0.0, half_speed = 0.0, half_time = 0.0;
-            int iterations = 0;
+            int iterations = 0, solves = 0;
             for (int step = 0; step < steps; ++step) {
                 const double before = block.body->positions(block.state.u).col(0).mean();
                 Timer timer;
-                const dynamics::StepInfo info = block.step();
+                int solved = 0;
+                const dynamics::StepInfo info = block.step(&solved);
                 seconds += timer.seconds();
                 iterations += info.newton_iterations;
+                solves += solved;
                 if (step + 1 > half)
                     creep = std::max(creep, std::abs(block.body->positions(block.state.u).col(0).mean() - before));
                 if (step + 1 == half) {
@@ -61,7 +64,8 @@ void slope_study(const RunContext& run, const Settings& settings)
             const double expected = slope_acceleration(setup.gravity, slope.angle, slope.friction);
             table.add_row({std::string(slope.name), c.activation_distance,
                            c.stiffness == 0.0 ? std::string("adaptive") : str(c.stiffness),
-                           str("1/", static_cast<int>(std::lround(1.0 / c.time_step))), c.tolerance, double(updates),
+                           str("1/", static_cast<int>(std::lround(1.0 / c.time_step))), c.tolerance,
+                           updates == 0 ? std::string("converged") : str(updates), double(solves) / steps,
                            acceleration,
                            expected, (acceleration - expected) / setup.gravity,
                            creep / (setup.contact.friction_velocity * c.time_step), double(iterations) / steps,

@@ -101,6 +101,23 @@ double ContactPotential::smallest_distance(const Eigen::VectorXd& u) const
     return smallest;
 }
 
+bool ContactPotential::out_of_contact(const Eigen::VectorXd& u, double time, const Eigen::VectorXd& u_end,
+                                      double end_time) const
+{
+    if (u.size() != 3 * rest_.rows() || u_end.size() != u.size())
+        throw Error(str("contact: out_of_contact needs u and u_end with 3n = ", 3 * rest_.rows(), " entries, got ",
+                        u.size(), " and ", u_end.size()));
+    const double reach = options_.activation_distance;
+    for (int v : surface_) {
+        const Eigen::Vector3d x = position(u, v), x_end = position(u_end, v);
+        for (const auto& obstacle : obstacles_)
+            if (obstacle->distance(x, time) < reach || obstacle->distance(x, end_time) < reach ||
+                obstacle->distance(x_end, end_time) < reach || obstacle->time_of_impact(x, x_end - x, end_time) <= 1.0)
+                return false;
+    }
+    return true;
+}
+
 void ContactPotential::begin_step(dynamics::Body& body, const dynamics::State& state, double time_step)
 {
     require_positive(time_step, "time step dt [s]");
@@ -158,36 +175,60 @@ void ContactPotential::lag_friction_at(const Eigen::VectorXd& u)
 
 dynamics::StepInfo step_with_friction_updates(hyper::NewtonBackwardEuler& newton, ContactPotential& contact,
                                               dynamics::Body& body, double time_step, dynamics::State& state,
-                                              int updates)
+                                              int updates, int* solves)
 {
-    if (updates < 1)
-        throw Error(str("contact: friction updates per step must be >= 1, got ", updates));
+    if (updates < 0)
+        throw Error(str("contact: friction updates per step must be >= 0 (0: until converged), got ", updates));
+    const bool until_converged = updates == 0;
+    const double tolerance = friction_lag_tolerance * contact.options().friction_velocity * time_step;
     dynamics::State solution = state;
     dynamics::StepInfo info = newton.step(body, time_step, solution);
-    for (int update = 1; update < updates; ++update) {
+    int solved = 1;
+    while (until_converged || solved < updates) {
         contact.lag_friction_at(solution.u);
+        const Eigen::VectorXd last = solution.u;
         solution = state;
         const dynamics::StepInfo again = newton.step(body, time_step, solution);
+        ++solved;
         info.newton_iterations += again.newton_iterations;
         info.solver_iterations += again.solver_iterations;
         info.damping_work = again.damping_work;
         info.boundary_work = again.boundary_work;
+        if (until_converged) {
+            const double moved = (solution.u - last).lpNorm<Eigen::Infinity>();
+            if (moved <= tolerance)
+                break;
+            if (solved == most_friction_updates)
+                throw Error(str("contact: the friction lag did not converge in ", most_friction_updates,
+                                " solves of step ", state.step + 1, " (t = ", state.time + time_step,
+                                " s): the last moved a vertex by ", moved, " m, above ", tolerance, " m"));
+        }
     }
+    if (solves != nullptr)
+        *solves = solved;
     state = std::move(solution);
     return info;
 }
 
-double ContactPotential::energy(const Eigen::VectorXd& u) const
+double ContactPotential::barrier_energy(const Eigen::VectorXd& u, double time) const
 {
     double total = 0.0;
     for (int v : surface_)
         for (const auto& obstacle : obstacles_) {
-            const double d = obstacle->distance(position(u, v), time_);
+            const double d = obstacle->distance(position(u, v), time);
             if (!(d > 0.0))
                 return infinity;
             if (d < options_.activation_distance)
                 total += stiffness_ * barrier(d, options_.activation_distance).value;
         }
+    return total;
+}
+
+double ContactPotential::energy(const Eigen::VectorXd& u) const
+{
+    double total = barrier_energy(u, time_);
+    if (!std::isfinite(total))
+        return total;
     for (const FrictionPair& pair : pairs_) {
         const double y = (pair.tangent.transpose() * (position(u, pair.vertex) - pair.start)).norm();
         total += pair.coefficient * pair.normal_force * friction_mollifier(y, friction_step_).f0;

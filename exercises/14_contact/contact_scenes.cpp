@@ -12,9 +12,9 @@
 
 namespace fem::contact {
 
-dynamics::StepInfo BlockScene::step()
+dynamics::StepInfo BlockScene::step(int* solves)
 {
-    return step_with_friction_updates(*integrator, *contact, *body, time_step, state, friction_updates);
+    return step_with_friction_updates(*integrator, *contact, *body, time_step, state, friction_updates, solves);
 }
 
 BlockScene block_scene(const BlockSettings& settings)

@@ -173,21 +173,37 @@ void ContactPotential::lag_friction_at(const Eigen::VectorXd& u)
 
 dynamics::StepInfo step_with_friction_updates(hyper::NewtonBackwardEuler& newton, ContactPotential& contact,
                                               dynamics::Body& body, double time_step, dynamics::State& state,
-                                              int updates)
+                                              int updates, int* solves)
 {
-    if (updates < 1)
-        throw Error(str("contact: friction updates per step must be >= 1, got ", updates));
+    if (updates < 0)
+        throw Error(str("contact: friction updates per step must be >= 0 (0: until converged), got ", updates));
+    const bool until_converged = updates == 0;
+    const double tolerance = friction_lag_tolerance * contact.options().friction_velocity * time_step;
     dynamics::State solution = state;
     dynamics::StepInfo info = newton.step(body, time_step, solution);
-    for (int update = 1; update < updates; ++update) {
+    int solved = 1;
+    while (until_converged || solved < updates) {
         contact.lag_friction_at(solution.u);
+        const Eigen::VectorXd last = solution.u;
         solution = state;
         const dynamics::StepInfo again = newton.step(body, time_step, solution);
+        ++solved;
         info.newton_iterations += again.newton_iterations;
         info.solver_iterations += again.solver_iterations;
         info.damping_work = again.damping_work;
         info.boundary_work = again.boundary_work;
+        if (until_converged) {
+            const double moved = (solution.u - last).lpNorm<Eigen::Infinity>();
+            if (moved <= tolerance)
+                break;
+            if (solved == most_friction_updates)
+                throw Error(str("contact: the friction lag did not converge in ", most_friction_updates,
+                                " solves of step ", state.step + 1, " (t = ", state.time + time_step,
+                                " s): the last moved a vertex by ", moved, " m, above ", tolerance, " m"));
+        }
     }
+    if (solves != nullptr)
+        *solves = solved;
     state = std::move(solution);
     return info;
 }

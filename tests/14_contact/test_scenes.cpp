@@ -96,7 +96,7 @@ TEST_CASE("a cube at rest on the floor: its contact forces sum to its weight at 
 TEST_CASE("a cube on a slope with tan(theta) < mu sticks: it creeps at most eps_v dt a step, as the mollifier says",
           "[ex14.4]")
 {
-    for (int updates : {1, 3}) {  // IPC's one lagged update a step, and the lag updated within it
+    for (int updates : {1, 3, 0}) {  // IPC's one lagged update a step, the lag updated within it, and to convergence
     BlockSettings settings;
     settings.slope = 20.0 * degree;
     settings.friction = 0.5;
@@ -119,6 +119,33 @@ TEST_CASE("a cube on a slope with tan(theta) < mu sticks: it creeps at most eps_
                  << " m");
     CHECK(std::abs(creep - expected) <= 0.01 * expected);
     }
+}
+
+TEST_CASE("friction lagged to convergence: one more update of the converged lag moves no vertex beyond its tolerance",
+          "[ex14.4]")
+{
+    BlockSettings settings;
+    settings.slope = 25.0 * degree;  // tan 25° = 0.466 against μ = 0.5: near the stick-slip threshold
+    settings.friction = 0.5;
+    settings.height = 0.5 * settings.contact.activation_distance;
+    settings.friction_updates = 0;
+    BlockScene block = block_scene(settings);
+    const double tolerance = friction_lag_tolerance * settings.contact.friction_velocity * settings.time_step;
+    int most = 0;
+    for (int step = 0; step < 20; ++step) {
+        const dynamics::State start = block.state;
+        int solves = 0;
+        block.step(&solves);
+        most = std::max(most, solves);
+        // The definition, checked from outside: solve the step again with λ, T lagged at its answer.
+        block.contact->lag_friction_at(block.state.u);
+        dynamics::State again = start;
+        block.integrator->step(*block.body, settings.time_step, again);
+        CHECK((again.u - block.state.u).lpNorm<Eigen::Infinity>() <= tolerance);
+    }
+    CHECK(most >= 2);  // the lag did need updating in some step
+    settings.friction_updates = -1;
+    CHECK_THROWS_WITH(block_scene(settings).step(), Catch::Contains(">= 0"));
 }
 
 TEST_CASE("a cube on a slope with tan(theta) > mu slides with acceleration g (sin theta - mu cos theta)", "[ex14.4]")
