@@ -375,6 +375,32 @@ TEST_CASE("shape-gradient form: the forces and energy of the stiffness-matrix fo
     CHECK((f_gradients - f_matrices).norm() <= 1e-12 * f_matrices.norm());
 }
 
+TEST_CASE("warped stiffness of one strained, rotated tet: every 3x3 block of K_R is R K_ab R^T", "[ex11.6]")
+{
+    // One tet, so K_R is the element's own block matrix: a wrong rotation (none, Rᵀ K R, R on one
+    // side only) or a block added at the wrong vertices shows in a named block.
+    TetMesh mesh;
+    mesh.V = random_tet(7);
+    mesh.T.resize(1, 4);
+    mesh.T << 0, 1, 2, 3;
+    CorotationalElasticity model(mesh, rubber);
+    Eigen::Matrix3d stretch;
+    stretch << 1.1, 0.05, 0.0, 0.02, 0.95, 0.03, 0.0, 0.04, 1.05;
+    const MatrixX3d x = rigidly_moved(MatrixX3d(mesh.V * stretch.transpose()), rotation(0.8, 17), Eigen::Vector3d(0.1, -0.2, 0.3));
+    const Eigen::VectorXd u = displacement(x, mesh.V);
+    const Eigen::MatrixXd K_R = Eigen::MatrixXd(model.stiffness(u));
+    const Eigen::Matrix3d R = model.rotations(u)[0];
+    const Matrix12d K_e = assembly::element_stiffnesses(mesh, elastic::lame_parameters(rubber.youngs_modulus, rubber.poisson_ratio))[0];
+    REQUIRE(K_R.rows() == 12);
+    for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 4; ++b) {
+            const Eigen::Matrix3d expected = R * K_e.block<3, 3>(3 * a, 3 * b) * R.transpose();
+            const double deviation = (K_R.block<3, 3>(3 * a, 3 * b) - expected).cwiseAbs().maxCoeff();
+            CAPTURE(a, b, deviation);
+            CHECK(deviation <= 1e-12 * K_e.cwiseAbs().maxCoeff());
+        }
+}
+
 TEST_CASE("small deformations: corotational and linear forces differ by O(eps^2)", "[ex11.6]")
 {
     const TetMesh mesh = box_mesh(2, 2, 2);
