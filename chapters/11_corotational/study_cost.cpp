@@ -58,12 +58,13 @@ dynamics::State sagging_state(dynamics::Body& body, int steps)
     return state;
 }
 
-/// Plain PCG (chapter 09's preconditioned_conjugate_gradient, β = r_{k+1}ᵀz_{k+1} / r_kᵀz_k) on the
+/// Plain PCG (chapter 09's preconditioned_conjugate_gradient, β = r_{k+1}ᵀz_{k+1} / r_kᵀz_k), and
+/// flexible PCG (flexible_conjugate_gradient, β = z_{k+1}ᵀ(r_{k+1} − r_k) / r_kᵀz_k), on the
 /// step matrix A = Pᵀ(M + Δt D + Δt² K_R(u))P at `state`, from x₀ = 0 with the lecture's right-hand
 /// side b = Pᵀ(M v + Δt (f + f_ext)), preconditioned by a stale factor: the Cholesky factor of the
 /// step matrix at an earlier state, A₀ = Pᵀ(M + Δt D + Δt² K_R(u₀))P, applied in single precision (z = A₀⁻¹ r through
 /// the float copy of L, which is neither exactly linear nor exactly symmetric) and in double
-/// precision. One row per factor and iteration k = 0 … `iterations`: the residual CG updates,
+/// precision (plain PCG only). One row per run and iteration k = 0 … `iterations`: the residual CG updates,
 /// ‖r_k‖₂/‖b‖₂, and the true one, ‖b − A x_k‖₂/‖b‖₂, computed afresh from x_k.
 /// docs/11_corotational.md#a-single-precision-preconditioner
 Table residual_table(dynamics::Body& body, const dynamics::State& earlier, const dynamics::State& state, int iterations)
@@ -83,26 +84,33 @@ Table residual_table(dynamics::Body& body, const dynamics::State& earlier, const
     factor_options.single_precision_copy = true;
     const direct::SparseCholesky factor(A0, factor_options);
 
-    Table table("Plain PCG on the bent beam's step matrix with a stale factor (the step matrix 5 steps "
+    Table table("PCG on the bent beam's step matrix with a stale factor (the step matrix 5 steps "
                 "earlier): the residual CG updates and the true one, per iteration",
                 {{"factor", Format::text}, {"iteration", Format::integer},
                  {"updated |r_k| / |b|", Format::scientific, 2}, {"true |b - A x_k| / |b|", Format::scientific, 2}});
     const cg::FunctionOperator product(A.rows(), [&](const Eigen::VectorXd& v, Eigen::VectorXd& Av) {
         Av.noalias() = A * v;
     });
-    for (const bool single : {true, false}) {
+    struct Variant {
+        std::string name;
+        bool single, flexible;
+    };
+    for (const Variant& run : {Variant{"single precision", true, false}, Variant{"double precision", false, false},
+                               Variant{"single precision, flexible PCG", true, true}}) {
         const cg::FunctionOperator preconditioner(A.rows(), [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) {
-            z = single ? factor.solve_single_precision(r) : factor.solve(r);
+            z = run.single ? factor.solve_single_precision(r) : factor.solve(r);
         });
         cg::CgSettings settings;
         settings.relative_tolerance = 1e-15;  // below round-off: the cap ends every run
         settings.max_iterations = iterations;
         settings.observer = [&](int k, const Eigen::VectorXd& x, double updated) {
-            table.add_row({std::string(single ? "single precision" : "double precision"), double(k), updated,
-                           (b - A * x).norm() / b.norm()});
+            table.add_row({run.name, double(k), updated, (b - A * x).norm() / b.norm()});
         };
         Eigen::VectorXd x = Eigen::VectorXd::Zero(b.size());
-        (void)cg::preconditioned_conjugate_gradient(product, preconditioner, b, x, settings);
+        if (run.flexible)
+            (void)flexible_conjugate_gradient(product, preconditioner, b, x, settings);
+        else
+            (void)cg::preconditioned_conjugate_gradient(product, preconditioner, b, x, settings);
     }
     return table;
 }

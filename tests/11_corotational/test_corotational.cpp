@@ -716,6 +716,23 @@ TEST_CASE("frozen-factor PCG in single precision: the true residual |b - A x| / 
         // Measured: 15 and 15 at 0.1 rad, 53 and 50 at 0.5, 158 and 130 at 1.5: over many
         // iterations the float rounding costs CG some of its conjugacy, a fifth more iterations at most.
         CHECK(single.stats().iterations <= 1.25 * exact.stats().iterations + 1);
+        // Flexible PCG (Polak–Ribière β) with the same float factor: its true residual reaches the
+        // tolerance too.
+        direct::CholeskyOptions factor_options;
+        factor_options.single_precision_copy = true;
+        const direct::SparseCholesky factor(step_matrix(0.0), factor_options);
+        const cg::FunctionOperator product(A.rows(), [&](const Eigen::VectorXd& v, Eigen::VectorXd& Av) { Av = A * v; });
+        const cg::FunctionOperator preconditioner(A.rows(), [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) {
+            z = factor.solve_single_precision(r);
+        });
+        cg::CgSettings settings;
+        settings.relative_tolerance = tolerance;
+        Eigen::VectorXd y;
+        const cg::CgResult flexible = flexible_conjugate_gradient(product, preconditioner, b, y, settings);
+        CAPTURE(flexible.iterations);
+        CHECK(flexible.converged);
+        CHECK((b - A * y).norm() / b.norm() <= tolerance);
+        CHECK(flexible.relative_residual <= tolerance);
     }
     CHECK(single.factorizations() == 1);
 }
