@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <exception>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <iterator>
 #include <new>
@@ -40,11 +41,12 @@ std::string interval_text(double low, double high, Ends ends)
     const bool high_in = ends == Ends::closed || ends == Ends::open_closed;
     if (std::isinf(low) && std::isinf(high))
         return "a finite number";
+    // 15 digits: a bound such as 0.499999995 must not print as 0.5.
     if (std::isinf(high))
-        return str("a finite number ", low_in ? ">= " : "> ", low);
+        return str(std::setprecision(15), "a finite number ", low_in ? ">= " : "> ", low);
     if (std::isinf(low))
-        return str("a finite number ", high_in ? "<= " : "< ", high);
-    return str("a number in ", low_in ? "[" : "(", low, ", ", high, high_in ? "]" : ")");
+        return str(std::setprecision(15), "a finite number ", high_in ? "<= " : "< ", high);
+    return str(std::setprecision(15), "a number in ", low_in ? "[" : "(", low, ", ", high, high_in ? "]" : ")");
 }
 
 }  // namespace

@@ -71,8 +71,18 @@ struct Scene {
 constexpr double lowest_youngs_modulus = 1e-2, highest_youngs_modulus = 1e13;  // [Pa]
 constexpr double lowest_density = 1e-2, highest_density = 1e6;                // [kg/m³]
 
+/// The largest Poisson's ratio a body may have: λ/μ = 2ν/(1 − 2ν) ≤ 1e8, i.e. ν ≤ 0.5 − 1/(2(1e8 + 1))
+/// ≈ 0.499999995. The condition number of the stiffness grows like λ/μ (times the mesh's own (L/h)²),
+/// and a double has 16 digits: at λ/μ = 1e8 a solve keeps about 8 before the mesh's factor; the sparse
+/// Cholesky of a 4×4×4-cell cube broke down (a pivot below n ε |a_jj|) at λ/μ ≈ 5e13. Long before, linear
+/// tets lock (they cannot bend without changing volume), so the bound takes away no physics. Below it,
+/// Newton may need a smaller Δt (its error says so): the hanging cube converges at ν = 0.49999999 with
+/// Δt = 1/600 s. docs/scenes.md#limits
+constexpr double largest_lame_ratio = 1e8;
+constexpr double highest_poisson_ratio = 0.5 - 0.5 / (largest_lame_ratio + 1.0);
+
 /// fem::Error, naming the field and what is allowed, unless: the mesh is valid (indices, no
-/// zero-volume or inverted tet: fem::validate with Inverted::reject), Y > 0, −1 < ν < 0.5, ρ > 0,
+/// zero-volume or inverted tet: fem::validate with Inverted::reject), Y > 0, −1 < ν ≤ highest_poisson_ratio, ρ > 0,
 /// g finite, 0 ≤ α, β ≤ 0.02, Δt > 0, duration ≥ 0 and a whole number of steps, and every pinned
 /// vertex lies in [0, #V) and is listed once, and some vertex is free. Nothing pinned is allowed
 /// (the body falls freely).

@@ -46,10 +46,11 @@ int main(int argc, char** argv)
     study::Settings settings;
     cli.app.add_option("--youngs", settings.beam.youngs_modulus, "Young's modulus Y of the beam [Pa]")
         ->check(check::real(lowest_youngs_modulus, highest_youngs_modulus, check::Ends::closed))->capture_default_str();
-    cli.app.add_option("--poisson", settings.beam.poisson_ratio, "Poisson's ratio of the beam (0.5 is incompressible; towards it, and for a large --youngs "
-                       "or a small --density, the accuracy study's symplectic Euler needs ever more steps: at most "
-                       "2000000 are run)")
-        ->check(check::real(-1.0, 0.5, check::Ends::open))->capture_default_str();
+    cli.app.add_option("--poisson", settings.beam.poisson_ratio, "Poisson's ratio of the beam, at most 0.499999995 "
+                       "(lambda/mu <= 1e8: nearer 0.5 the stiffness leaves a double no digits; towards it, and for a "
+                       "large --youngs or a small --density, the accuracy study's symplectic Euler needs ever more "
+                       "steps: at most 2000000 are run)")
+        ->check(check::real(-1.0, highest_poisson_ratio, check::Ends::open_closed))->capture_default_str();
     cli.app.add_option("--density", settings.beam.density, "Density of the beam [kg/m^3]")
         ->check(check::real(lowest_density, highest_density, check::Ends::closed))->capture_default_str();
     cli.app.add_option("--duration", settings.duration, "Accuracy horizon and demo length [s]")

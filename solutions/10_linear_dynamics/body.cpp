@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <utility>
 #include <cmath>
+#include <iomanip>
 
 namespace fem::dynamics {
 
@@ -17,9 +18,11 @@ void validate(const Scene& scene)
     fem::validate(mesh, "scene mesh", Inverted::reject);
     const Material& m = scene.material;
     require_positive(m.youngs_modulus, "Young's modulus Y [Pa]");
-    if (!(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5))
-        throw Error(str("Poisson's ratio must lie in (-1, 0.5) (0.5 is incompressible, which linear tets "
-                        "cannot model), got ", m.poisson_ratio));
+    if (!(m.poisson_ratio > -1.0 && m.poisson_ratio <= highest_poisson_ratio))
+        throw Error(str(std::setprecision(15), "Poisson's ratio must lie in (-1, ", highest_poisson_ratio, "] (lambda/mu at most ",
+                        largest_lame_ratio, ": nearer 0.5 the stiffness's condition number leaves a double no "
+                        "digits, and 0.5 is incompressible, which linear tets cannot model), got ",
+                        m.poisson_ratio));
     require_positive(m.density, "density rho [kg/m^3]");
     for (int c = 0; c < 3; ++c)
         require_finite(scene.gravity[c], "gravity g [m/s^2]");

@@ -22,6 +22,7 @@
 #include <array>
 #include <cmath>
 #include <fstream>
+#include <iomanip>
 #include <set>
 #include <sys/resource.h>
 #include <sstream>
@@ -754,8 +755,11 @@ BodySpec read_body(const toml::table& table, const std::string& name, const Sour
         str("a number in (0, ", largest_youngs_modulus, "] Pa (diamond is 1.2e12 Pa; beyond the bound the stresses "
             "of a large strain and the Lame parameters near nu = 0.5 leave a double's range)"));
     body.material.poisson_ratio = material.number(
-        "poisson_ratio", body.material.poisson_ratio, [](double nu) { return nu > -1.0 && nu < 0.5; },
-        "a number in (-1, 0.5) (0.5 is incompressible, which a displacement model cannot represent)");
+        "poisson_ratio", body.material.poisson_ratio,
+        [](double nu) { return nu > -1.0 && nu <= dynamics::highest_poisson_ratio; },
+        str(std::setprecision(15), "a number in (-1, ", dynamics::highest_poisson_ratio, "] (lambda/mu at most ",
+            dynamics::largest_lame_ratio, ": nearer 0.5 the stiffness's condition number leaves a double no digits; "
+            "0.5 is incompressible, which a displacement model cannot represent)"));
     body.material.density = material.positive("density", body.material.density);
     body.mass = fields.text("mass", "lumped", {"lumped", "consistent"}) == "lumped" ? dynamics::MassModel::lumped
                                                                                    : dynamics::MassModel::consistent;

@@ -93,6 +93,13 @@ TEST_CASE("scenes: every bad field is refused with its name and what is allowed"
     refused([](Scene& s) { s.duration = -1.0; }, "duration");
     refused([](Scene& s) { s.material.poisson_ratio = 0.5; }, "Poisson");
     refused([](Scene& s) { s.material.poisson_ratio = 0.7; }, "Poisson");
+    // λ/μ = 5e13: the sparse Cholesky broke down; the bound (λ/μ ≤ 1e8) refuses it before any solve
+    refused([](Scene& s) { s.material.poisson_ratio = 0.49999999999999; }, "lambda/mu at most");
+    Scene at_bound = good;
+    at_bound.material.poisson_ratio = highest_poisson_ratio;
+    CHECK_NOTHROW(validate(at_bound));
+    const double lame_ratio = 2.0 * highest_poisson_ratio / (1.0 - 2.0 * highest_poisson_ratio);
+    CHECK(lame_ratio == Approx(largest_lame_ratio).epsilon(1e-6));
     refused([](Scene& s) { s.material.youngs_modulus = 0.0; }, "Young");
     refused([](Scene& s) { s.material.youngs_modulus = INFINITY; }, "Young");
     refused([](Scene& s) { s.material.density = -1.0; }, "density");
