@@ -66,7 +66,7 @@
 
 namespace fem::fig {
 
-const int figure_code_version = 4;  // bump it when a figure's look changes (figures.hpp)
+const int figure_code_version = 5;  // bump it when a figure's look changes (figures.hpp)
 
 namespace {
 
@@ -263,32 +263,57 @@ std::string superscript(int n)
     return out;
 }
 
-/// The labels of one axis's ticks (round values: a few significant digits), in one notation as a
-/// person writes them: plain (0.002, 50000) when every nonzero tick lies in [0.001, 100000), else
-/// powers of ten for all (10⁻⁶, 2·10⁻⁵, 1.5·10⁵), never a mix of the two.
+}  // namespace
+
 std::vector<std::string> tick_labels(const std::vector<double>& values)
 {
     const bool plain = std::all_of(values.begin(), values.end(), [](double v) {
         return v == 0.0 || (std::abs(v) >= 1e-3 * (1 - 1e-9) && std::abs(v) < 1e5);
     });
-    const auto digits = [](double value, int significant) {  // no trailing zeros
+    const auto digits = [](double value, int significant) {  // no trailing zeros, no sign
         std::ostringstream out;
-        out << std::setprecision(significant) << value;
+        out << std::setprecision(significant) << std::abs(value);
         return out.str();
     };
     std::vector<std::string> labels;
     for (double value : values) {
+        const std::string sign = value < 0.0 ? "\u2212" : "";
         if (plain || value == 0.0) {
-            labels.push_back(digits(value, 6));  // 6 digits: 10000 stays 10000, not 1e+04
+            labels.push_back(sign + digits(value, 6));  // 6 digits: 10000 stays 10000, not 1e+04
             continue;
         }
         const int exponent = static_cast<int>(std::floor(std::log10(std::abs(value)) + 1e-9));
         const std::string mantissa = digits(value / std::pow(10.0, exponent), 4);
-        labels.push_back((mantissa == "1" ? std::string() : mantissa == "-1" ? std::string("\u2212") : mantissa + "\u00B7") +
-                         "10" + superscript(exponent));
+        labels.push_back(sign + (mantissa == "1" ? std::string() : mantissa + "\u00B7") + "10" + superscript(exponent));
     }
     return labels;
 }
+
+double percentile(std::vector<double> values, double percent)
+{
+    if (values.empty() || !(percent > 0.0 && percent <= 100.0))
+        throw Error(str("percentile: need at least one value and a percent in (0, 100], got ", values.size(),
+                        " values and ", percent));
+    const auto rank = static_cast<std::size_t>(std::ceil(percent / 100.0 * static_cast<double>(values.size())));
+    const auto at = values.begin() + static_cast<std::ptrdiff_t>(std::clamp<std::size_t>(rank, 1, values.size()) - 1);
+    std::nth_element(values.begin(), at, values.end());
+    return *at;
+}
+
+std::string clip_note(double percent, double largest, const std::string& unit)
+{
+    std::ostringstream p;
+    p << percent;
+    const int last = static_cast<int>(percent) % 10, tens = static_cast<int>(percent) % 100 / 10;
+    const bool whole = percent == std::floor(percent);
+    const char* suffix = !whole || tens == 1 ? "th" : last == 1 ? "st" : last == 2 ? "nd" : last == 3 ? "rd" : "th";
+    std::ostringstream rounded;  // 3 significant digits, then written as an axis writes it
+    rounded << std::setprecision(3) << largest;
+    return str("clipped at the ", p.str(), suffix, " percentile\nmax ", tick_labels({std::stod(rounded.str())}).front(),
+               unit.empty() ? "" : " " + unit);
+}
+
+namespace {
 
 /// Ticks at round values over [low, high] on a linear axis: the multiples of the step 1, 2, 2.5 or
 /// 5 times a power of ten that gives at most 8 of them, labelled by tick_labels (VTK's own choice
@@ -568,12 +593,46 @@ io::MeshData cut_away(const io::MeshData& mesh, const CutPlane& plane)
     return out;
 }
 
+/// A colour bar's labels, written by us rather than by VTK (whose printf format has no true minus
+/// sign: "-0.5"): the bar, the renderer its labels go to, the values to label and the bar's range.
+/// Where the bar's colour strip lies is known only after a render (render_with_labels).
+struct BarLabels {
+    vtkSmartPointer<vtkScalarBarActor> bar;  // nullptr: no colour bar (a categorical field)
+    vtkSmartPointer<vtkRenderer> texts;
+    std::vector<double> ticks;
+    double low = 0.0, high = 1.0;
+    int font_size = 15;
+};
+
+/// Renders window, then writes labels' values (tick_labels) beside its colour strip, each centred
+/// on its value's height, and renders again.
+void render_with_labels(vtkRenderWindow* window, const BarLabels& labels)
+{
+    window->Render();
+    if (!labels.bar)
+        return;
+    int strip[4];  // x, y, width, height in pixels
+    labels.bar->GetScalarBarRect(strip, labels.texts);
+    const std::vector<std::string> texts = tick_labels(labels.ticks);
+    for (std::size_t k = 0; k < labels.ticks.size(); ++k) {
+        const double at = labels.high > labels.low ? (labels.ticks[k] - labels.low) / (labels.high - labels.low) : 0.5;
+        auto label = vtkSmartPointer<vtkTextActor>::New();
+        label->SetInput(texts[k].c_str());
+        set_font(label->GetTextProperty(), labels.font_size);
+        label->GetTextProperty()->SetVerticalJustificationToCentered();
+        label->SetPosition(strip[0] + strip[2] + 0.4 * labels.font_size, strip[1] + at * strip[3]);
+        labels.texts->AddActor2D(label);
+    }
+    window->Render();
+}
+
 /// Adds to window the renderers that draw a data set's surface coloured by a field: a white
 /// backdrop, the data (lit and framed as options say) and the texts (title, colour bar or legend).
 /// A mesh (lit = true) is lit by a key, a fill and a back light, with ambient light so that no face
 /// is black, and shows its edges if asked; a flat grid is drawn unlit, in the colour map's own
-/// colours. The PNGs and an on-screen MeshWindow share it, so they show the same picture.
-void add_renderers(vtkRenderWindow* window, vtkDataSet* data, bool cell_field, bool lit, const RenderOptions& options)
+/// colours. The PNGs and an on-screen MeshWindow share it, so they show the same picture; draw it
+/// with render_with_labels, which writes the colour bar's labels.
+BarLabels add_renderers(vtkRenderWindow* window, vtkDataSet* data, bool cell_field, bool lit, const RenderOptions& options)
 {
     vtkNew<vtkDataSetSurfaceFilter> surface;
     surface->SetInputData(data);
@@ -586,6 +645,21 @@ void add_renderers(vtkRenderWindow* window, vtkDataSet* data, bool cell_field, b
     array->GetRange(range, component);
     if (options.range)
         std::tie(range[0], range[1]) = *options.range;
+    std::string clipped;  // the bar's note when its top is clipped
+    if (!options.range && options.clip_percentile < 100.0 && options.categories.empty()) {
+        std::vector<double> shown(static_cast<std::size_t>(array->GetNumberOfTuples()));
+        for (vtkIdType i = 0; i < array->GetNumberOfTuples(); ++i) {
+            double magnitude = 0.0;
+            for (int c = 0; c < array->GetNumberOfComponents(); ++c)
+                magnitude += array->GetComponent(i, c) * array->GetComponent(i, c);
+            shown[static_cast<std::size_t>(i)] = component < 0 ? std::sqrt(magnitude) : array->GetComponent(i, component);
+        }
+        const double top = percentile(shown, options.clip_percentile);
+        if (top < range[1] && top > range[0]) {
+            clipped = clip_note(options.clip_percentile, range[1], options.unit);
+            range[1] = top;
+        }
+    }
 
     const int s = options.scale;
     vtkNew<vtkPolyDataMapper> mapper;
@@ -643,13 +717,16 @@ void add_renderers(vtkRenderWindow* window, vtkDataSet* data, bool cell_field, b
     // that a long field name is never cut to the bar's width); a categorical one a row of swatches
     // along the bottom instead.
     std::vector<vtkSmartPointer<vtkActor2D>> keys;
+    BarLabels bar_labels;
     if (options.categories.empty()) {
-        // Labels at round values (1, 2, 2.5 or 5 times a power of ten), printed as %g prints them:
-        // 2000, 0.0035, never "665." or "2.66e+03".
+        // Labels at round values (1, 2, 2.5 or 5 times a power of ten), written by tick_labels
+        // (2000, 0.0035, −0.5; never "665." or "2.66e+03") in render_with_labels; VTK lays the
+        // bar out for its own labels of the same values, drawn transparent, so the room is kept.
         auto bar = vtkSmartPointer<vtkScalarBarActor>::New();
         bar->SetLookupTable(colours);
         vtkNew<vtkDoubleArray> ticks;
-        for (double tick : round_ticks(range[0], range[1]))
+        bar_labels.ticks = round_ticks(range[0], range[1]);
+        for (double tick : bar_labels.ticks)
             ticks->InsertNextValue(tick);
         bar->SetUseCustomLabels(true);
         bar->SetCustomLabels(ticks);
@@ -659,10 +736,19 @@ void add_renderers(vtkRenderWindow* window, vtkDataSet* data, bool cell_field, b
         bar->SetPosition(0.88, 0.08);
         bar->UnconstrainedFontSizeOn();
         set_font(bar->GetLabelTextProperty(), 15 * s);
+        bar->GetLabelTextProperty()->SetOpacity(0.0);
         keys.push_back(bar);
+        bar_labels.bar = bar;
+        bar_labels.low = range[0];
+        bar_labels.high = range[1];
+        bar_labels.font_size = 15 * s;
         const std::string name = options.unit.empty() ? options.field : str(options.field, " [", options.unit, "]");
         auto bar_title = vtkSmartPointer<vtkTextActor>::New();
-        bar_title->SetInput((options.range_note.empty() ? name : name + "\n" + options.range_note).c_str());
+        std::string bar_text = name;
+        for (const std::string& note : {options.range_note, clipped})
+            if (!note.empty())
+                bar_text += "\n" + note;
+        bar_title->SetInput(bar_text.c_str());
         set_font(bar_title->GetTextProperty(), 17 * s, true);
         bar_title->GetTextProperty()->SetJustificationToRight();
         bar_title->GetTextProperty()->SetVerticalJustificationToBottom();
@@ -700,7 +786,9 @@ void add_renderers(vtkRenderWindow* window, vtkDataSet* data, bool cell_field, b
     const bool bar_strip = options.categories.empty();
     // An outline gets a renderer of its own under the data's (same viewport and camera): the body,
     // drawn on the layer above, covers it wherever the two overlap, so it shows only around the body.
-    vtkNew<vtkRenderer> backdrop, beneath, renderer, texts;
+    vtkNew<vtkRenderer> backdrop, beneath, renderer;
+    auto texts = vtkSmartPointer<vtkRenderer>::New();
+    bar_labels.texts = texts;
     backdrop->SetBackground(1.0, 1.0, 1.0);
     renderer->SetBackground(1.0, 1.0, 1.0);
     renderer->SetViewport(0.0, 0.0, bar_strip ? 0.84 : 1.0, 1.0);
@@ -753,6 +841,7 @@ void add_renderers(vtkRenderWindow* window, vtkDataSet* data, bool cell_field, b
         window->AddRenderer(beneath);
     window->AddRenderer(renderer);
     window->AddRenderer(texts);
+    return bar_labels;
 }
 
 /// Draws a data set's surface coloured by a field into a PNG (add_renderers, offscreen).
@@ -763,8 +852,7 @@ bool render_dataset(const std::filesystem::path& path, vtkDataSet* data, bool ce
     window->SetDisplayId(shared_display());
     window->SetOffScreenRendering(1);
     window->SetSize(options.width * options.scale, options.height * options.scale);
-    add_renderers(window, data, cell_field, lit, options);
-    window->Render();
+    render_with_labels(window, add_renderers(window, data, cell_field, lit, options));
     write_png(window, path);
     return true;
 }
@@ -1056,8 +1144,7 @@ void MeshWindow::show(const io::MeshData& mesh, const RenderOptions& options)
 {
     const auto [grid, cell_field] = drawable(mesh, options);
     impl_->window->GetRenderers()->RemoveAllItems();
-    add_renderers(impl_->window, grid, cell_field, true, options);
-    impl_->window->Render();
+    render_with_labels(impl_->window, add_renderers(impl_->window, grid, cell_field, true, options));
 }
 
 std::string MeshWindow::poll_keys()

@@ -50,6 +50,23 @@ struct Series {
 /// way, its texts, lines and markers scaled alike, so the layout the callers chose stays.
 inline constexpr int pixel_scale = 2;
 
+/// The labels of one axis's ticks (round values: a few significant digits), in one notation as a
+/// person writes them: plain (0.002, 50000) when every nonzero tick lies in [0.001, 100000), else
+/// powers of ten for all (10⁻⁶, 2·10⁻⁵, 1.5·10⁵), never a mix of the two; a negative value gets a
+/// true minus sign (U+2212: −0.002, −2·10⁻⁶), as wide as the plus, never a hyphen.
+/// values: n tick values; returns n labels, in the same order.
+std::vector<std::string> tick_labels(const std::vector<double>& values);
+
+/// The nearest-rank percentile of values: the smallest value with at least `percent` percent of
+/// them at or below it (percent in (0, 100]; 100 gives the largest). values: n ≥ 1 numbers in any
+/// order. fem::Error for no values or a percent outside (0, 100].
+double percentile(std::vector<double> values, double percent);
+
+/// The lines a clipped colour bar carries under its title: "clipped at the 99th percentile" and
+/// "max 66500 Pa" (percent as clip_percentile; largest the field's largest value, rounded to 3
+/// significant digits and written as tick_labels writes it; unit may be empty).
+std::string clip_note(double percent, double largest, const std::string& unit);
+
 /// A corner of a chart's plot area, where its legend may go.
 enum class Corner { top_left, top_right, bottom_left, bottom_right };
 
@@ -60,8 +77,9 @@ struct LineChart {
     bool log_x = false;
     bool log_y = false;
     std::vector<Series> series;
-    int width = 900;   ///< layout pixels (the PNG has pixel_scale times as many)
-    int height = 650;
+    /// Layout pixels (the PNG has pixel_scale times as many): 16:9, 1920 × 1080 pixels, a full slide.
+    int width = 960;
+    int height = 540;
     /// The corner the legend goes to if no line or marker passes there; otherwise the first free
     /// one of top right, top left, bottom right, bottom left; if none is free, the y range grows
     /// until the legend fits above or below the data. A legend never covers data.
@@ -98,6 +116,12 @@ struct RenderOptions {
     std::string range_note;            ///< a line under the bar's title, e.g. "range of all 121 frames"
     int component = -1;                ///< -1: the magnitude for vectors, the value for scalars
     std::optional<std::pair<double, double>> range;  ///< colour range; default: the field's range
+    /// Without a range given: the colour range's top at this percentile of the field's values (e.g.
+    /// 99) instead of their largest, so that a few spikes (the stress in the tets at a pinned
+    /// corner) do not set the scale and leave the rest of the body one dark colour. Values above
+    /// it take the top colour, and the colour bar says it is clipped and gives the largest value.
+    /// 100: the full range.
+    double clip_percentile = 100.0;
     std::array<double, 3> view_direction{0.0, 0.0, -1.0};  ///< camera looks along this direction
     std::array<double, 3> view_up{0.0, 1.0, 0.0};
     bool show_edges = true;            ///< draw a mesh's edges (grids never show theirs)

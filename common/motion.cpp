@@ -94,6 +94,7 @@ int MotionRecorder::render_png_frames(const std::filesystem::path& stem, const f
         box[2 * axis + 1] = -std::numeric_limits<double>::infinity();
     }
     double low = std::numeric_limits<double>::infinity(), high = -low;
+    std::vector<double> pooled;  // every shown value of the kept frames, for a clipped range
     for (const auto& [time, mesh] : deformed) {
         for (int axis = 0; axis < 3; ++axis) {
             box[2 * axis] = std::min(box[2 * axis], mesh.points.col(axis).minCoeff());
@@ -105,6 +106,9 @@ int MotionRecorder::render_png_frames(const std::filesystem::path& stem, const f
                                           : Eigen::VectorXd(values.col(options.component));
         low = std::min(low, values.cols() == 1 ? values.minCoeff() : shown.minCoeff());
         high = std::max(high, values.cols() == 1 ? values.maxCoeff() : shown.maxCoeff());
+        if (options.clip_percentile < 100.0)
+            for (Eigen::Index i = 0; i < values.rows(); ++i)
+                pooled.push_back(values.cols() == 1 ? values(i, 0) : shown(i));
     }
     if (!shared.range) {
         const auto all = field_ranges_.find(options.field);
@@ -113,6 +117,14 @@ int MotionRecorder::render_png_frames(const std::filesystem::path& stem, const f
         shared.range = whole_run ? all->second : std::make_pair(low, high);
         if (whole_run && shared.range_note.empty() && added_ > kept_.size())
             shared.range_note = str("range of all ", added_, " frames");
+        // Clipped: the top at the percentile of the kept frames' values, pooled (the percentile
+        // needs the values; the whole run keeps only its range).
+        const double top = pooled.empty() ? shared.range->second : fig::percentile(pooled, options.clip_percentile);
+        if (top < shared.range->second && top > shared.range->first) {
+            const std::string note = fig::clip_note(options.clip_percentile, shared.range->second, options.unit);
+            shared.range_note = shared.range_note.empty() ? note : shared.range_note + "\n" + note;
+            shared.range->second = top;
+        }
     }
     if (warp_scale != 1.0 && !shared.outline) {
         shared.outline = kept_.front().second;  // its points are the rest positions

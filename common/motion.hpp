@@ -54,7 +54,9 @@ public:
     /// <stem>_0000.png, …: one camera framing the union of the deformed bodies' bounds (unless
     /// options.frame_bounds is set), and one colour range for options.field over all kept frames
     /// (unless options.range is set); the range of a scalar field or a vector's magnitude is taken
-    /// over every frame added, not only the kept ones, and the colour bar says so. The title is
+    /// over every frame added, not only the kept ones, and the colour bar says so. With
+    /// options.clip_percentile < 100 the range's top is that percentile of the kept frames' values
+    /// (all of them pooled), and the bar says it is clipped and gives the whole run's largest value. The title is
     /// frame_title's; when warp_scale ≠ 1 the rest shape is drawn faint behind the body (unless
     /// options.outline is set). Returns the number of
     /// PNGs written (0 without a display, after can_draw's note, see figures.hpp). fem::Error if the field is missing from

@@ -144,7 +144,9 @@ void rotation_study(const RunContext& run, const Lame& material)
     table.print(std::cout);
     table.write_csv(run.file("rotation_table.csv"));
     fig::LineChart chart{"Strain of a rigidly rotated tet", "rotation angle [degrees]", "|strain| (Frobenius)", true,
-                         true, {{"linear strain", angles, linear}, {"theta^2 / sqrt2 (small angles)", angles, small_angle},
+                         true, {{"linear strain", angles, linear},
+                                // dashed: up to 45 degrees it lies on the linear strain
+                                {"theta^2 / sqrt2 (small angles)", angles, small_angle, false, true},
                                 {"Green strain (round-off)", angles, green}}};
     fig::save_chart(chart, run.out_dir / "rotation_strain", run.figures);
 }
@@ -314,6 +316,7 @@ void twisted_beam_study(const RunContext& run, const Settings& settings, const L
               std::tuple{"vM Green", "twisted_beam_green.png", "Green strain"}}) {
             fig::RenderOptions options;
             options.field = field;
+            options.unit = "Pa";
             options.title = str("beam twisted by ", settings.twist, " degrees: von Mises stress [Pa] from ", what);
             options.range = std::make_pair(0.0, top);
             options.view_direction = {-0.45, 0.75, -0.5};

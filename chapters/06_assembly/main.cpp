@@ -463,12 +463,14 @@ void beam(const RunContext& run, const elastic::Lame& material, const Settings& 
     options.view_up = {0.0, 0.0, 1.0};
     options.height = 520;
     options.field = "lumped mass";
+    options.unit = "kg";
     options.title = "lumped vertex masses m_v = sum of rho V / 4 over the tets at v [kg],\ncut open at y = "
                     + str(side / 2) + " m";
     options.cut = fig::CutPlane{{0.0, side / 2, 0.0}, {0.0, -1.0, 0.0}};
     fig::render_mesh_png(run.file("beam_masses.png"), data, options);
     options.cut.reset();
     options.field = "displacement";
+    options.unit = "m";
     options.title = "clamped beam sagging under gravity (true scale): |u| [m]";
     fig::render_mesh_png(run.file("beam_sag.png"), io::warped(data), options);
     std::cout << "\nbeam.vtu: " << mesh.T.rows() << " tets with lumped and consistent masses, gravity forces "

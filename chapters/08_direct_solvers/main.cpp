@@ -778,6 +778,7 @@ void box_under_gravity(const RunContext& run)
         options.view_direction = {0.4, 1.0, -0.3};
         options.view_up = {0.0, 0.0, 1.0};
         options.field = "displacement";
+        options.unit = "m";
         options.title = "rubber cube clamped at x = 0, sagging under gravity (true scale): |u| [m]";
         options.height = 620;
         fig::render_mesh_png(run.file("box_displacement.png"), io::warped(data), options);

@@ -842,6 +842,7 @@ void box_picture(const RunContext& run, const Settings& settings)
     options.title =
         str("clamped box sagging under its weight (true scale, ", figure_label(solver->name()), "): |u| [m]");
     options.field = "displacement";
+    options.unit = "m";
     options.view_direction = {0.5, 1.0, -0.6};
     options.view_up = {0.0, 0.0, 1.0};
     options.height = 560;

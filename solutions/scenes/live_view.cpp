@@ -20,6 +20,15 @@ std::string unit_of(const std::string& field)
     return field == "displacement" ? "m" : field == "velocity" ? "m/s" : field == "von Mises stress" ? "Pa" : "";
 }
 
+/// The percentile a frame field's colour range is clipped at (RenderOptions::clip_percentile): the
+/// stress at 99, as it concentrates in the few tets at a pin or a contact, whose peak would set the
+/// scale and leave the rest of the body one colour (the hanging cube's corners: 6.65·10⁴ Pa); the
+/// others at 100 (not clipped).
+double clip_percentile_of(const std::string& field)
+{
+    return field == "von Mises stress" ? 99.0 : 100.0;
+}
+
 }  // namespace
 
 fig::RenderOptions frame_view(const SceneSpec& scene)
@@ -29,6 +38,7 @@ fig::RenderOptions frame_view(const SceneSpec& scene)
     view.title = scene.title;
     view.field = out.colour;
     view.unit = unit_of(out.colour);
+    view.clip_percentile = clip_percentile_of(out.colour);
     view.view_direction = {out.view_direction.x(), out.view_direction.y(), out.view_direction.z()};
     view.view_up = {out.view_up.x(), out.view_up.y(), out.view_up.z()};
     view.width = out.width;
@@ -65,6 +75,7 @@ void LiveView::frame(const io::MeshData& frame, int step, double time)
         fig::RenderOptions view = frame_view(scene_);
         view.field = fields_[field_];
         view.unit = unit_of(view.field);
+        view.clip_percentile = clip_percentile_of(view.field);
         if (field_ != 0)
             view.range.reset();  // the fixed range belongs to the scene's colour field
         view.title = frame_title(scene_, time);

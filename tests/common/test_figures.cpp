@@ -11,6 +11,7 @@
 #include <vtkPNGReader.h>
 #include <vtkPointData.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <fstream>
@@ -25,6 +26,8 @@ struct PngSummary {
     int width = 0, height = 0;
     std::size_t colours = 0;
     std::size_t marked_edge_pixels = 0;
+    std::size_t text_pixels_right = 0;  ///< dark grey (text) pixels in the colour bar's label column
+    std::size_t low_end_pixels = 0;     ///< pixels in viridis' purple low end (blue well above green)
 };
 
 PngSummary read_png(const std::filesystem::path& path)
@@ -49,6 +52,14 @@ PngSummary read_png(const std::filesystem::path& path)
         const bool at_edge = x < 4 || y < 4 || x >= dims[0] - 4 || y >= dims[1] - 4;
         if (at_edge && rgb != 0xFFFFFF)
             ++summary.marked_edge_pixels;
+        // The labels of a colour bar: right of its strip (x ≥ 0.93 of the width, the strip ends
+        // at about 0.92), over the strip's height (0.08 to 0.80 of the height, under its title).
+        const double r = pixels->GetComponent(i, 0), g = pixels->GetComponent(i, 1), b = pixels->GetComponent(i, 2);
+        const bool label_column = x >= 0.93 * dims[0] && y >= 0.08 * dims[1] && y <= 0.8 * dims[1];
+        if (label_column && std::max({r, g, b}) < 90 && std::max({r, g, b}) - std::min({r, g, b}) < 10)
+            ++summary.text_pixels_right;
+        if (b > g + 40 && r > g)
+            ++summary.low_end_pixels;
     }
     summary.colours = colours.size();
     return summary;
@@ -96,6 +107,7 @@ TEST_CASE("a log-log chart is saved as CSV always and as PNG when a display exis
         const auto png = read_png(dir / "errors.png");
         CHECK(png.width == chart.width * fem::fig::pixel_scale);  // slide resolution
         CHECK(png.height == chart.height * fem::fig::pixel_scale);
+        CHECK((png.width == 1920 && png.height == 1080));  // by default a full 16:9 slide
         CHECK(figure_version(dir / "errors.png") == fem::fig::figure_code_version);
         std::ifstream svg(dir / "errors.svg");  // the vector twin, with the series' names as text
         const std::string text((std::istreambuf_iterator<char>(svg)), std::istreambuf_iterator<char>());
@@ -144,8 +156,48 @@ TEST_CASE("a mesh coloured by a field renders with its scalar bar", "[common][fi
         CHECK(png.width == options.width * options.scale);
         CHECK(figure_version(dir / "square.png") == fem::fig::figure_code_version);
         CHECK(png.colours > 50);  // a colour ramp, not a flat fill
+        CHECK(png.text_pixels_right > 100);  // the bar's labels are written (VTK's own are transparent)
     }
+
+    // One spike sets the scale: nearly the whole square takes the low end's purple, unless the
+    // range is clipped at a percentile, which spreads the colours over the rest again.
+    mesh.point_data[0].values(n * n / 2 + n / 2) = 1e3;
+    const bool spiked = fem::fig::render_mesh_png(dir / "spike.png", mesh, options);
+    options.clip_percentile = 90.0;
+    fem::fig::render_mesh_png(dir / "spike_clipped.png", mesh, options);
+    if (spiked) {
+        const auto full = read_png(dir / "spike.png"), clipped = read_png(dir / "spike_clipped.png");
+        CHECK(clipped.low_end_pixels * 3 < full.low_end_pixels);
+    }
+    options.clip_percentile = 100.0;
     options.field = "no_such_field";
     CHECK_THROWS_AS(fem::fig::render_mesh_png(dir / "bad.png", mesh, options), fem::Error);
     CHECK_FALSE(std::filesystem::exists(dir / "bad.png"));
+}
+
+TEST_CASE("tick labels: one notation per axis, a true minus sign for negative values", "[common][figures]")
+{
+    using fem::fig::tick_labels;
+    const std::string minus = "\u2212";
+    CHECK(tick_labels({-0.5, 0.0, 0.5}) == std::vector<std::string>{minus + "0.5", "0", "0.5"});
+    CHECK(tick_labels({-2e-3, 1e-3}) == std::vector<std::string>{minus + "0.002", "0.001"});
+    // powers of ten for all when one tick is outside [0.001, 100000): the sign before the mantissa
+    CHECK(tick_labels({-2e-6, 0.0, 1e-6}) ==
+          std::vector<std::string>{minus + "2\u00B710\u207B\u2076", "0", "10\u207B\u2076"});
+    CHECK(tick_labels({-1e5, 1.5e5}) == std::vector<std::string>{minus + "10\u2075", "1.5\u00B710\u2075"});
+    for (const std::string& label : tick_labels({-3.0, -2e-7, -4e8}))
+        CHECK(label.find('-') == std::string::npos);  // never a hyphen
+}
+
+TEST_CASE("percentiles and the note of a clipped colour bar", "[common][figures]")
+{
+    using fem::fig::percentile;
+    CHECK(percentile({5, 1, 3, 2, 4}, 100) == 5);
+    CHECK(percentile({5, 1, 3, 2, 4}, 60) == 3);  // 3 of 5 values at or below it
+    CHECK(percentile({5, 1, 3, 2, 4}, 1) == 1);
+    CHECK_THROWS_AS(percentile({}, 50), fem::Error);
+    CHECK_THROWS_AS(percentile({1.0}, 0), fem::Error);
+    CHECK_THROWS_AS(percentile({1.0}, 101), fem::Error);
+    CHECK(fem::fig::clip_note(99, 66512.3, "Pa") == "clipped at the 99th percentile\nmax 66500 Pa");
+    CHECK(fem::fig::clip_note(92, 2.04e-6, "m") == "clipped at the 92nd percentile\nmax 2.04\u00B710\u207B\u2076 m");
 }
