@@ -80,6 +80,16 @@ io::MeshData body_frame(const Body& body, const State& state);
 /// T, U and W of a state (see Energies). docs/10_linear_dynamics.md#energy
 Energies energies(const Body& body, const State& state);
 
+/// The energy one θ-step of an undamped linear body takes out of H = T + U + W by itself (the
+/// integrator's dissipation, a derivation exercise):
+///     H − H⁺ = (θ − ½) [(v⁺ − v)ᵀ M (v⁺ − v) + (u⁺ − u)ᵀ K (u⁺ − u)]  [J],
+/// ≥ 0 for θ ≥ ½ and M, K positive semi-definite, zero for the midpoint rule; a constant load does
+/// not change it. M, K: n×n; u, u_next, v, v_next: n each (the state before and after the step).
+/// fem::Error for θ outside [½, 1] or mismatched sizes. docs/10_linear_dynamics.md#energy
+double theta_step_dissipation(const SparseMatrix& M, const SparseMatrix& K, const Eigen::VectorXd& u,
+                              const Eigen::VectorXd& u_next, const Eigen::VectorXd& v, const Eigen::VectorXd& v_next,
+                              double theta);
+
 // --- The teaching pieces of the implicit step (exercises) -------------------------------------
 
 /// The matrix of the θ-step, A = M + θΔt D + θ²Δt² K with D = α M + β K, i.e.

@@ -115,6 +115,27 @@ Energies energies(const Body& body, const State& state)
     return e;
 }
 
+double theta_step_dissipation(const SparseMatrix& M, const SparseMatrix& K, const Eigen::VectorXd& u,
+                              const Eigen::VectorXd& u_next, const Eigen::VectorXd& v, const Eigen::VectorXd& v_next,
+                              double theta)
+{
+    require_theta(theta);
+    const Eigen::Index n = M.rows();
+    if (M.cols() != n || K.rows() != n || K.cols() != n || u.size() != n || u_next.size() != n || v.size() != n ||
+        v_next.size() != n)
+        throw Error(str("theta_step_dissipation: M (", M.rows(), "x", M.cols(), "), K (", K.rows(), "x", K.cols(),
+                        "), u, u+, v, v+ (", u.size(), ", ", u_next.size(), ", ", v.size(), ", ", v_next.size(),
+                        ") must be of one size"));
+    double dissipated = 0.0;
+    // BEGIN EXERCISE 10.10 theta_step_dissipation #energy
+    // HINT: multiply the step M (v⁺ − v) = −Δt K u_θ by v_θᵀ, use u⁺ − u = Δt v_θ and write
+    // HINT: v_θ = ½(v⁺ + v) + (θ − ½)(v⁺ − v), u_θ likewise; the ½(v⁺ + v) parts give H⁺ − H.
+    const Eigen::VectorXd du = u_next - u, dv = v_next - v;
+    dissipated = (theta - 0.5) * (dv.dot(M * dv) + du.dot(K * du));
+    // END EXERCISE
+    return dissipated;
+}
+
 SparseMatrix step_matrix(const SparseMatrix& M, const SparseMatrix& K, const Damping& damping, double time_step,
                          double theta)
 {

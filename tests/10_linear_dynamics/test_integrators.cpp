@@ -9,6 +9,7 @@
 
 #include <Eigen/SparseCholesky>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 
@@ -382,4 +383,45 @@ TEST_CASE("integrators by name, and steps that refuse bad input", "[ch10]")
     CHECK_THROWS_WITH(integrator.step(body, 0.01, wrong), Contains("does not fit"));
     Simulation simulation(body, integrator, state);
     CHECK_THROWS_AS(simulation.run(-1), fem::Error);
+}
+
+TEST_CASE("theta_step_dissipation: the energy each theta-step takes out of an undamped body, step by step",
+          "[ex10.10]")
+{
+    // The independent answer: H before minus H after each step, H = ½ vᵀMv + U + W summed here
+    // from the state (not by energies()), on a loaded beam falling from rest.
+    Body body(cantilever_scene(6, 2, true));
+    const SparseMatrix& M = body.mass_matrix();
+    const Eigen::VectorXd& f_ext = body.external_forces();
+    const auto total = [&](const State& state) {
+        return kinetic_energy(M, state.v) + state.elastic_energy + load_potential(f_ext, state.u);
+    };
+    for (const double theta : {1.0, 0.75, 0.5}) {
+        ThetaMethod integrator(theta);
+        State state = initial_state(body);
+        const SparseMatrix K = body.model().stiffness(state.u);
+        double booked = 0.0, measured = 0.0, scale = 0.0;
+        for (int step = 0; step < 40; ++step) {
+            const State before = state;
+            integrator.step(body, 0.01, state);
+            const double loss = total(before) - total(state);
+            const double derived = theta_step_dissipation(M, K, before.u, state.u, before.v, state.v, theta);
+            scale = std::max({scale, kinetic_energy(M, state.v), std::abs(load_potential(f_ext, state.u))});
+            CAPTURE(theta, step, fem::test::sci(loss), fem::test::sci(derived));
+            CHECK(derived == Approx(loss).margin(1e-9 * scale));
+            CHECK(derived >= 0.0);
+            booked += derived;
+            measured += loss;
+        }
+        CAPTURE(theta, fem::test::sci(booked), fem::test::sci(measured), fem::test::sci(scale));
+        CHECK(booked == Approx(measured).margin(1e-9 * scale));
+        if (theta > 0.5)
+            CHECK(booked > 1e-3 * scale);  // backward Euler and θ = ¾ lose a visible share
+        else
+            CHECK(booked == 0.0);          // the midpoint rule loses nothing
+    }
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(M.rows());
+    const SparseMatrix K = body.model().stiffness(zero);
+    CHECK_THROWS_AS(theta_step_dissipation(M, K, zero, zero, zero, zero, 0.4), fem::Error);
+    CHECK_THROWS_AS(theta_step_dissipation(M, K, zero, zero, zero, Eigen::VectorXd::Zero(3), 1.0), fem::Error);
 }
