@@ -66,6 +66,13 @@ Eigen::Matrix3d best_fit_rotation(const Eigen::Matrix3d& S);
 /// both for skewed tets. docs/11_corotational.md#edges-centroid-or-polar-decomposition
 Eigen::Matrix3d polar_rotation(const Eigen::Matrix3d& F);
 
+/// The change δR of the polar rotation R = polar_rotation(F) when F changes by δF (a derivation
+/// exercise): with S = RᵀF (symmetric) and w the vector of the skew matrix RᵀδF − δFᵀR
+/// (w = (A₃₂ − A₂₃, A₁₃ − A₃₁, A₂₁ − A₁₂) for A = RᵀδF), ω = ((tr S) I − S)⁻¹ w and δR = R ω̂
+/// (ω̂ a = ω × a). Rᵀ δR is skew. fem::Error for a non-finite F or δF, or where (tr S) I − S is
+/// singular (two singular values of F zero: δR is unbounded). docs/11_corotational.md#the-derivative-of-r
+Eigen::Matrix3d polar_rotation_variation(const Eigen::Matrix3d& F, const Eigen::Matrix3d& dF);
+
 /// The same rotation as polar_rotation, by Higham's scaled Newton iteration on the polar factor:
 /// X₀ = F, X_{k+1} = ½(ζ_k X_k + ζ_k⁻¹ X_k⁻ᵀ), ζ_k = |det X_k|^(−1/3) while X_k is far from
 /// orthogonal (and det X_k not within 1 % of 1), 1 after; X⁻ᵀ from cross products of X's columns.

@@ -1,5 +1,6 @@
 // Best-fit rotations of a tet: the reflection fix, the covariances of the edge and centroid fits,
-// the SVD's best-fit rotation and the polar rotation of F (exercises 11.1–11.3).
+// the SVD's best-fit rotation and the polar rotation of F (exercises 11.1–11.3), and how that
+// rotation changes with F (exercise 11.8).
 // docs/11_corotational.md#the-best-fit-rotation
 #include "11_corotational/corotational.hpp"
 
@@ -7,6 +8,9 @@
 
 #include <Eigen/LU>
 #include <Eigen/SVD>
+
+#include <algorithm>
+#include <cmath>
 
 namespace fem::corot {
 
@@ -61,6 +65,33 @@ Eigen::Matrix3d polar_rotation(const Eigen::Matrix3d& F)
     // HINT: F = U Σ Vᵀ = (U Vᵀ)(V Σ Vᵀ): the rotation is U Vᵀ, made proper by proper_rotation.
     return proper_rotation(svd.matrixU(), svd.matrixV());
     // END EXERCISE
+}
+
+Eigen::Matrix3d polar_rotation_variation(const Eigen::Matrix3d& F, const Eigen::Matrix3d& dF)
+{
+    if (!dF.allFinite())
+        throw Error("polar rotation variation: dF has a non-finite entry");
+    const Eigen::Matrix3d R = polar_rotation(F);
+    const Eigen::Matrix3d RtF = R.transpose() * F;
+    const Eigen::Matrix3d S = 0.5 * (RtF + RtF.transpose());
+    const Eigen::Matrix3d T = S.trace() * Eigen::Matrix3d::Identity() - S;
+    if (!(std::abs(T.determinant()) > 1e-12 * std::pow(std::max(F.norm(), 1e-300), 3)))
+        throw Error("polar rotation variation: (tr S) I - S is singular (F has two zero singular values): "
+                    "dR is unbounded");
+    Eigen::Matrix3d dR;
+    // BEGIN EXERCISE 11.8 polar_rotation_variation #the-derivative-of-r
+    // HINT: A = Rᵀ δF; w is the vector of A − Aᵀ: (A₃₂ − A₂₃, A₁₃ − A₃₁, A₂₁ − A₁₂) (0-based: (2,1), (0,2), (1,0)).
+    // HINT: Solve ((tr S) I − S) ω = w (T above), then δR = R ω̂ with ω̂ the cross-product matrix of ω.
+    const Eigen::Matrix3d A = R.transpose() * dF;
+    const Eigen::Vector3d w(A(2, 1) - A(1, 2), A(0, 2) - A(2, 0), A(1, 0) - A(0, 1));
+    const Eigen::Vector3d omega = T.partialPivLu().solve(w);
+    Eigen::Matrix3d omega_hat;
+    omega_hat << 0.0, -omega[2], omega[1],
+                 omega[2], 0.0, -omega[0],
+                 -omega[1], omega[0], 0.0;
+    dR = R * omega_hat;
+    // END EXERCISE
+    return dR;
 }
 
 }  // namespace fem::corot
