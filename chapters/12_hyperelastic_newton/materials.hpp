@@ -81,6 +81,15 @@ public:
     Matrix9d piola_derivative(const Eigen::Matrix3d& H) const override;
 };
 
+/// The change δP of neo-Hookean's first Piola stress for a change δF of F (a derivation exercise):
+/// with G = F⁻ᵀ and J = det F,
+///     δP = μ δF + (μ − λ ln J) G δFᵀ G + λ (G:δF) G,
+/// the directional derivative of P = μ(F − F⁻ᵀ) + λ ln J F⁻ᵀ along δF (what
+/// NeoHookean::piola_derivative gives as a 9×9 matrix). fem::Error for a non-finite F or δF, or
+/// det F ≤ 0. docs/12_hyperelastic_newton.md#neo-hookean
+Eigen::Matrix3d neo_hookean_stress_change(const elastic::Lame& lame, const Eigen::Matrix3d& F,
+                                          const Eigen::Matrix3d& dF);
+
 /// Stable neo-Hookean, the course's log-free variant of Smith, de Goes, Kim 2018 (not the paper's
 /// energy, which is PaperStableNeoHookean):
 /// ψ = (μ/2)(tr(FᵀF) − 3) − μ(J − 1) + (λ̂/2)(J − 1)², λ̂ = λ + μ (which makes it agree with linear

@@ -186,6 +186,25 @@ Matrix9d NeoHookean::piola_derivative(const Eigen::Matrix3d& H) const
     return dP;
 }
 
+Eigen::Matrix3d neo_hookean_stress_change(const elastic::Lame& lame, const Eigen::Matrix3d& F,
+                                          const Eigen::Matrix3d& dF)
+{
+    if (!F.allFinite() || !dF.allFinite())
+        throw Error("neo_hookean_stress_change: F and dF must be finite");
+    const double J = F.determinant();
+    if (!(J > 0.0))
+        throw Error(str("neo_hookean_stress_change: neo-Hookean is undefined for det F <= 0, got det F = ", J));
+    const Eigen::Matrix3d G = F.inverse().transpose();
+    const double mu = lame.mu, lambda = lame.lambda, log_J = std::log(J);
+    Eigen::Matrix3d dP;
+    // BEGIN EXERCISE 12.10 neo_hookean_stress_change #neo-hookean
+    // HINT: δ(F⁻ᵀ) = −G δFᵀ G and δ(ln J) = G:δF (Jacobi's formula, G:δF = Σ_ab G_ab δF_ab);
+    // HINT: differentiate P = μ(F − G) + λ ln J G term by term.
+    dP = mu * dF + (mu - lambda * log_J) * G * dF.transpose() * G + lambda * (G.cwiseProduct(dF).sum()) * G;
+    // END EXERCISE
+    return dP;
+}
+
 // --- stable neo-Hookean: the course's form and the paper's -----------------------------------------
 
 namespace {

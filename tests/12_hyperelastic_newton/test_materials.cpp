@@ -219,3 +219,37 @@ TEST_CASE("PSD projection: clamp or mirror the negative eigenvalues, leave a PSD
     const Matrix9d positive = StableNeoHookean(steel_like).piola_derivative(Eigen::Matrix3d::Zero());
     CHECK((project_to_psd<9>(positive, Projection::clamp) - positive).norm() <= 1e-9 * positive.norm());
 }
+
+TEST_CASE("neo_hookean_stress_change: dP along dF against finite differences of P written out", "[ex12.10]")
+{
+    // The independent answer: P = μ(F − F⁻ᵀ) + λ ln J F⁻ᵀ written here from F with Eigen's inverse
+    // (not the chapter's first_piola), differenced centrally along δF over a sweep of steps.
+    const elastic::Lame lame = steel_like;
+    const auto piola = [&](const Eigen::Matrix3d& F) -> Eigen::Matrix3d {
+        const Eigen::Matrix3d G = F.inverse().transpose();
+        return lame.mu * (F - G) + lame.lambda * std::log(F.determinant()) * G;
+    };
+    std::vector<Eigen::Matrix3d> samples;
+    for (unsigned seed = 1; seed <= 8; ++seed)
+        samples.push_back(random_deformation(seed));
+    const Eigen::Matrix3d R = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+    samples.push_back(1.3 * R);                                           // ln J ≠ 0, μ − λ ln J < 0
+    samples.push_back(R * Eigen::Vector3d(1.4, 0.9, 0.2).asDiagonal());  // strongly compressed
+    for (std::size_t k = 0; k < samples.size(); ++k) {
+        const Eigen::Matrix3d& F = samples[k];
+        const Eigen::Matrix3d dF = random_matrix(3, 3, 50 + static_cast<unsigned>(k));
+        const Eigen::Matrix3d dP = neo_hookean_stress_change(lame, F, dF);
+        double best = 1e300;
+        for (double h = 1e-3; h > 1e-9; h /= 10.0) {
+            const Eigen::Matrix3d fd = (piola(F + h * dF) - piola(F - h * dF)) / (2.0 * h);
+            best = std::min(best, (fd - dP).norm() / fd.norm());
+        }
+        CAPTURE(k, F.determinant(), best);
+        CHECK(best < 1e-7);
+    }
+    // Linear in δF, zero for δF = 0; refused where neo-Hookean is undefined.
+    const Eigen::Matrix3d F = random_deformation(3), dF = random_matrix(3, 3, 7);
+    CHECK(neo_hookean_stress_change(lame, F, 2.0 * dF).isApprox(2.0 * neo_hookean_stress_change(lame, F, dF), 1e-14));
+    CHECK(neo_hookean_stress_change(lame, F, Eigen::Matrix3d::Zero()).isZero(0.0));
+    CHECK_THROWS_AS(neo_hookean_stress_change(lame, Eigen::Vector3d(1.0, 1.0, -0.5).asDiagonal(), dF), Error);
+}
