@@ -6,14 +6,15 @@
 #include "common/parallel.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <csignal>
 #include <cstdlib>
 #include <exception>
 #include <fstream>
-#include <iomanip>
 #include <iostream>
 #include <iterator>
 #include <new>
@@ -35,18 +36,27 @@ bool parse_real(const std::string& text, double& value)
     return end == text.c_str() + text.size() && errno != ERANGE;
 }
 
+/// The shortest decimal text that reads back as x (std::to_chars): 1e+13, 0.499999995, 0.02.
+std::string shortest_text(double x)
+{
+    std::array<char, 32> text{};
+    const auto [end, error] = std::to_chars(text.data(), text.data() + text.size(), x);
+    return error == std::errc() ? std::string(text.data(), end) : str(x);
+}
+
 std::string interval_text(double low, double high, Ends ends)
 {
     const bool low_in = ends == Ends::closed || ends == Ends::closed_open;
     const bool high_in = ends == Ends::closed || ends == Ends::open_closed;
     if (std::isinf(low) && std::isinf(high))
         return "a finite number";
-    // 15 digits: a bound such as 0.499999995 must not print as 0.5.
+    // Every digit of a bound: 0.499999995 must not print as 0.5.
+    const std::string low_text = shortest_text(low), high_text = shortest_text(high);
     if (std::isinf(high))
-        return str(std::setprecision(15), "a finite number ", low_in ? ">= " : "> ", low);
+        return str("a finite number ", low_in ? ">= " : "> ", low_text);
     if (std::isinf(low))
-        return str(std::setprecision(15), "a finite number ", high_in ? "<= " : "< ", high);
-    return str(std::setprecision(15), "a number in ", low_in ? "[" : "(", low, ", ", high, high_in ? "]" : ")");
+        return str("a finite number ", high_in ? "<= " : "< ", high_text);
+    return str("a number in ", low_in ? "[" : "(", low_text, ", ", high_text, high_in ? "]" : ")");
 }
 
 }  // namespace

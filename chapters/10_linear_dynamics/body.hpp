@@ -71,7 +71,7 @@ struct Scene {
 constexpr double lowest_youngs_modulus = 1e-2, highest_youngs_modulus = 1e13;  // [Pa]
 constexpr double lowest_density = 1e-2, highest_density = 1e6;                // [kg/m³]
 
-/// The largest Poisson's ratio a body may have: λ/μ = 2ν/(1 − 2ν) ≤ 1e8, i.e. ν ≤ 0.5 − 1/(2(1e8 + 1))
+/// The largest Poisson's ratio a body may have: λ/μ = 2ν/(1 − 2ν) ≤ 1e8, i.e. ν ≤ 0.499999995
 /// ≈ 0.499999995. The condition number of the stiffness grows like λ/μ (times the mesh's own (L/h)²),
 /// and a double has 16 digits: at λ/μ = 1e8 a solve keeps about 8 before the mesh's factor; the sparse
 /// Cholesky of a 4×4×4-cell cube broke down (a pivot below n ε |a_jj|) at λ/μ ≈ 5e13. Long before, linear
@@ -79,7 +79,7 @@ constexpr double lowest_density = 1e-2, highest_density = 1e6;                //
 /// Newton may need a smaller Δt (its error says so): the hanging cube converges at ν = 0.49999999 with
 /// Δt = 1/600 s. docs/scenes.md#limits
 constexpr double largest_lame_ratio = 1e8;
-constexpr double highest_poisson_ratio = 0.5 - 0.5 / (largest_lame_ratio + 1.0);
+constexpr double highest_poisson_ratio = 0.499999995;  // λ/μ = 2ν/(1 − 2ν) = 1e8 (to 1e-8)
 
 /// fem::Error, naming the field and what is allowed, unless: the mesh is valid (indices, no
 /// zero-volume or inverted tet: fem::validate with Inverted::reject), Y > 0, −1 < ν ≤ highest_poisson_ratio, ρ > 0,

@@ -1,5 +1,6 @@
 // Study 6 of ch10_linear_dynamics: what a simulated second costs, four ways, on beams up to 36k
-// dofs; the prefactored step against its floor; SOFA's beam. docs/10_linear_dynamics.md#cost
+// dofs; the prefactored step against its floor and against other libraries' sparse Cholesky (peers,
+// like for like); SOFA's beam. docs/10_linear_dynamics.md#cost
 #include "10_linear_dynamics/modes.hpp"
 #include "10_linear_dynamics/studies.hpp"
 
@@ -9,14 +10,18 @@
 
 #include <cmath>
 #include <iostream>
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace fem::dynamics::study {
 namespace {
 
 /// Time per step of `integrator` on body, from rest under gravity: the best of `steps` steps after
-/// one first step (which prepares the matrix; its time is returned in first_step).
+/// one first step (which prepares the matrix; its time is returned in first_step). The state after
+/// the 1 + steps steps is left in `final_state` when given.
 double step_time(Body& body, Integrator& integrator, double time_step, int steps, double& first_step,
-                 double& iterations)
+                 double& iterations, State* final_state = nullptr)
 {
     State state = initial_state(body);
     Timer first;
@@ -30,6 +35,8 @@ double step_time(Body& body, Integrator& integrator, double time_step, int steps
         total_iterations += info.solver_iterations;
     }
     iterations = total_iterations / steps;
+    if (final_state != nullptr)
+        *final_state = std::move(state);
     return best;
 }
 
@@ -51,6 +58,19 @@ void cost_study(const RunContext& run, const Settings& settings)
                  {"floor [s]", Format::scientific, 2}, {"step, solve for dv [s]", Format::scientific, 2},
                  {"step, solve for v+ [s]", Format::scientific, 2}, {"dv step / floor [measured]", Format::fixed, 2},
                  {"v+ step / floor [measured]", Format::fixed, 2}});
+    // Peers, like for like: the same prefactored step (same beam, Δt, exact solve), only the
+    // factorization and the triangular solves from another library.
+    Table peers("Peers, like for like: the prefactored backward Euler step on the beam with each library's sparse "
+                "Cholesky (one core; the same steps from rest)",
+                {{"free dofs", Format::integer}, {"solver", Format::text}, {"factorization [s]", Format::scientific, 2},
+                 {"time per step [s]", Format::scientific, 2}, {"step / ours [measured]", Format::fixed, 2},
+                 {"max |u - u_ours| / max |u_ours| [round-off]", Format::scientific, 1}});
+    std::vector<std::pair<std::string, std::string>> peer_solvers{{"ours-cholesky", "ours (supernodal, ch08)"},
+                                                                  {"eigen-llt", "Eigen SimplicialLLT"}};
+    if (cg::cholmod_available())
+        peer_solvers.emplace_back("cholmod", "CHOLMOD supernodal LLT");
+    else
+        std::cout << "CHOLMOD: not in this build (install libsuitesparse-dev and configure again for its row)\n";
     for (int cells : settings.cost_cells) {
         Scene scene = cantilever_scene(settings.beam, cells);
         Body body(scene);
@@ -100,11 +120,30 @@ void cost_study(const RunContext& run, const Settings& settings)
         const double lecture_time = step_time(body, lecture_step, dt, steps, first, iterations);
         floor.add_row({free_dofs, double(K.nonZeros()), floor_time, once_step, lecture_time, once_step / floor_time,
                        lecture_time / floor_time});
+
+        State ours_state;
+        double ours_step = 0.0;
+        for (const auto& [solver_name, label] : peer_solvers) {
+            ImplicitOptions peer_options;
+            peer_options.solver = solver_name;
+            ThetaMethod peer(1.0, peer_options);
+            State peer_state;
+            const double peer_step = step_time(body, peer, dt, steps, first, iterations, &peer_state);
+            if (solver_name == "ours-cholesky") {
+                ours_state = peer_state;
+                ours_step = peer_step;
+            }
+            peers.add_row({free_dofs, label, first - peer_step, peer_step, peer_step / ours_step,
+                           (peer_state.u - ours_state.u).lpNorm<Eigen::Infinity>() /
+                               ours_state.u.lpNorm<Eigen::Infinity>()});
+        }
     }
     cost.print(std::cout);
     cost.write_csv(run.file("cost_table.csv"));
     floor.print(std::cout);
     floor.write_csv(run.file("floor_table.csv"));
+    peers.print(std::cout);
+    peers.write_csv(run.file("peers_table.csv"));
 
     // Why: a published reference point. SOFA's implicit Euler on its 1,664-vertex validation beam
     // takes 8.5 ms a step with CG capped at 20 iterations (an inexact solve).
