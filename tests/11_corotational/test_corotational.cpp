@@ -65,6 +65,29 @@ double orthogonality_error(const Eigen::Matrix3d& R)
     return (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
 }
 
+/// A 4×2×2-cell rubber beam whose backward-Euler step matrix M + Δt² K_R(u) (Δt = 1/60 s) is taken
+/// after a rigid turn by `angle` about a random axis (axis_seed): what a frozen factor meets when the
+/// body turns under it.
+class TurningBeam {
+public:
+    explicit TurningBeam(unsigned axis_seed) : axis_seed_(axis_seed) {}
+
+    dynamics::SparseMatrix step_matrix(double angle)
+    {
+        const Eigen::VectorXd u =
+            displacement(rigidly_moved(mesh.V, rotation(angle, axis_seed_), Eigen::Vector3d::Zero()), mesh.V);
+        return dynamics::SparseMatrix(mass_ + time_step_ * time_step_ * model_.stiffness(u));
+    }
+
+    const TetMesh mesh = box_mesh(4, 2, 2, Eigen::Vector3d(0.4, 0.2, 0.2));
+
+private:
+    unsigned axis_seed_;
+    CorotationalElasticity model_{mesh, rubber};
+    dynamics::SparseMatrix mass_ = assembly::lumped_mass_matrix(mesh, rubber.density);
+    double time_step_ = 1.0 / 60.0;
+};
+
 }  // namespace
 
 TEST_CASE("reflection fix: A B^T, with A's last column negated when det(A B^T) = -1", "[ex11.1]")
@@ -689,14 +712,9 @@ TEST_CASE("frozen-factor PCG in single precision: the true residual |b - A x| / 
     // The float copy of the factor is neither exactly linear nor exactly symmetric, so plain PCG's
     // theory does not cover it: check the true residual of the answer, recomputed here, on a stale
     // factor (the body turned under it), against the double-precision factor's iteration count.
-    const TetMesh mesh = box_mesh(4, 2, 2, Eigen::Vector3d(0.4, 0.2, 0.2));
-    CorotationalElasticity model(mesh, rubber);
-    const auto M = assembly::lumped_mass_matrix(mesh, rubber.density);
-    const double dt = 1.0 / 60.0;
-    const auto step_matrix = [&](double angle) {
-        const Eigen::VectorXd u = displacement(rigidly_moved(mesh.V, rotation(angle, 93), Eigen::Vector3d::Zero()), mesh.V);
-        return dynamics::SparseMatrix(M + dt * dt * model.stiffness(u));
-    };
+    TurningBeam beam(93);
+    const auto step_matrix = [&](double angle) { return beam.step_matrix(angle); };
+    const TetMesh& mesh = beam.mesh;
     const Eigen::VectorXd b = fem::random_vector(3 * mesh.V.rows(), 94);
     const double tolerance = 1e-10;
     FrozenFactorPcg single({tolerance}, {}, {}, FactorPrecision::single_precision);
@@ -788,14 +806,9 @@ TEST_CASE("flexible PCG: plain PCG's iterates for a fixed preconditioner, fewer 
 TEST_CASE("frozen-factor PCG: the balanced refresh refactors once the extra iterations have cost a factorization",
           "[ex11.7]")
 {
-    const TetMesh mesh = box_mesh(4, 2, 2, Eigen::Vector3d(0.4, 0.2, 0.2));
-    CorotationalElasticity model(mesh, rubber);
-    const auto M = assembly::lumped_mass_matrix(mesh, rubber.density);
-    const double dt = 1.0 / 60.0;
-    const auto step_matrix = [&](double angle) {
-        const Eigen::VectorXd u = displacement(rigidly_moved(mesh.V, rotation(angle, 91), Eigen::Vector3d::Zero()), mesh.V);
-        return dynamics::SparseMatrix(M + dt * dt * model.stiffness(u));
-    };
+    TurningBeam beam(91);
+    const auto step_matrix = [&](double angle) { return beam.step_matrix(angle); };
+    const TetMesh& mesh = beam.mesh;
     const Eigen::VectorXd b = fem::random_vector(3 * mesh.V.rows(), 92);
     // The same matrix again and again: no solve needs more than the first, so it never refactors.
     FrozenFactorPcg steady({}, RefreshRule{.balance_cost = true});
