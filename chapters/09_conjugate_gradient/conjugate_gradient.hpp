@@ -28,6 +28,20 @@ inline constexpr double default_relative_tolerance = 1e-8;
 /// needs at most n, round-off can delay convergence beyond that, and 2n is Eigen's choice too.
 inline constexpr int iteration_cap_per_unknown = 2;
 
+/// How PCG turns the new preconditioned residual z_{k+1} = M⁻¹ r_{k+1} into the next direction
+/// p_{k+1} = z_{k+1} + β_k p_k. docs/09_conjugate_gradient.md#flexible-pcg
+enum class CgBeta {
+    /// β_k = r_{k+1}ᵀz_{k+1} / r_kᵀz_k (Fletcher–Reeves): the classical CG and PCG, right when M⁻¹
+    /// is one fixed symmetric positive definite matrix (the identity, Jacobi, IC(0) in double).
+    fletcher_reeves,
+    /// β_k = z_{k+1}ᵀ(r_{k+1} − r_k) / r_kᵀz_k (Polak–Ribière): flexible PCG (Golub and Ye 1999,
+    /// Notay 2000), for an M⁻¹ that is not exactly linear or symmetric or that changes from one
+    /// application to the next (a factor applied in single precision, an inner iteration). For a
+    /// fixed SPD M⁻¹, z_{k+1}ᵀr_k = 0 and the two β agree; Polak–Ribière costs one more stored
+    /// vector (r_k) and one more dot product per iteration.
+    polak_ribiere,
+};
+
 /// When CG stops, and who watches it.
 struct CgSettings {
     /// Stop at the first k with ‖r_k‖₂ ≤ relative_tolerance · ‖b‖₂ (r_k the updated residual).
@@ -38,6 +52,8 @@ struct CgSettings {
     /// Called with (k, x_k, ‖r_k‖/‖b‖) for k = 0 (the start) and after every iteration, if set:
     /// e.g. to record the error against a known solution. It must not change CG's vectors.
     std::function<void(int iteration, const Eigen::VectorXd& x, double relative_residual)> observer;
+    /// The formula of β (PCG; for plain CG, z = r, the two differ only by round-off).
+    CgBeta beta = CgBeta::fletcher_reeves;
 };
 
 /// What a CG run did.
@@ -50,9 +66,9 @@ struct CgResult {
     double relative_residual = 0.0;
     /// ‖r_k‖₂ / ‖b‖₂ of the updated residual for k = 0 … iterations (iterations + 1 entries).
     std::vector<double> residual_history;
-    /// The step lengths α_k = r_kᵀz_k / p_kᵀA p_k (one per iteration) and the ratios
-    /// β_k = r_{k+1}ᵀz_{k+1} / r_kᵀz_k (one per new search direction): the Lanczos coefficients
-    /// that lanczos_extreme_eigenvalues turns into eigenvalue estimates.
+    /// The step lengths α_k = r_kᵀz_k / p_kᵀA p_k (one per iteration) and the ratios β_k of
+    /// CgSettings::beta (one per new search direction): the Lanczos coefficients that
+    /// lanczos_extreme_eigenvalues turns into eigenvalue estimates (for a fixed SPD M⁻¹).
     std::vector<double> alpha;
     std::vector<double> beta;
 };
@@ -72,7 +88,9 @@ CgResult conjugate_gradient(const LinearOperator& A, const Eigen::VectorXd& b, E
 
 /// Preconditioned CG with M⁻¹ given as an operator (e.g. JacobiPreconditioner,
 /// IncompleteCholesky): the same loop with z_k = M⁻¹ r_k taking r_k's place in α, β and p:
-///     α_k = r_kᵀz_k / p_kᵀA p_k,  β_k = r_{k+1}ᵀz_{k+1} / r_kᵀz_k,  p_{k+1} = z_{k+1} + β_k p_k.
+///     α_k = r_kᵀz_k / p_kᵀA p_k,  β_k = r_{k+1}ᵀz_{k+1} / r_kᵀz_k,  p_{k+1} = z_{k+1} + β_k p_k,
+/// or, with settings.beta = CgBeta::polak_ribiere (flexible PCG, for an M⁻¹ that is not exactly a
+/// fixed SPD matrix), β_k = z_{k+1}ᵀ(r_{k+1} − r_k) / r_kᵀz_k.
 /// The stopping rule still measures ‖r_k‖₂, so runs with different M compare directly. Errors as
 /// conjugate_gradient, plus a size mismatch of M and r_kᵀz_k ≤ 0 (M⁻¹ not positive definite).
 /// docs/09_conjugate_gradient.md#preconditioning

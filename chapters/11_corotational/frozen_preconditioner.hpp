@@ -32,23 +32,9 @@ using BlockRotations = std::function<std::vector<Eigen::Matrix3d>()>;
 /// The precision the frozen factor is applied in: its substitutions read L from memory, so a copy
 /// rounded to float (chapter 08's solve_single_precision) halves their cost. The float factor is not
 /// an exactly linear, symmetric M⁻¹; the cost study measures that plain PCG still reaches its
-/// tolerance in the true residual. docs/11_corotational.md#a-single-precision-preconditioner
-enum class FactorPrecision { single_precision, double_precision };
-
-/// Flexible preconditioned CG (Golub and Ye 1999, Notay 2000) for A x = b, A symmetric positive
-/// definite (n×n), M⁻¹ an n×n operator that need not be exactly linear or symmetric (a factor applied
-/// in single precision): chapter 09's preconditioned loop, with z_k = M⁻¹ r_k,
-///     α_k = r_kᵀz_k / p_kᵀA p_k,  x_{k+1} = x_k + α_k p_k,  r_{k+1} = r_k − α_k A p_k,
-///     β_k = z_{k+1}ᵀ(r_{k+1} − r_k) / r_kᵀz_k  (Polak–Ribière; plain PCG: z_{k+1}ᵀr_{k+1} / r_kᵀz_k),
-///     p_{k+1} = z_{k+1} + β_k p_k.
-/// For a fixed SPD M⁻¹, z_{k+1}ᵀr_k = 0 and the two β agree. x holds the start on entry (empty: 0)
-/// and the answer on exit. The stopping rule (‖r_k‖ ≤ relative_tolerance · ‖b‖), the cap, the
-/// observer and the result (relative_residual recomputed as ‖b − A x‖/‖b‖) are chapter 09's
-/// CgSettings and CgResult. fem::Error if sizes disagree, b or x is not finite, the tolerance is not
-/// in (0, 1), the cap is negative, p_kᵀA p_k ≤ 0 or r_kᵀz_k ≤ 0.
+/// tolerance in the true residual, beside flexible PCG (chapter 09's CgBeta::polak_ribiere).
 /// docs/11_corotational.md#a-single-precision-preconditioner
-cg::CgResult flexible_conjugate_gradient(const cg::LinearOperator& A, const cg::LinearOperator& M_inverse,
-                                         const Eigen::VectorXd& b, Eigen::VectorXd& x, const cg::CgSettings& settings = {});
+enum class FactorPrecision { single_precision, double_precision };
 
 /// When FrozenFactorPcg factors the current matrix again (at the next prepare()); both rules may be
 /// on, e.g. RefreshRule{.iterations_above = 30} or RefreshRule{.balance_cost = true}.

@@ -59,7 +59,7 @@ dynamics::State sagging_state(dynamics::Body& body, int steps)
 }
 
 /// Plain PCG (chapter 09's preconditioned_conjugate_gradient, β = r_{k+1}ᵀz_{k+1} / r_kᵀz_k), and
-/// flexible PCG (flexible_conjugate_gradient, β = z_{k+1}ᵀ(r_{k+1} − r_k) / r_kᵀz_k), on the
+/// flexible PCG (the same with CgBeta::polak_ribiere, β = z_{k+1}ᵀ(r_{k+1} − r_k) / r_kᵀz_k), on the
 /// step matrix A = Pᵀ(M + Δt D + Δt² K_R(u))P at `state`, from x₀ = 0 with the lecture's right-hand
 /// side b = Pᵀ(M v + Δt (f + f_ext)), preconditioned by a stale factor: the Cholesky factor of the
 /// step matrix at an earlier state, A₀ = Pᵀ(M + Δt D + Δt² K_R(u₀))P, applied in single precision (z = A₀⁻¹ r through
@@ -106,11 +106,9 @@ Table residual_table(dynamics::Body& body, const dynamics::State& earlier, const
         settings.observer = [&](int k, const Eigen::VectorXd& x, double updated) {
             table.add_row({run.name, double(k), updated, (b - A * x).norm() / b.norm()});
         };
+        settings.beta = run.flexible ? cg::CgBeta::polak_ribiere : cg::CgBeta::fletcher_reeves;
         Eigen::VectorXd x = Eigen::VectorXd::Zero(b.size());
-        if (run.flexible)
-            (void)flexible_conjugate_gradient(product, preconditioner, b, x, settings);
-        else
-            (void)cg::preconditioned_conjugate_gradient(product, preconditioner, b, x, settings);
+        (void)cg::preconditioned_conjugate_gradient(product, preconditioner, b, x, settings);
     }
     return table;
 }

@@ -90,13 +90,15 @@ CgResult cg_loop(const LinearOperator& A, const LinearOperator* M_inverse, const
             z = r;
     };
 
-    Eigen::VectorXd r(n), z(n), p(n), q(n);
+    const bool flexible = settings.beta == CgBeta::polak_ribiere;
+    Eigen::VectorXd r(n), z(n), p(n), q(n), r_old;  // r_old: r_k, kept for Polak–Ribière's β only
     // BEGIN EXERCISE 09.1 conjugate_gradient #the-conjugate-gradient-method
     // HINT: r = b − A x, z = M⁻¹ r (precondition), p = z, rz = rᵀz; record(0, ‖r‖).
     // HINT: while ‖r‖ > threshold and k < cap: q = A p; check_curvature(where, k, pᵀq); α = rz / pᵀq;
-    // HINT: x += α p; r −= α q; k += 1; record(k, ‖r‖) and push α onto result.alpha; stop if converged;
-    // HINT: z = M⁻¹ r; rz_new = rᵀz (check_preconditioner(where, k, rz_new)); β = rz_new / rz, pushed
-    // HINT: onto result.beta; p = z + β p; rz = rz_new. Set result.iterations and result.converged.
+    // HINT: x += α p; r −= α q (if flexible, keep r_old = r first); k += 1; record(k, ‖r‖) and push α
+    // HINT: onto result.alpha; stop if converged; z = M⁻¹ r; rz_new = rᵀz (check_preconditioner(where,
+    // HINT: k, rz_new)); β = rz_new / rz, or (rz_new − r_oldᵀz) / rz if flexible (Polak–Ribière),
+    // HINT: pushed onto result.beta; p = z + β p; rz = rz_new. Set result.iterations and result.converged.
     A.apply(x, q);
     r = b - q;
     double r_norm = r.norm();
@@ -113,6 +115,8 @@ CgResult cg_loop(const LinearOperator& A, const LinearOperator* M_inverse, const
         check_curvature(where, k, pAp);
         const double alpha = rz / pAp;
         x += alpha * p;
+        if (flexible)
+            r_old = r;
         r -= alpha * q;
         r_norm = r.norm();
         ++k;
@@ -123,7 +127,7 @@ CgResult cg_loop(const LinearOperator& A, const LinearOperator* M_inverse, const
         precondition(r, z);
         const double rz_new = r.dot(z);
         check_preconditioner(where, k, rz_new);
-        const double beta = rz_new / rz;
+        const double beta = (flexible ? rz_new - r_old.dot(z) : rz_new) / rz;
         result.beta.push_back(beta);
         p = z + beta * p;
         rz = rz_new;

@@ -8,81 +8,8 @@
 #include "common/error.hpp"
 
 #include <algorithm>
-#include <cmath>
 
 namespace fem::corot {
-
-cg::CgResult flexible_conjugate_gradient(const cg::LinearOperator& A, const cg::LinearOperator& M_inverse,
-                                         const Eigen::VectorXd& b, Eigen::VectorXd& x, const cg::CgSettings& settings)
-{
-    const Eigen::Index n = A.size();
-    if (M_inverse.size() != n || b.size() != n || (x.size() != 0 && x.size() != n))
-        throw Error(str("flexible_conjugate_gradient: sizes differ: A is ", n, "x", n, ", M⁻¹ ", M_inverse.size(), "x",
-                        M_inverse.size(), ", b has ", b.size(), " entries, x ", x.size()));
-    if (!(settings.relative_tolerance > 0.0 && settings.relative_tolerance < 1.0) || settings.max_iterations < 0)
-        throw Error(str("flexible_conjugate_gradient: the tolerance must be in (0, 1) and the cap >= 0, got ",
-                        settings.relative_tolerance, " and ", settings.max_iterations));
-    if (!b.allFinite() || !x.allFinite())
-        throw Error("flexible_conjugate_gradient: b and the start x must be finite");
-    if (x.size() == 0)
-        x = Eigen::VectorXd::Zero(n);
-    cg::CgResult result;
-    const double b_norm = b.norm();
-    const auto record = [&](int k, double r_norm) {
-        result.residual_history.push_back(b_norm > 0.0 ? r_norm / b_norm : 0.0);
-        if (settings.observer)
-            settings.observer(k, x, result.residual_history.back());
-    };
-    if (b_norm == 0.0) {  // the solution of A x = 0 is x = 0, whatever the start
-        x.setZero();
-        result.converged = true;
-        record(0, 0.0);
-        return result;
-    }
-    const long long cap = settings.max_iterations > 0 ? settings.max_iterations
-                                                       : cg::iteration_cap_per_unknown * static_cast<long long>(n);
-    const double threshold = settings.relative_tolerance * b_norm;
-    Eigen::VectorXd r(n), z(n), p(n), q(n), r_old(n);
-    A.apply(x, q);
-    r = b - q;
-    double r_norm = r.norm();
-    record(0, r_norm);
-    M_inverse.apply(r, z);
-    double rz = r.dot(z);
-    p = z;
-    int k = 0;
-    while (r_norm > threshold && k < cap) {
-        if (!(rz > 0.0))
-            throw Error(str("flexible_conjugate_gradient: r_kᵀz_k = ", rz, " at iteration ", k,
-                            ": the preconditioner is not positive definite"));
-        A.apply(p, q);
-        const double pAp = p.dot(q);
-        if (!(pAp > 0.0) || !std::isfinite(pAp))
-            throw Error(str("flexible_conjugate_gradient: p_kᵀA p_k = ", pAp, " at iteration ", k,
-                            ": A is not positive definite"));
-        const double alpha = rz / pAp;
-        x += alpha * p;
-        r_old = r;
-        r -= alpha * q;
-        r_norm = r.norm();
-        ++k;
-        record(k, r_norm);
-        result.alpha.push_back(alpha);
-        if (r_norm <= threshold)
-            break;
-        M_inverse.apply(r, z);
-        const double rz_new = r.dot(z);
-        const double beta = (rz_new - r_old.dot(z)) / rz;  // z_{k+1}ᵀ(r_{k+1} − r_k) / r_kᵀz_k
-        result.beta.push_back(beta);
-        p = z + beta * p;
-        rz = rz_new;
-    }
-    result.iterations = k;
-    result.converged = r_norm <= threshold;
-    A.apply(x, q);
-    result.relative_residual = (b - q).norm() / b_norm;
-    return result;
-}
 
 FrozenFactorPcg::FrozenFactorPcg(const cg::SolverOptions& options, RefreshRule refresh, BlockRotations rotations,
                                  FactorPrecision precision)
