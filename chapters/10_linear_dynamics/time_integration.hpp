@@ -199,6 +199,9 @@ public:
     virtual std::string name() const = 0;
     /// The order of accuracy in Δt (1 or 2).
     virtual int order() const = 0;
+    /// True for an explicit step (stable only below a limit on Δt, as symplectic Euler below
+    /// 2/ω_max); the time loop's divergence message says what to change by it.
+    virtual bool is_explicit() const { return false; }
     /// Advances state by Δt: u, v, forces, elastic_energy, time and step. fem::Error from the solver
     /// (a matrix that is not positive definite, an iterative solver that misses its tolerance) or
     /// for Δt ≤ 0; state is then unchanged.
@@ -240,6 +243,7 @@ class SymplecticEuler final : public Integrator {
 public:
     std::string name() const override { return "symplectic Euler"; }
     int order() const override { return 1; }
+    bool is_explicit() const override { return true; }
     StepInfo step(Body& body, double time_step, State& state) override;
 
 private:

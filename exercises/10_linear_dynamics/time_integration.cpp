@@ -446,9 +446,23 @@ void Simulation::run(int steps, const Observer& observer)
             return str("step ", record.step, " (t = ", record.time, " s, dt = ", time_step, " s, ",
                        integrator_.name(), ", ", body_.model().name(), " model)");
         };
+        // What makes this integrator gain energy, and what to change (built only for the message).
+        const auto cause = [&] {
+            if (integrator_.is_explicit())
+                return std::string("an explicit step above its stability limit 2/omega_max does this: use a "
+                                   "smaller dt (below explicit_stability_limit) or an implicit integrator");
+            if (body_.model().constant_stiffness())
+                return str("an implicit step (", integrator_.name(), ") of a linear body cannot gain energy at "
+                           "any dt: look for a wrong term in the step (its matrix or right-hand side), or a load "
+                           "or pin motion the step hook changed without its work booked");
+            return str("an implicit step (", integrator_.name(), ") of a nonlinear force model can gain energy "
+                       "where the step does not hold the motion (a midpoint step, a linearised stiffness far "
+                       "from the tangent): use a smaller dt or a more dissipative step (a theta above 1/2, "
+                       "backward Euler)");
+        };
         if (!std::isfinite(total) || !std::isfinite(record.work_in) || !state_.u.allFinite() || !state_.v.allFinite())
             throw Error(str("the run diverged at ", where(), ": the state is no longer finite (energy ", total,
-                            " J); use a smaller dt or an implicit integrator"));
+                            " J); ", cause()));
         largest_magnitude_ = std::max(largest_magnitude_, record.energies.magnitude());
         const double rise = total - record.work_in - initial_total_;
         if (rise > divergence_energy_fraction * largest_magnitude_)
@@ -456,9 +470,7 @@ void Simulation::run(int steps, const Observer& observer)
                             " J the scene put in) rose from ", initial_total_, " J to ", total - record.work_in,
                             " J, by ", rise / std::max(largest_magnitude_, 1e-300),
                             " of the largest energy in play (the limit is ", divergence_energy_fraction,
-                            "); an explicit step above its stability limit 2/omega_max does this (use a smaller "
-                            "dt or an implicit integrator), and so does a force model pushed past what it can "
-                            "hold (an implicit step: use a smaller dt or a nonlinear model)"));
+                            "); ", cause()));
         record.integrator_dissipated = initial_total_ + record.work_in - total - record.damping_dissipated;
         last_ = record;
         if (observer)

@@ -618,7 +618,9 @@ TEST_CASE("the midpoint rule with the warped stiffness diverges on a large swing
         });
     };
     double gain = 0.0;
-    CHECK_THROWS_WITH(run(0.5, gain), Contains("diverged"));
+    // The loop's message names the cause of a nonlinear model's implicit step, not an explicit limit.
+    CHECK_THROWS_WITH(run(0.5, gain), Contains("diverged") && Contains("nonlinear force model") &&
+                                          Contains("theta above 1/2") && !Contains("stability limit"));
     double damped_gain = 0.0;
     CHECK_NOTHROW(run(0.55, damped_gain));
     CHECK(damped_gain < 0.1);
