@@ -25,6 +25,8 @@
 
 using namespace fem;
 using namespace fem::corot;
+using fem::test::EntriesNear;
+using fem::test::entries_of;
 using Catch::Matchers::Contains;
 
 namespace {
@@ -94,13 +96,13 @@ TEST_CASE("reflection fix: A B^T, with A's last column negated when det(A B^T) =
 {
     for (unsigned seed = 1; seed <= 10; ++seed) {
         const Eigen::Matrix3d A = rotation(0.5 * seed, seed), B = rotation(0.3 * seed, seed + 50);
-        CHECK((proper_rotation(A, B) - A * B.transpose()).norm() <= 1e-14);  // already proper
+        CHECK_THAT(entries_of(proper_rotation(A, B)), EntriesNear(A * B.transpose(), 1e-14));  // already proper
         const Eigen::Matrix3d flip = Eigen::Vector3d(1.0, 1.0, -1.0).asDiagonal();
         const Eigen::Matrix3d reflected = A * flip;  // det(reflected Bᵀ) = −1
         const Eigen::Matrix3d R = proper_rotation(reflected, B);
         CAPTURE(seed);
         CHECK(R.determinant() == Approx(1.0).epsilon(1e-13));
-        CHECK((R - A * B.transpose()).norm() <= 1e-14);  // the last column flipped back, not another
+        CHECK_THAT(entries_of(R), EntriesNear(A * B.transpose(), 1e-14));  // the last column flipped back, not another
     }
 }
 
@@ -148,7 +150,8 @@ TEST_CASE("best-fit rotation: reflections, flat, collapsed and uniformly scaled 
         CHECK(R.determinant() == Approx(1.0).epsilon(1e-12));
     }
     // Uniform scaling has repeated singular values; its rotation is still the identity.
-    CHECK((best_fit_rotation(edge_covariance(X, tet::TetVertices(3.0 * X))) - Eigen::Matrix3d::Identity()).norm() <= 1e-12);
+    CHECK_THAT(entries_of(best_fit_rotation(edge_covariance(X, tet::TetVertices(3.0 * X)))),
+               EntriesNear(Eigen::Matrix3d::Identity(), 1e-12));
     CHECK_THROWS_AS(best_fit_rotation(Eigen::Matrix3d::Constant(std::nan(""))), Error);
 }
 
@@ -160,7 +163,7 @@ TEST_CASE("polar rotation: F = R S with S symmetric positive semi-definite, a pr
         stretch = stretch * stretch.transpose() + 0.1 * Eigen::Matrix3d::Identity();  // SPD
         const Eigen::Matrix3d R = polar_rotation(Q * stretch);
         CAPTURE(seed);
-        CHECK((R - Q).norm() <= 1e-12);
+        CHECK_THAT(entries_of(R), EntriesNear(Q, 1e-12));
     }
     // Inverted (det F < 0), flat (rank 2), a line (rank 1), zero: proper rotations, no NaN.
     Eigen::Matrix3d inverted = rotation(1.0, 3) * Eigen::Vector3d(1.2, 0.9, -0.3).asDiagonal();
@@ -174,7 +177,7 @@ TEST_CASE("polar rotation: F = R S with S symmetric positive semi-definite, a pr
     }
     // The inverted F: R^T F is symmetric with one negative eigenvalue (the smallest stretch).
     const Eigen::Matrix3d S = polar_rotation(inverted).transpose() * inverted;
-    CHECK((S - S.transpose()).norm() <= 1e-12);
+    CHECK_THAT(entries_of(S), EntriesNear(S.transpose(), 1e-12));
     CHECK(S.determinant() < 0.0);
     CHECK_THROWS_AS(polar_rotation(Eigen::Matrix3d::Constant(INFINITY)), Error);
 }
@@ -200,7 +203,7 @@ TEST_CASE("polar rotation by Newton's iteration: the SVD's rotation to round-off
     const Eigen::Matrix3d flat = rotation(2.0, 4) * Eigen::Vector3d(1.0, 0.5, 0.0).asDiagonal();
     for (const Eigen::Matrix3d& F : {inverted, flat, Eigen::Matrix3d(Eigen::Matrix3d::Zero())}) {
         const Eigen::Matrix3d R = polar_rotation_newton(F);
-        CHECK((R - polar_rotation(F)).norm() <= 1e-12);
+        CHECK_THAT(entries_of(R), EntriesNear(polar_rotation(F), 1e-12));
         CHECK(R.determinant() == Approx(1.0).epsilon(1e-12));
     }
 }
@@ -252,8 +255,8 @@ TEST_CASE("edges, centroid or polar: equal for the tets they were made for, diff
                                              best_fit_rotation(edge_covariance(X, x))};
     };
     const auto c = fits(corner), r = fits(regular), k = fits(skewed);
-    CHECK((c[0] - c[2]).norm() <= 1e-12);   // corner tet: polar = edges
-    CHECK((r[0] - r[1]).norm() <= 1e-12);   // regular tet: polar = centroid
+    CHECK_THAT(entries_of(c[0]), EntriesNear(c[2], 1e-12));   // corner tet: polar = edges
+    CHECK_THAT(entries_of(r[0]), EntriesNear(r[1], 1e-12));   // regular tet: polar = centroid
     CHECK((k[0] - k[1]).norm() > 1e-3);     // skewed: all three differ
     CHECK((k[0] - k[2]).norm() > 1e-3);
     CHECK((k[1] - k[2]).norm() > 1e-3);
@@ -263,7 +266,7 @@ TEST_CASE("edges, centroid or polar: equal for the tets they were made for, diff
     // The polar rotation leaves RᵀF symmetric: no rotation is left in the corotated strain.
     const Eigen::Matrix3d F = tet::deformation_gradient(skewed, skewed * A.transpose());
     const Eigen::Matrix3d stretch = k[0].transpose() * F;
-    CHECK((stretch - stretch.transpose()).norm() <= 1e-12 * stretch.norm());
+    CHECK_THAT(entries_of(stretch), EntriesNear(stretch.transpose(), 1e-12 * stretch.norm()));
 }
 
 TEST_CASE("rotated stiffness: every 3x3 block becomes R K_ab R^T", "[ex11.4]")
@@ -301,7 +304,7 @@ TEST_CASE("corotated force: -R K_e (R^T x - X), zero for rigid motions, the line
         rotated.segment<3>(3 * i) = Q * stretched.segment<3>(3 * i);
     const Vector12d f = corotated_force(K_e, Q, rotated, X_e), f0 = -(K_e * (stretched - X_e));
     for (int i = 0; i < 4; ++i)
-        CHECK((f.segment<3>(3 * i) - Q * f0.segment<3>(3 * i)).norm() <= 1e-10 * f0.norm());
+        CHECK_THAT(entries_of(f.segment<3>(3 * i)), EntriesNear(Q * f0.segment<3>(3 * i), 1e-10 * f0.norm()));
 }
 
 TEST_CASE("corotational body: no force under rigid motion, rotation covariance of f and K_R", "[ex11.6]")
@@ -333,7 +336,7 @@ TEST_CASE("corotational body: no force under rigid motion, rotation covariance o
     corotational.evaluate(u, f_x);
     corotational.evaluate(u_rotated, f_Qx);
     const MatrixX3d rotated_forces = io::vertex_rows(f_x) * Q.transpose();
-    CHECK((io::vertex_rows(f_Qx) - rotated_forces).norm() <= 1e-10 * f_x.norm());
+    CHECK_THAT(entries_of(io::vertex_rows(f_Qx)), EntriesNear(rotated_forces, 1e-10 * f_x.norm()));
     const Eigen::MatrixXd K_x(corotational.stiffness(u)), K_Qx(corotational.stiffness(u_rotated));
     Eigen::MatrixXd Q_hat = Eigen::MatrixXd::Zero(K_x.rows(), K_x.cols());
     for (Eigen::Index v = 0; v < mesh.V.rows(); ++v)
@@ -347,7 +350,7 @@ TEST_CASE("corotational body: no force under rigid motion, rotation covariance o
     CorotationalElasticity by_svd(mesh, rubber, RotationFit::polar, PolarAlgorithm::svd);
     Eigen::VectorXd f_svd;
     by_svd.evaluate(u, f_svd);
-    CHECK((f_x - f_svd).norm() <= 1e-12 * f_svd.norm());
+    CHECK_THAT(entries_of(f_x), EntriesNear(f_svd, 1e-12 * f_svd.norm()));
 }
 
 TEST_CASE("shape-gradient form: the forces and energy of the stiffness-matrix form, to round-off",
@@ -377,7 +380,7 @@ TEST_CASE("shape-gradient form: the forces and energy of the stiffness-matrix fo
         const GradientFormElement element = gradient_form_forces(F, R, rest_inverse, volume, lame);
         const Vector12d forces = element.forces.reshaped();
         // x is 50 m from the origin: its round-off (1e-14) over the edges, times K_e, bounds both forms
-        CHECK((forces - expected).norm() <= 1e-11 * K_e.norm() * d.norm() + 1e-13 * K_e.norm());
+        CHECK_THAT(entries_of(forces), EntriesNear(expected, 1e-11 * K_e.norm() * d.norm() + 1e-13 * K_e.norm()));
         CHECK(element.energy == Approx(0.5 * d.dot(K_e * d)).epsilon(1e-10));
     }
     // As a body's force model: the same forces and energy as the default form, and the same K_R.
@@ -389,13 +392,13 @@ TEST_CASE("shape-gradient form: the forces and energy of the stiffness-matrix fo
     Eigen::VectorXd f_matrices, f_gradients;
     const double energy = matrices.evaluate(u, f_matrices);
     CHECK(gradients.evaluate(u, f_gradients) == Approx(energy).epsilon(1e-12));
-    CHECK((f_gradients - f_matrices).norm() <= 1e-12 * f_matrices.norm());
+    CHECK_THAT(entries_of(f_gradients), EntriesNear(f_matrices, 1e-12 * f_matrices.norm()));
     const Eigen::MatrixXd K_matrices(matrices.stiffness(u)), K_gradients(gradients.stiffness(u));
     CHECK(K_gradients == K_matrices);  // K_R is R K_ab Rᵀ in both: the same rotations, the same bits
     // and after a step to another u (the kept F must follow u)
     const Eigen::VectorXd v = u + 0.01 * fem::random_vector(u.size(), 78);
     CHECK(gradients.evaluate(v, f_gradients) == Approx(matrices.evaluate(v, f_matrices)).epsilon(1e-12));
-    CHECK((f_gradients - f_matrices).norm() <= 1e-12 * f_matrices.norm());
+    CHECK_THAT(entries_of(f_gradients), EntriesNear(f_matrices, 1e-12 * f_matrices.norm()));
 }
 
 TEST_CASE("warped stiffness of one strained, rotated tet: every 3x3 block of K_R is R K_ab R^T", "[ex11.6]")
@@ -481,7 +484,7 @@ TEST_CASE("vertex order: corners permuted or the mesh renumbered change nothing,
             CHECK(std::abs(energy_corners - energy) > 1e-4 * energy);
         } else {
             CHECK(energy_corners == Approx(energy).epsilon(1e-12));
-            CHECK((f_corners - f_ref).norm() <= 1e-12 * f_ref.norm());
+            CHECK_THAT(entries_of(f_corners), EntriesNear(f_ref, 1e-12 * f_ref.norm()));
         }
     }
 }
@@ -660,7 +663,7 @@ TEST_CASE("frozen-factor PCG: exact at rest, more iterations as the body turns, 
     // 1e-7): one more iteration takes the residual below the default 1e-8, to the same answer.
     FrozenFactorPcg rounded;
     rounded.prepare(step_matrix(rest));
-    CHECK((rounded.solve(b) - x).norm() <= 1e-7 * x.norm());
+    CHECK_THAT(entries_of(rounded.solve(b)), EntriesNear(x, 1e-7 * x.norm()));
     CHECK(rounded.stats().iterations == 2);
     std::vector<int> iterations;
     for (const double angle : {0.3, 1.0, 2.0}) {
@@ -671,7 +674,7 @@ TEST_CASE("frozen-factor PCG: exact at rest, more iterations as the body turns, 
         iterations.push_back(frozen.stats().iterations);
         const auto direct = cg::make_solver("default");
         direct->prepare(A);
-        CHECK((x - direct->solve(b)).norm() <= 1e-7 * x.norm());
+        CHECK_THAT(entries_of(x), EntriesNear(direct->solve(b), 1e-7 * x.norm()));
     }
     CAPTURE(iterations[0], iterations[1], iterations[2]);
     CHECK(iterations[0] < iterations[2]);
@@ -701,7 +704,7 @@ TEST_CASE("frozen-factor PCG: exact at rest, more iterations as the body turns, 
         CHECK(turning.stats().iterations <= 1);
         const auto direct = cg::make_solver("default");
         direct->prepare(A);
-        CHECK((x - direct->solve(b)).norm() <= 1e-7 * x.norm());
+        CHECK_THAT(entries_of(x), EntriesNear(direct->solve(b), 1e-7 * x.norm()));
     }
     CHECK(turning.factorizations() == 1);
     FrozenFactorPcg wrong_size({}, {}, [] { return std::vector<Eigen::Matrix3d>(2, Eigen::Matrix3d::Identity()); });
