@@ -1,8 +1,10 @@
 // Study 3 of ch11_corotational: what a corotational step costs — the rotations, the forces, the
 // warped stiffness, the step matrix and the solve — on beams up to 36k dofs, with four ways to
-// solve a matrix that changes every step; SOFA's corotational beam as the goal.
+// solve a matrix that changes every step; SOFA's corotational beam as the goal; the plain route
+// (plain_routes.hpp) against ours, like for like, and what each speed-up adds.
 // docs/11_corotational.md#cost
 #include "11_corotational/frozen_preconditioner.hpp"
+#include "11_corotational/plain_routes.hpp"
 #include "11_corotational/studies.hpp"
 
 #include "06_assembly/assembly.hpp"
@@ -14,7 +16,11 @@
 #include "common/table.hpp"
 #include "common/timer.hpp"
 
+#include <functional>
 #include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
 
 namespace fem::corot::study {
 namespace {
@@ -45,6 +51,64 @@ StepCost step_cost(dynamics::Body& body, const dynamics::ImplicitOptions& option
     if (const auto* frozen = dynamic_cast<const FrozenFactorPcg*>(&integrator.solver()))
         cost.factorizations = frozen->factorizations();
     return cost;
+}
+
+/// One route of the peers table: a force model and the options of its step.
+struct Route {
+    std::string name;
+    std::function<std::unique_ptr<dynamics::ForceModel>(const dynamics::Scene&)> model;
+    std::function<dynamics::ImplicitOptions(dynamics::Body&)> options;
+};
+
+/// The plain route, then one speed-up of the chapter added per row (the last row is the fastest
+/// step the chapter has, the one the SOFA goal times).
+std::vector<Route> ladder()
+{
+    const auto plain_model = [](plain::PlainRotation rotation) {
+        return [rotation](const dynamics::Scene& scene) -> std::unique_ptr<dynamics::ForceModel> {
+            return std::make_unique<plain::PlainCorotational>(scene.mesh, scene.material, rotation);
+        };
+    };
+    const auto our_model = [](ForceForm form) {
+        return [form](const dynamics::Scene& scene) -> std::unique_ptr<dynamics::ForceModel> {
+            return std::make_unique<CorotationalElasticity>(scene.mesh, scene.material, RotationFit::polar,
+                                                            PolarAlgorithm::newton, form);
+        };
+    };
+    const auto plain_solver = [](dynamics::Body&) { return plain::plain_step_options(); };
+    const auto named = [](const std::string& name) {
+        return [name](dynamics::Body& body) { return solver_option(name, solve_tolerance, body); };
+    };
+    return {{"plain: JacobiSVD per tet, triplets, SimplicialLLT refactored", plain_model(plain::PlainRotation::jacobi_svd),
+             plain_solver},
+            {"+ polar iteration (Newton) for the rotations", plain_model(plain::PlainRotation::polar_newton), plain_solver},
+            {"+ K_R into the fixed pattern, step matrix refilled", our_model(ForceForm::stiffness_matrix), plain_solver},
+            {"+ supernodal Cholesky, symbolic analysis reused", our_model(ForceForm::stiffness_matrix), named("refactor")},
+            {"+ frozen factor turned with the body, PCG to 1e-8", our_model(ForceForm::stiffness_matrix),
+             named("rotated-frozen-factor-pcg")},
+            {"+ shape-gradient forces (ours, fastest)", our_model(ForceForm::shape_gradients),
+             named("rotated-frozen-factor-pcg")}};
+}
+
+/// Mean time per step of `steps` backward Euler steps from `start` by one route, every step counted
+/// (the first one makes the solver and factors: a route's setup is part of its cost), the best of
+/// `repeats` runs (on a shared machine another job's burst slows one run, not all); the state
+/// after them in `final_state`.
+double route_time(const dynamics::Scene& scene, const Route& route, const dynamics::State& start, int steps,
+                  int repeats, dynamics::State& final_state)
+{
+    double best = 1e300;
+    for (int r = 0; r < repeats; ++r) {
+        dynamics::Body body(scene, route.model(scene));
+        dynamics::ThetaMethod integrator(1.0, route.options(body));
+        dynamics::State state = dynamics::initial_state(body, start.u, start.v);
+        Timer clock;
+        for (int k = 0; k < steps; ++k)
+            integrator.step(body, scene.time_step, state);
+        best = std::min(best, clock.seconds() / steps);
+        final_state = std::move(state);
+    }
+    return best;
 }
 
 /// The state after `steps` backward Euler steps from rest: a beam bent by its weight, its
@@ -111,6 +175,56 @@ Table residual_table(dynamics::Body& body, const dynamics::State& earlier, const
         (void)cg::preconditioned_conjugate_gradient(product, preconditioner, b, x, settings);
     }
     return table;
+}
+
+/// The largest beam (cells along it) of the peers table.
+constexpr int largest_peer_cells = 60;
+
+/// Peers, like for like: the plain route and every rung of the ladder on the cost study's beams of
+/// at most largest_peer_cells cells, from the same bent state, the same Δt and number of steps, on
+/// one core.
+void peers_study(const RunContext& run, const Settings& settings)
+{
+    const int steps = run.quick ? 3 : 5, repeats = 2;
+    Table peers(str("Peers, like for like: the plain corotational step against ours (the same ", steps,
+                    " backward Euler steps from a bent state, dt = 1/60 s, one core, the best of ", repeats, " runs)"),
+                {{"free dofs", Format::integer}, {"tets", Format::integer}, {"plain step [s]", Format::scientific, 2},
+                 {"our step [s]", Format::scientific, 2}, {"plain / ours [measured]", Format::fixed, 1},
+                 {"max |u - u_plain| / max |u_plain| [±1e-7]", Format::scientific, 1}});
+    Table rungs("From the plain step to ours, one speed-up at a time (each row adds one to the row above; same run, "
+                "same steps)",
+                {{"free dofs", Format::integer}, {"route", Format::text}, {"time per step [s]", Format::scientific, 2},
+                 {"row above / this row [measured]", Format::fixed, 2}, {"plain / this row [measured]", Format::fixed, 1},
+                 {"max |u - u_plain| / max |u_plain| [±1e-7]", Format::scientific, 1}});
+    const int threads_before = thread_count();
+    set_thread_count(1);  // like for like: the plain route runs on one core
+    for (int cells : settings.cost_cells) {
+        if (cells > largest_peer_cells)
+            continue;  // the plain route's fresh factorizations take seconds a step beyond it
+        const dynamics::Scene scene = dynamics::cantilever_scene(settings.sofa, cells, 1.0);
+        dynamics::Body body(scene, force_model("corotational", scene));
+        const dynamics::State start = sagging_state(body, 10);
+        const double free_dofs = double(body.dofs().size());
+        dynamics::State plain_state;
+        double plain_time = 0.0, previous = 0.0, deviation = 0.0, ours = 0.0;
+        for (const Route& route : ladder()) {
+            dynamics::State state;
+            const double seconds = route_time(scene, route, start, steps, repeats, state);
+            if (plain_state.u.size() == 0) {
+                plain_state = state;
+                plain_time = previous = seconds;
+            }
+            deviation = (state.u - plain_state.u).lpNorm<Eigen::Infinity>() / plain_state.u.lpNorm<Eigen::Infinity>();
+            rungs.add_row({free_dofs, route.name, seconds, previous / seconds, plain_time / seconds, deviation});
+            previous = ours = seconds;
+        }
+        peers.add_row({free_dofs, double(scene.mesh.T.rows()), plain_time, ours, plain_time / ours, deviation});
+    }
+    set_thread_count(threads_before);
+    peers.print(std::cout);
+    peers.write_csv(run.file("peers_table.csv"));
+    rungs.print(std::cout);
+    rungs.write_csv(run.file("ladder_table.csv"));
 }
 
 }  // namespace
@@ -201,6 +315,8 @@ void cost_study(const RunContext& run, const Settings& settings)
     set_thread_count(threads_before);
     goal.print(std::cout);
     goal.write_csv(run.file("sofa_table.csv"));
+
+    peers_study(run, settings);
 
     // Why: the float factor is not an exactly linear, symmetric M⁻¹, so PCG's theory does not cover
     // it; the true residual shows whether plain PCG still converges with it.
