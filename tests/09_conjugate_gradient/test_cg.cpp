@@ -302,8 +302,8 @@ TEST_CASE("flexible PCG: plain PCG's iterates for a fixed preconditioner, fewer 
                               << "; by hand r_1^T z_1 / r_0^T z_0 = " << fletcher_reeves
                               << " (Fletcher-Reeves) and z_1^T (r_1 - r_0) / r_0^T z_0 = " << polak_ribiere
                               << " (Polak-Ribiere, CgBeta::polak_ribiere)");
-    CHECK(std::abs(plain_changing.beta[0] - fletcher_reeves) <= 1e-12 * std::abs(fletcher_reeves));
-    CHECK(std::abs(flexible_changing.beta[0] - polak_ribiere) <= 1e-12 * std::abs(fletcher_reeves));
+    CHECK(plain_changing.beta[0] == Approx(fletcher_reeves).epsilon(1e-12));
+    CHECK(flexible_changing.beta[0] == Approx(polak_ribiere).epsilon(1e-12));
     CAPTURE(plain_changing.iterations, flexible_changing.iterations, plain.iterations);
     CHECK(flexible_changing.converged);
     CHECK(flexible_changing.relative_residual <= 1e-10);
