@@ -791,8 +791,50 @@ BarLabels add_renderers(vtkRenderWindow* window, vtkDataSet* data, bool cell_fie
     bar_labels.texts = texts;
     backdrop->SetBackground(1.0, 1.0, 1.0);
     renderer->SetBackground(1.0, 1.0, 1.0);
-    renderer->SetViewport(0.0, 0.0, bar_strip ? 0.84 : 1.0, 1.0);
+    double top = 1.0;
+    if (options.data_under_title) {  // the title's lines (about 26 layout pixels each) stay clear
+        const auto lines = 1 + std::count(options.title.begin(), options.title.end(), '\n');
+        top = std::max(0.5, 1.0 - (20.0 + 26.0 * static_cast<double>(lines)) / options.height);
+    }
+    renderer->SetViewport(0.0, 0.0, bar_strip ? 0.84 : 1.0, top);
     renderer->AddActor(actor);
+    for (const Prop& prop : options.props) {  // obstacles, a lattice: in the data's camera and lights
+        vtkNew<vtkDataSetSurfaceFilter> prop_surface;
+        auto prop_grid = io::detail::to_vtk(prop.shape);
+        prop_surface->SetInputData(prop_grid);
+        vtkNew<vtkPolyDataMapper> prop_mapper;
+        vtkNew<vtkPolyDataNormals> prop_normals;  // a ball smooth, a box's edges kept (split at 30°)
+        prop_normals->SetInputConnection(prop_surface->GetOutputPort());
+        prop_mapper->SetInputConnection(prop.wireframe ? prop_surface->GetOutputPort() : prop_normals->GetOutputPort());
+        if (prop.by_field) {
+            if (prop_grid->GetPointData()->HasArray(options.field.c_str()))
+                prop_mapper->SetScalarModeToUsePointFieldData();
+            else if (prop_grid->GetCellData()->HasArray(options.field.c_str()))
+                prop_mapper->SetScalarModeToUseCellFieldData();
+            else
+                throw Error(str("cannot draw a prop by the field '", options.field, "': it has no such field"));
+            prop_mapper->SelectColorArray(options.field.c_str());
+            prop_mapper->SetLookupTable(colours);
+            prop_mapper->SetScalarRange(range);
+            prop_mapper->ScalarVisibilityOn();
+        } else {
+            prop_mapper->ScalarVisibilityOff();
+        }
+        vtkNew<vtkActor> prop_actor;
+        prop_actor->SetMapper(prop_mapper);
+        vtkProperty* prop_look = prop_actor->GetProperty();
+        prop_look->SetColor(prop.colour[0], prop.colour[1], prop.colour[2]);
+        prop_look->SetOpacity(prop.opacity);
+        prop_look->SetAmbient(0.3);
+        prop_look->SetDiffuse(0.7);
+        prop_look->SetSpecular(0.0);
+        if (prop.wireframe) {
+            prop_look->SetRepresentationToWireframe();
+            prop_look->SetLineWidth(1.5f * s);
+            prop_look->LightingOff();
+        }
+        renderer->AddActor(prop_actor);
+    }
     const int layers = options.outline ? 3 : 2;
     if (options.outline) {  // light grey, lit softly, no edges
         vtkNew<vtkDataSetSurfaceFilter> outline_surface;
@@ -869,6 +911,22 @@ std::pair<vtkSmartPointer<vtkUnstructuredGrid>, bool> drawable(const io::MeshDat
 }
 
 }  // namespace
+
+void grow_bounds(std::array<double, 6>& box, const MatrixX3d& points)
+{
+    if (points.rows() == 0)
+        return;
+    for (int axis = 0; axis < 3; ++axis) {
+        box[2 * axis] = std::min(box[2 * axis], points.col(axis).minCoeff());
+        box[2 * axis + 1] = std::max(box[2 * axis + 1], points.col(axis).maxCoeff());
+    }
+}
+
+std::array<double, 6> empty_bounds()
+{
+    const double inf = std::numeric_limits<double>::infinity();
+    return {inf, -inf, inf, -inf, inf, -inf};
+}
 
 bool display_available()
 {

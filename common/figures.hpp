@@ -108,6 +108,24 @@ struct CutPlane {
     std::array<double, 3> normal;
 };
 
+/// A shape drawn beside a rendered mesh, not coloured by its field unless asked: an obstacle of a
+/// scene (a floor patch, a sphere, a box, a triangle mesh) or the lattice that carries a skin.
+struct Prop {
+    io::MeshData shape;  ///< its surface is drawn (triangles, or the boundary of tets), points as they are
+    std::array<double, 3> colour{0.55, 0.55, 0.58};  ///< RGB in [0, 1], when not coloured by the field
+    /// Coloured by the mesh's field (RenderOptions::field, which shape must have) with the mesh's colour
+    /// map and range, e.g. a lattice on the colour scale of the skin it carries.
+    bool by_field = false;
+    bool wireframe = false;  ///< its edges only, e.g. a lattice around the skin
+    double opacity = 1.0;
+};
+
+/// Grows box (xmin, xmax, ymin, ymax, zmin, zmax) to hold every row of points (#P×3).
+void grow_bounds(std::array<double, 6>& box, const MatrixX3d& points);
+
+/// The box of nothing yet (every min +∞, every max −∞): grow_bounds makes it the box of what it is given.
+std::array<double, 6> empty_bounds();
+
 /// How to colour and frame a rendered mesh or grid.
 struct RenderOptions {
     std::string title;                 ///< drawn at the top of the image
@@ -140,6 +158,12 @@ struct RenderOptions {
     /// A mesh only: smooth shading (normals averaged at the vertices) instead of flat facets;
     /// meant for render surfaces, which also hide their edges (show_edges = false).
     bool smooth = false;
+    /// A mesh only: shapes drawn with it (an obstacle, a lattice), in the same camera and light; the
+    /// camera's box (frame_bounds or the mesh's bounds) is the caller's to make hold them.
+    std::vector<Prop> props;
+    /// Draw the data under the title's lines, never behind them (a motion frame's title of two or
+    /// three lines would cover a body framed to the top); false: over the whole height.
+    bool data_under_title = false;
     int width = 900;   ///< layout pixels; the PNG has scale times as many each way
     int height = 700;
     int scale = pixel_scale;  ///< 1 for an on-screen window that must fit the screen

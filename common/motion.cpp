@@ -7,10 +7,11 @@
 #include <cstdio>
 #include <limits>
 #include <sstream>
+#include <tuple>
 
 namespace fem::io {
 
-std::string frame_title(const std::string& title, double time, double warp_scale)
+std::string time_label(double time)
 {
     std::ostringstream rounded;
     rounded.setf(std::ios::fixed);
@@ -19,10 +20,18 @@ std::string frame_title(const std::string& title, double time, double warp_scale
     std::string t = rounded.str();
     while (t.size() > 1 && t.find('.') != std::string::npos && (t.back() == '0' || t.back() == '.'))
         t.pop_back();
-    std::string out = str(title, ", t = ", t == "-0" ? "0" : t, " s");
-    if (warp_scale != 1.0)
-        out += str("\ndisplacement drawn \u00D7", warp_scale, " (grey: the body at rest)");
-    return out;
+    return str("t = ", t == "-0" ? "0" : t, " s");
+}
+
+std::string warp_note(double warp_scale)
+{
+    return warp_scale == 1.0 ? "" : str("displacement drawn \u00D7", warp_scale, " (grey: the body at rest)");
+}
+
+std::string frame_title(const std::string& title, double time, double warp_scale)
+{
+    const std::string note = warp_note(warp_scale);
+    return str(title, ", ", time_label(time), note.empty() ? "" : "\n", note);
 }
 
 MotionRecorder::MotionRecorder(std::filesystem::path pvd_path, int png_every, FrameFile file)
@@ -79,28 +88,26 @@ double MotionRecorder::visible_warp(double fraction) const
     return power;
 }
 
-int MotionRecorder::render_png_frames(const std::filesystem::path& stem, const fig::RenderOptions& options,
-                                      double warp_scale) const
+std::array<double, 6> MotionRecorder::motion_bounds(double warp_scale) const
 {
-    std::vector<std::pair<double, MeshData>> deformed;
-    for (const auto& [time, mesh] : kept_)
-        deformed.emplace_back(time, warped(mesh, warp_scale));
-    if (deformed.empty() || !fig::can_draw(true))
-        return 0;
-    fig::RenderOptions shared = options;
-    std::array<double, 6> box{};
-    for (int axis = 0; axis < 3; ++axis) {
-        box[2 * axis] = std::numeric_limits<double>::infinity();
-        box[2 * axis + 1] = -std::numeric_limits<double>::infinity();
-    }
+    if (kept_.empty())
+        throw Error("motion_bounds: no frame was kept for the PNGs (png_every = 0, or nothing added)");
+    std::array<double, 6> box = fig::empty_bounds();
+    for (const auto& kept : kept_)
+        fig::grow_bounds(box, warped(kept.second, warp_scale).points);
+    if (warp_scale != 1.0)  // the rest shape, drawn faint behind the body
+        fig::grow_bounds(box, kept_.front().second.points);
+    return box;
+}
+
+std::pair<std::pair<double, double>, std::string> MotionRecorder::colour_range(const fig::RenderOptions& options) const
+{
+    if (options.range)
+        return {*options.range, options.range_note};
     double low = std::numeric_limits<double>::infinity(), high = -low;
     std::vector<double> pooled;  // every shown value of the kept frames, for a clipped range
-    for (const auto& [time, mesh] : deformed) {
-        for (int axis = 0; axis < 3; ++axis) {
-            box[2 * axis] = std::min(box[2 * axis], mesh.points.col(axis).minCoeff());
-            box[2 * axis + 1] = std::max(box[2 * axis + 1], mesh.points.col(axis).maxCoeff());
-        }
-        const Eigen::MatrixXd& values = mesh.field(options.field).values;
+    for (const auto& kept : kept_) {
+        const Eigen::MatrixXd& values = kept.second.field(options.field).values;
         const Eigen::VectorXd shown = values.cols() == 1 || options.component < 0
                                           ? Eigen::VectorXd(values.rowwise().norm())
                                           : Eigen::VectorXd(values.col(options.component));
@@ -110,40 +117,56 @@ int MotionRecorder::render_png_frames(const std::filesystem::path& stem, const f
             for (Eigen::Index i = 0; i < values.rows(); ++i)
                 pooled.push_back(values.cols() == 1 ? values(i, 0) : shown(i));
     }
-    if (!shared.range) {
-        const auto all = field_ranges_.find(options.field);
-        const bool whole_run = all != field_ranges_.end() &&
-                               (options.component < 0 || deformed.front().second.field(options.field).values.cols() == 1);
-        shared.range = whole_run ? all->second : std::make_pair(low, high);
-        if (whole_run && shared.range_note.empty() && added_ > kept_.size())
-            shared.range_note = str("range of all ", added_, " frames");
-        // Clipped: the top at the percentile of the kept frames' values, pooled (the percentile
-        // needs the values; the whole run keeps only its range).
-        const double top = pooled.empty() ? shared.range->second : fig::percentile(pooled, options.clip_percentile);
-        if (top < shared.range->second && top > shared.range->first) {
-            const std::string note = fig::clip_note(options.clip_percentile, shared.range->second, options.unit);
-            shared.range_note = shared.range_note.empty() ? note : shared.range_note + "\n" + note;
-            shared.range->second = top;
-        }
+    const auto all = field_ranges_.find(options.field);
+    const bool whole_run = !kept_.empty() && all != field_ranges_.end() &&
+                           (options.component < 0 || kept_.front().second.field(options.field).values.cols() == 1);
+    std::pair<double, double> range = whole_run ? all->second : std::make_pair(low, high);
+    std::string note = options.range_note;
+    if (whole_run && note.empty() && added_ > kept_.size())
+        note = str("range of all ", added_, " frames");
+    // Clipped: the top at the percentile of the kept frames' values, pooled (the percentile needs
+    // the values; the whole run keeps only its range).
+    const double top = pooled.empty() ? range.second : fig::percentile(pooled, options.clip_percentile);
+    if (top < range.second && top > range.first) {
+        const std::string clipped = fig::clip_note(options.clip_percentile, range.second, options.unit);
+        note = note.empty() ? clipped : note + "\n" + clipped;
+        range.second = top;
     }
-    if (warp_scale != 1.0 && !shared.outline) {
+    return {range, note};
+}
+
+int MotionRecorder::render_png_frames(const std::filesystem::path& stem, const fig::RenderOptions& options,
+                                      double warp_scale, const FrameExtras& extras) const
+{
+    std::vector<std::pair<double, MeshData>> deformed;
+    for (const auto& [time, mesh] : kept_)
+        deformed.emplace_back(time, warped(mesh, warp_scale));
+    if (deformed.empty() || !fig::can_draw(true))
+        return 0;
+    fig::RenderOptions shared = options;
+    std::tie(shared.range, shared.range_note) = colour_range(options);
+    if (warp_scale != 1.0 && !shared.outline)
         shared.outline = kept_.front().second;  // its points are the rest positions
-        if (!options.frame_bounds)               // the camera frames the rest shape too
-            for (int axis = 0; axis < 3; ++axis) {
-                box[2 * axis] = std::min(box[2 * axis], shared.outline->points.col(axis).minCoeff());
-                box[2 * axis + 1] = std::max(box[2 * axis + 1], shared.outline->points.col(axis).maxCoeff());
-            }
-    }
+    std::vector<std::vector<fig::Prop>> props(deformed.size());
+    std::array<double, 6> box = motion_bounds(warp_scale);
+    for (std::size_t k = 0; k < deformed.size(); ++k)
+        if (extras.props) {
+            props[k] = extras.props(k, deformed[k].first);
+            for (const fig::Prop& prop : props[k])
+                fig::grow_bounds(box, prop.shape.points);  // the camera frames the obstacles too
+        }
     if (!shared.frame_bounds)  // a box the caller fixed (e.g. a live view's) is kept
         shared.frame_bounds = box;
     int written = 0;
-    for (const auto& [time, mesh] : deformed) {
+    for (std::size_t k = 0; k < deformed.size(); ++k) {
+        const auto& [time, mesh] = deformed[k];
         char suffix[32];
         std::snprintf(suffix, sizeof suffix, "_%04d.png", written);
         std::filesystem::path path = stem;
         path += suffix;
         fig::RenderOptions frame_options = shared;
-        frame_options.title = frame_title(options.title, time, warp_scale);
+        frame_options.title = extras.title ? extras.title(k, time) : frame_title(options.title, time, warp_scale);
+        frame_options.props = std::move(props[k]);
         written += fig::render_mesh_png(path, mesh, frame_options) ? 1 : 0;
     }
     return written;

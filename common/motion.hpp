@@ -7,7 +7,9 @@
 #include "common/figures.hpp"
 #include "common/vtk_io.hpp"
 
+#include <array>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <utility>
 #include <string>
@@ -25,6 +27,23 @@ enum class FrameFile {
 /// displacement is drawn exaggerated (warp_scale ≠ 1) a second line saying by how much and that the
 /// grey shape is the body at rest.
 std::string frame_title(const std::string& title, double time, double warp_scale);
+
+/// "t = 0.67 s": the time rounded to 0.01 s, trailing zeros dropped ("t = 0.5 s", "t = 0 s").
+std::string time_label(double time);
+
+/// The line a frame drawn with its displacement exaggerated carries: "displacement drawn ×5 (grey:
+/// the body at rest)"; "" for warp_scale = 1.
+std::string warp_note(double warp_scale);
+
+/// What a caller draws around each PNG frame of a motion (MotionRecorder::render_png_frames): frame
+/// k (0, 1, … of the kept frames) at its time.
+struct FrameExtras {
+    /// The frame's title; unset: frame_title(options.title, time, warp_scale).
+    std::function<std::string(std::size_t k, double time)> title;
+    /// Shapes drawn with the frame (fig::Prop: obstacles at the frame's time, a lattice), in the
+    /// frames' deformed coordinates; the camera's box holds them too (unless options.frame_bounds is set).
+    std::function<std::vector<fig::Prop>(std::size_t k, double time)> props;
+};
 
 /// Records the frames of one body's motion.
 class MotionRecorder {
@@ -50,6 +69,15 @@ public:
     /// magnitudes), e.g. to colour two series on one scale; fem::Error for a field no frame has.
     std::pair<double, double> field_range(const std::string& field) const;
 
+    /// The box (xmin, xmax, ymin, ymax, zmin, zmax) of the kept frames warped by warp_scale × their
+    /// displacement, with the rest shape when warp_scale ≠ 1 (the box the frames' camera frames).
+    /// fem::Error for no kept frame.
+    std::array<double, 6> motion_bounds(double warp_scale = 1.0) const;
+
+    /// The kept frame k (rest positions and fields, as added), k < kept_frames().
+    const MeshData& kept_frame(std::size_t k) const { return kept_.at(k).second; }
+    std::size_t kept_frames() const { return kept_.size(); }
+
     /// Renders the kept frames, warped by warp_scale × their displacement (1: true scale), to
     /// <stem>_0000.png, …: one camera framing the union of the deformed bodies' bounds (unless
     /// options.frame_bounds is set), and one colour range for options.field over all kept frames
@@ -57,12 +85,17 @@ public:
     /// over every frame added, not only the kept ones, and the colour bar says so. With
     /// options.clip_percentile < 100 the range's top is that percentile of the kept frames' values
     /// (all of them pooled), and the bar says it is clipped and gives the whole run's largest value. The title is
-    /// frame_title's; when warp_scale ≠ 1 the rest shape is drawn faint behind the body (unless
-    /// options.outline is set). Returns the number of
+    /// extras.title's (default frame_title's); extras.props are drawn with each frame; when warp_scale ≠ 1
+    /// the rest shape is drawn faint behind the body (unless options.outline is set). Returns the number of
     /// PNGs written (0 without a display, after can_draw's note, see figures.hpp). fem::Error if the field is missing from
     /// a frame or warp_scale is not finite.
     int render_png_frames(const std::filesystem::path& stem, const fig::RenderOptions& options,
-                          double warp_scale = 1.0) const;
+                          double warp_scale = 1.0, const FrameExtras& extras = {}) const;
+
+    /// The colour range render_png_frames gives options.field (options.range when set), and the note
+    /// its bar carries ("range of all N frames", and with clip_percentile < 100 the clip_note when the
+    /// percentile of the kept frames' values, pooled, lies inside the range). fem::Error as render_png_frames.
+    std::pair<std::pair<double, double>, std::string> colour_range(const fig::RenderOptions& options) const;
 
 private:
     PvdSeries series_;

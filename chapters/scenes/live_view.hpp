@@ -8,6 +8,7 @@
 #include "common/timer.hpp"
 #include "common/vtk_io.hpp"
 
+#include <array>
 #include <cstddef>
 #include <filesystem>
 #include <string>
@@ -19,11 +20,33 @@ namespace fem::scenes {
 /// range when the scene fixes them. The PNG frames and the live view use it alike.
 fig::RenderOptions frame_view(const SceneSpec& scene);
 
-/// The title of the frame at time t, as the PNG frames write it.
-std::string frame_title(const SceneSpec& scene, double time);
+/// How a model is named on a frame: "linear", "corotational", "StVK", "neo-Hookean", "stable
+/// neo-Hookean" (chapter 12's names, as the docs write them); any other name as it is.
+std::string model_label(const std::string& model);
 
-/// The live view of --view: a window that plays the run's frames as they come, one frame interval
-/// (1/frame_rate) apart at least, drawn as the PNG frames are. Keys: space pauses and resumes, the
+/// How many times slower than real time the run's frames play: the video's (make_video) frames per
+/// second are fewer than output.frame_rate when the run's frames (frame_count) would last less than
+/// min_video_seconds; 1 when they last long enough. The live view plays at the same pace.
+double slow_motion(const SceneSpec& scene);
+
+/// The caption of the frame at time t: "<scene file's stem> · <models> · t = 0.5 s" and, when the
+/// frames play slower than real time (slow_motion), " · slow motion ×5" (rounded to 0.1). models:
+/// what each body uses at that frame, e.g. "stable neo-Hookean" (frame_models in runner.cpp).
+std::string frame_caption(const SceneSpec& scene, const std::string& models, double time);
+
+/// The title of the frame at time t, as the PNG frames and the live view both write it: the scene's
+/// title, frame_caption under it, and when the displacement is drawn exaggerated a line saying so.
+std::string frame_title(const SceneSpec& scene, const std::string& models, double time);
+
+/// The shapes the scene's obstacles are drawn as at time t (fig::Prop, grey), each moved by t·w:
+/// a half-space as the square of its plane under body_box (the box's corners projected on the plane,
+/// grown by half the box's diagonal each way: the floor or slope where the body moves), a sphere as
+/// a fine triangulated ball, a box as its 12 triangles. body_box: (xmin, xmax, ymin, ymax, zmin,
+/// zmax) of the body's motion [m]. docs/scenes.md#outputs
+std::vector<fig::Prop> obstacle_props(const SceneSpec& scene, const std::array<double, 6>& body_box, double time);
+
+/// The live view of --view: a window that plays the run's frames as they come, one frame interval of
+/// the video (slow_motion/frame_rate) apart at least, drawn as the PNG frames are. Keys: space pauses and resumes, the
 /// right arrow steps one frame while paused, r restarts the run (throws Restart), c switches the
 /// colour field, q stops the run (fem::request_stop). docs/scenes.md#the-live-view
 class LiveView {
@@ -33,8 +56,9 @@ public:
     /// Opens the window (fem::Error without a display). screenshot_step ≥ 0: save the window at that
     /// step to screenshot (for the test against the PNG frame of the same step).
     LiveView(const SceneSpec& scene, std::filesystem::path screenshot = {}, int screenshot_step = -1);
-    /// Shows one frame and handles the keys pressed since the last one.
-    void frame(const io::MeshData& frame, int step, double time);
+    /// Shows one frame (models: what the bodies use now, as frame_caption writes it) and handles the
+    /// keys pressed since the last one.
+    void frame(const io::MeshData& frame, int step, double time, const std::string& models);
 
 private:
     const SceneSpec& scene_;

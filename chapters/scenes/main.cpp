@@ -118,7 +118,9 @@ int main(int argc, char** argv)
         std::unique_ptr<LiveView> live;
         if (view && fig::display_available()) {
             live = std::make_unique<LiveView>(scenes.front(), run.file(str("view_", screenshot, ".png")), screenshot);
-            options.on_frame = [&](const io::MeshData& frame, int step, double time) { live->frame(frame, step, time); };
+            options.on_frame = [&](const io::MeshData& frame, int step, double time, const std::string& models) {
+                live->frame(frame, step, time, models);
+            };
         } else if (view) {
             std::cout << "note: no display for --view (set DISPLAY); the run goes on headless\n";
         }

@@ -47,7 +47,10 @@ void make_video(const RunContext& run, const std::string& stem, const OutputSpec
 
 /// The shortest video make_video writes [s].
 inline constexpr double min_video_seconds = 5.0;
-void make_video(const RunContext& run, const std::string& stem, const OutputSpec& output);
+
+/// The frames per second a video of `frames` frames plays at: output.frame_rate, or fewer,
+/// frames / min_video_seconds, when that would last less than min_video_seconds (slow motion).
+double video_frame_rate(int frames, const OutputSpec& output);
 
 /// A one-line progress bar on stderr (only when it is a terminal): done, time left, steps per
 /// second, Newton iterations per step.

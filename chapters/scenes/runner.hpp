@@ -59,8 +59,10 @@ struct RunResult {
     int frame_count = 0;
 };
 
-/// Called with every frame written (the merged mesh of every body), its step and time.
-using FrameObserver = std::function<void(const io::MeshData& frame, int step, double time)>;
+/// Called with every frame written (the merged mesh of every body), its step and time, and the
+/// models the bodies use at that frame (as frame_caption writes them).
+using FrameObserver =
+    std::function<void(const io::MeshData& frame, int step, double time, const std::string& models)>;
 
 /// How to run a scene.
 struct RunOptions {
@@ -87,6 +89,9 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options);
 /// The steps between two frames: 1/(frame_rate Δt) rounded, at least 1 (a frame at every multiple
 /// of it, and at the last step).
 int steps_per_frame(const SceneSpec& scene);
+
+/// The frames a whole run writes: one at step 0, at every steps_per_frame-th step and at the last.
+int frame_count(const SceneSpec& scene);
 
 /// run_scene writing nothing and printing nothing, keeping every frame's positions (and every step's
 /// record): the run a comparison or a test looks at. model (when set) replaces every body's model.

@@ -135,6 +135,12 @@ bool have_ffmpeg()
 
 }  // namespace
 
+double video_frame_rate(int frames, const OutputSpec& output)
+{
+    // Slow motion when the frames at their own rate would last less than min_video_seconds.
+    return frames > 0 ? std::min(output.frame_rate, frames / min_video_seconds) : output.frame_rate;
+}
+
 void make_video(const RunContext& run, const std::string& stem, const OutputSpec& output)
 {
     if (!have_ffmpeg()) {
@@ -151,8 +157,7 @@ void make_video(const RunContext& run, const std::string& stem, const OutputSpec
     int frames = 0;
     while (frame_exists(frames))
         ++frames;
-    // Slow motion when the frames at their own rate would last less than min_video_seconds.
-    const double rate = frames > 0 ? std::min(output.frame_rate, frames / min_video_seconds) : output.frame_rate;
+    const double rate = video_frame_rate(frames, output);
     const std::string filter =
         output.video == "mp4"
             ? "-pix_fmt yuv420p -r 30 -vf 'scale=1280:720:force_original_aspect_ratio=decrease,"

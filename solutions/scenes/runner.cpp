@@ -70,6 +70,7 @@ struct BodyRun {
     std::unique_ptr<LevelIntegrator> integrator;
     std::unique_ptr<ContactIntegrator> contact;  // null: the scene has no obstacles
     std::unique_ptr<dynamics::Simulation> simulation;
+    bool automatic = false;  // the model is auto's choice of the moment
     std::vector<Segment> segments;
     std::vector<dynamics::StepRecord> records;
 
@@ -83,6 +84,7 @@ BodyRun start_body(const BodySpec& spec, const SceneSpec& scene, const std::stri
     b.spec = &spec;
     const std::string chosen = model.empty() ? spec.model : model;
     const bool automatic = chosen == "auto";
+    b.automatic = automatic;
     const std::string hyperelastic = hyper::is_hyperelastic(chosen) ? chosen : scene.thresholds.hyperelastic;
     auto forces = std::make_unique<SceneForces>(spec.mesh, spec.material, hyperelastic,
                                                 automatic ? Level::linear : level_of(chosen));
@@ -141,6 +143,29 @@ io::MeshData scene_frame(const std::vector<BodyRun>& bodies, const OutputSpec& o
     return merged_frame(parts, output);
 }
 
+/// The models the bodies use now, for a frame's caption: "stable neo-Hookean", "auto: corotational"
+/// for auto's choice, and with several bodies each named ("stiff corotational, soft stable neo-Hookean").
+std::string frame_models(const std::vector<BodyRun>& bodies)
+{
+    std::string out;
+    for (const BodyRun& b : bodies) {
+        const std::string model = str(b.automatic ? "auto: " : "", model_label(b.forces->level_model()));
+        out += bodies.size() == 1 ? model : str(out.empty() ? "" : ", ", b.spec->name, " ", model);
+    }
+    return out;
+}
+
+/// The lattice of a skinned body drawn around its skin: the body's frame k (warped as the skin is),
+/// its surface's edges coloured by the skin's field on the skin's colour scale.
+fig::Prop lattice_prop(const io::MotionRecorder& bodies, std::size_t k, double warp)
+{
+    fig::Prop lattice;
+    lattice.shape = io::warped(bodies.kept_frame(k), warp);
+    lattice.by_field = true;
+    lattice.wireframe = true;
+    return lattice;
+}
+
 }  // namespace
 
 RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
@@ -169,8 +194,10 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
     StepHistory history;
     RunResult result;
     result.frames.resize(bodies.size());
+    std::vector<std::string> models;  // per frame, for its caption
     const auto frame = [&] {
         const dynamics::State& first = bodies.front().state();
+        models.push_back(frame_models(bodies));
         if (recorder || options.on_frame) {
             const io::MeshData data = scene_frame(bodies, scene.output);
             if (recorder)
@@ -178,7 +205,7 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
             if (skin_recorder)
                 skin_recorder->add(first.time, skin->frame(bodies[skinned].state().u));
             if (options.on_frame)
-                options.on_frame(data, first.step, first.time);
+                options.on_frame(data, first.step, first.time, models.back());
         }
         if (options.keep_positions)
             for (std::size_t i = 0; i < bodies.size(); ++i)
@@ -238,15 +265,33 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
     if (scene.output.charts)
         history.save_charts(scene, bodies.size(), *run);
     if (recorder && png && !result.interrupted) {
-        const int written = recorder->render_png_frames(run->file(stem), frame_view(scene), scene.output.warp);
-        // A skinned scene's picture is its skin (the bunny, not the lattice that carries it), coloured
-        // by its displacement, the one field a skin frame has besides its normals; the video shows it.
+        // Every frame captioned with the models of its moment; the obstacles drawn at its time under
+        // the box the camera frames (the scene's, as the live view takes it, or the motion's).
+        const double warp = scene.output.warp;
+        const std::array<double, 6> box = scene.output.frame_box.value_or(recorder->motion_bounds(warp));
+        io::FrameExtras extras;
+        extras.title = [&](std::size_t k, double time) { return frame_title(scene, models.at(k), time); };
+        extras.props = [&](std::size_t, double time) { return obstacle_props(scene, box, time); };
+        const int written = recorder->render_png_frames(run->file(stem), frame_view(scene), warp, extras);
+        // A skinned scene's picture is its skin (the bunny), coloured by its displacement, the one
+        // field a skin frame has besides its normals, with the lattice that carries it drawn around it
+        // as edges on the same colour scale; the video shows it.
         int skin_written = 0;
         if (skin_recorder) {
             fig::RenderOptions view = frame_view(scene);
             view.field = "displacement";
+            view.unit = "m";
+            view.clip_percentile = 100.0;
             view.range.reset();
-            skin_written = skin_recorder->render_png_frames(run->file(stem + "_skin"), view, scene.output.warp);
+            view.smooth = true;  // a render surface: shaded smooth by its normals, no facets or edges
+            view.show_edges = false;
+            io::FrameExtras skin_extras = extras;
+            skin_extras.props = [&](std::size_t k, double time) {
+                std::vector<fig::Prop> props = obstacle_props(scene, box, time);
+                props.push_back(lattice_prop(*recorder, k, warp));
+                return props;
+            };
+            skin_written = skin_recorder->render_png_frames(run->file(stem + "_skin"), view, warp, skin_extras);
         }
         if (written > 0 && scene.output.video != "none")
             make_video(*run, skin_written > 0 ? stem + "_skin" : stem, scene.output);
@@ -257,6 +302,12 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
 int steps_per_frame(const SceneSpec& scene)
 {
     return std::max(1, static_cast<int>(std::lround(1.0 / (scene.output.frame_rate * scene.time_step))));
+}
+
+int frame_count(const SceneSpec& scene)
+{
+    const int steps = dynamics::step_count(scene.duration, scene.time_step), every = steps_per_frame(scene);
+    return 1 + steps / every + (steps % every != 0 ? 1 : 0);
 }
 
 RunResult run_positions(const SceneSpec& scene, const std::string& model)

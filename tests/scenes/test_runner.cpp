@@ -1,6 +1,7 @@
 // The runner: loads and prescribed motion against closed forms, determinism, an interrupted run,
 // and bad scene files refused by fem_scene before it writes anything. docs/scenes.md#the-runner
 #include "scenes/runner.hpp"
+#include "scenes/scene_text.hpp"
 
 #include "06_assembly/assembly.hpp"
 
@@ -31,14 +32,7 @@ namespace {
 const std::filesystem::path gallery = FEM_SCENES_DIR;
 const std::filesystem::path output = FEM_TEST_OUTPUT_DIR;
 
-/// A scene from its text, written into the tests' output folder first.
-SceneSpec scene_from(const std::string& name, const std::string& text)
-{
-    std::filesystem::create_directories(output);
-    const std::filesystem::path file = output / (name + ".toml");
-    std::ofstream(file) << text;
-    return read_scene(file);
-}
+using testing::scene_from;
 
 
 /// A free 0.1 m cube (no pin, no gravity) pushed by one load for 0.2 s at Δt = 0.02 s.
@@ -249,20 +243,35 @@ TEST_CASE("the live view shows the PNG frame of the same step, pixel for pixel",
         WARN("SKIPPED: no X display: run the tests under xvfb-run -a to check the live view");
         return;
     }
-    const std::filesystem::path base = output / "view";
-    std::filesystem::remove_all(base);
-    const std::string scene = (gallery / "cantilever.toml").string();
-    const std::string files = "'" FEM_SCENE_EXE "' '" + scene + "' --quick --no-progress --out '" + (base / "files").string() +
-                              "' >/dev/null 2>&1";
-    const std::string view = "'" FEM_SCENE_EXE "' '" + scene + "' --quick --no-progress --view --screenshot 5 --out '" +
-                             (base / "view").string() + "' >/dev/null 2>&1";
-    REQUIRE(std::system(files.c_str()) == 0);
-    REQUIRE(std::system(view.c_str()) == 0);
-    // [quick]: 12 frames per second at dt = 1/60 s, a frame every 5 steps: step 5 is frame 1.
-    const std::string png = read_text(base / "files" / "cantilever_0001.png");
-    REQUIRE(png.size() > 1000);
-    CHECK(read_text(base / "view" / "view_5.png") == png);
-    CHECK(read_text(base / "view" / "cantilever_0002.png") != png);  // another step is another picture
+    // The cantilever, and the bunny dropped on a floor: its obstacle and the caption (scene, model,
+    // time, slow motion) drawn alike by both paths. Each scene fixes the camera's box and the colour
+    // range, so that the live view, which cannot know the run's, draws exactly what the PNGs do.
+    struct Case {
+        std::string scene, settings, png;
+        int step;
+    };
+    const std::string bunny_box = "--set 'output.frame_box=[[-0.1, -0.01, -0.08], [0.08, 0.11, 0.08]]' "
+                                  "--set 'output.colour_range=[0.0, 2000.0]' --set output.png=true";
+    // [quick]: cantilever 12 frames per second at dt = 1/60 s, a frame every 5 steps: step 5 is frame
+    // 1; bunny_drop 25 frames per second at dt = 1/100 s, every 4 steps: step 8 is frame 2.
+    for (const Case& c : {Case{"cantilever", "", "cantilever_0001.png", 5},
+                          Case{"bunny_drop", bunny_box, "bunny_drop_0002.png", 8}}) {
+        CAPTURE(c.scene);
+        const std::filesystem::path base = output / ("view_" + c.scene);
+        std::filesystem::remove_all(base);
+        const std::string scene = (gallery / (c.scene + ".toml")).string();
+        const std::string files = "'" FEM_SCENE_EXE "' '" + scene + "' --quick --no-progress " + c.settings + " --out '" +
+                                  (base / "files").string() + "' >/dev/null 2>&1";
+        const std::string view = "'" FEM_SCENE_EXE "' '" + scene + "' --quick --no-progress " + c.settings +
+                                 " --view --screenshot " + std::to_string(c.step) + " --out '" + (base / "view").string() +
+                                 "' >/dev/null 2>&1";
+        REQUIRE(std::system(files.c_str()) == 0);
+        REQUIRE(std::system(view.c_str()) == 0);
+        const std::string png = read_text(base / "files" / c.png);
+        REQUIRE(png.size() > 1000);
+        CHECK(read_text(base / "view" / ("view_" + std::to_string(c.step) + ".png")) == png);
+        CHECK(read_text(base / "view" / (c.scene + "_0000.png")) != png);  // another step is another picture
+    }
 }
 
 TEST_CASE("the live view without a display: one line says so and the run goes on headless", "[scenes]")
