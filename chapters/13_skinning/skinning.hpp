@@ -128,10 +128,30 @@ private:
     std::vector<int> offsets_, tets_;   // tets of cell c: tets_[offsets_[c] … offsets_[c+1]−1]
 };
 
+/// A node of a bounding-volume hierarchy: its box, and either two children or a range of items.
+struct BoxNode {
+    Eigen::Vector3d low, high;
+    int left = -1, right = -1;   ///< children (-1 for a leaf)
+    int first = 0, count = 0;    ///< a leaf's items: items[first … first + count − 1]
+};
+
+/// A bounding-volume hierarchy over any boxes: nodes[0] is the root, and the leaves' ranges index
+/// items, the box numbers in tree order.
+struct BoxHierarchy {
+    std::vector<BoxNode> nodes;
+    std::vector<int> items;
+};
+
+/// The hierarchy of boxes (each 2×3: rows min and max): a node's box holds its items' boxes, split
+/// at the median of the box centres along the node box's longest axis until a leaf holds at most
+/// leaf_size (≥ 1) boxes. The tree of AabbTree (tets) and of chapter 14's mesh obstacle (triangles).
+/// docs/13_skinning.md#an-aabb-tree
+BoxHierarchy box_hierarchy(const std::vector<Eigen::Matrix<double, 2, 3>>& boxes, int leaf_size);
+
 /// A bounding-volume hierarchy: a binary tree of axis-aligned boxes, each node's box holding its
 /// tets' padded boxes, split at the median of the tet centroids along the box's longest axis until
-/// a leaf holds at most `leaf_size` tets. A query descends into every child whose box holds p.
-/// docs/13_skinning.md#an-aabb-tree
+/// a leaf holds at most `leaf_size` tets (box_hierarchy). A query descends into every child whose
+/// box holds p. docs/13_skinning.md#an-aabb-tree
 class AabbTree final : public PointLocator {
 public:
     /// fem::Error for a tolerance outside [0, 0.5) or leaf_size < 1. frames must outlive the tree.
@@ -143,15 +163,9 @@ public:
     int depth() const;
 
     /// A node: its box, and either two children or a range of tets_ (first, count).
-    struct Node {
-        Eigen::Vector3d low, high;
-        int left = -1, right = -1;   ///< children (-1 for a leaf)
-        int first = 0, count = 0;    ///< a leaf's tets: tets_[first … first + count − 1]
-    };
+    using Node = BoxNode;
 
 private:
-    int build(int first, int count, int leaf_size, const std::vector<Eigen::Vector3d>& centroids);
-
     const BarycentricFrames& frames_;
     double tolerance_;
     std::vector<Eigen::Matrix<double, 2, 3>> boxes_;  // padded box per tet

@@ -6,10 +6,12 @@
 //
 // For a body with surface vertices x_v = X_v + u_v and obstacles o (at the step's end time t + Δt):
 //
-//   P(u) = Σ_v Σ_o κ b(d_o(x_v))  +  Σ_k μ_k λ_k f₀(‖T_kᵀ (x_v − x_vᵗ − Δt w_o)‖)
+//   P(u) = Σ_v Σ_o Σ_p κ b(d_{o,p}(x_v))  +  Σ_k μ_k λ_k f₀(‖T_kᵀ (x_v − x_vᵗ − Δt w_o)‖)
 //
-// the barrier (b of barrier.hpp, active where d < d̂) and the friction of every pair k = (v, o) that
-// was within d̂ at the step's start: λ_k = κ |b'(d_o(x_vᵗ))| its lagged normal force [N], T_k (3×2)
+// the barrier (b of barrier.hpp, active where d < d̂) over the pieces p of each obstacle within d̂
+// (Obstacle::pieces: a half-space, sphere or box is one piece, a mesh one per triangle: IPC's one
+// barrier per pair) and the friction of every pair k = (v, o) that was within d̂ at the step's start:
+// λ_k = κ Σ_p |b'(d_{o,p}(x_vᵗ))| its lagged normal force [N], T_k (3×2)
 // an orthonormal basis of the tangent plane ⟂ ∇d_o(x_vᵗ), w_o the obstacle's velocity (IPC: lagged friction).
 
 #include "14_contact/obstacles.hpp"
@@ -42,7 +44,7 @@ struct ContactOptions {
 /// of the step's start.
 struct FrictionPair {
     int vertex = 0, obstacle = 0;
-    double normal_force = 0.0;           ///< λ = κ |b'(d(x_vᵗ))| [N]
+    double normal_force = 0.0;           ///< λ = κ Σ_p |b'(d_p(x_vᵗ))| over the obstacle's pieces [N]
     double coefficient = 0.0;            ///< μ of the obstacle
     Eigen::Matrix<double, 3, 2> tangent; ///< T: orthonormal, ⟂ ∇d(x_vᵗ)
     Eigen::Vector3d start;               ///< x_vᵗ + Δt w_o: where the vertex sticks to the obstacle
@@ -76,7 +78,7 @@ public:
 
     /// P(u) of the header [J] (+∞ when some surface vertex has d ≤ 0).
     double energy(const Eigen::VectorXd& u) const override;
-    /// ∇P (3n): κ b'(d) ∇d per active pair, plus μλ f₁(y) T ŷ per friction pair (ŷ = Tᵀ(x − start)/y).
+    /// ∇P (3n): κ b'(d) ∇d per active pair and piece, plus μλ f₁(y) T ŷ per friction pair (ŷ = Tᵀ(x − start)/y).
     Eigen::VectorXd gradient(const Eigen::VectorXd& u) const override;
     /// ∇²P made PSD (3n×3n, vertex blocks only): each vertex's block is the sum of κ (b'' ∇d ∇dᵀ + b' ∇²d)
     /// over its active pairs and, per friction pair with s = Tᵀ(x − start), y = ‖s‖,
@@ -86,7 +88,7 @@ public:
     /// min(1, safety × the earliest time of impact of any surface vertex's path x_v + s·Δx_v).
     double largest_safe_step(const Eigen::VectorXd& u, const Eigen::VectorXd& du) const override;
 
-    /// The barrier's part of P: Σ_v Σ_o κ b(d_o(x_v, time)) with the current step's κ [J] (+∞ when
+    /// The barrier's part of P: Σ_v Σ_o Σ_p κ b(d_{o,p}(x_v, time)) with the current step's κ [J] (+∞ when
     /// some surface vertex has d ≤ 0). Its change over a step, with the obstacles at the step's start
     /// and end times, is the work the obstacles did on the body (the scenes runner books it).
     double barrier_energy(const Eigen::VectorXd& u, double time) const;

@@ -12,8 +12,17 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace fem::contact {
+
+/// One piece of an obstacle as a point sees it: the point's distance to the piece [m], its gradient
+/// (3) and Hessian (3×3). The barrier is summed over the pieces within d̂ (IPC: one barrier per pair).
+struct DistancePiece {
+    double distance = 0.0;
+    Eigen::Vector3d gradient = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d hessian = Eigen::Matrix3d::Zero();
+};
 
 /// A rigid obstacle. The body's vertices are kept at d > 0 by chapter 14's barrier.
 class Obstacle {
@@ -37,12 +46,23 @@ public:
     /// beyond the true one).
     virtual double local_time_of_impact(const Eigen::Vector3d& p, const Eigen::Vector3d& dp) const = 0;
 
+    /// The pieces p feels within reach, appended to pieces: a half-space, a sphere or a box is one
+    /// piece, itself (when d₀(p) < reach); a mesh one per triangle within reach. Where the pieces
+    /// meet at an angle (a mesh's creases) the nearest one's distance has a kink, the sum of their
+    /// barriers does not. docs/14_contact.md#mesh-obstacles
+    virtual void local_pieces(const Eigen::Vector3d& p, double reach, std::vector<DistancePiece>& pieces) const;
+
     /// d(x, t) = d₀(x − t w) [m].
     double distance(const Eigen::Vector3d& x, double time) const { return local_distance(x - time * velocity_); }
     /// ∇d(x, t) (3).
     Eigen::Vector3d gradient(const Eigen::Vector3d& x, double time) const { return local_gradient(x - time * velocity_); }
     /// ∇²d(x, t) (3×3).
     Eigen::Matrix3d hessian(const Eigen::Vector3d& x, double time) const { return local_hessian(x - time * velocity_); }
+    /// The pieces x feels within reach at time t (local_pieces), appended to pieces.
+    void pieces(const Eigen::Vector3d& x, double time, double reach, std::vector<DistancePiece>& pieces) const
+    {
+        local_pieces(x - time * velocity_, reach, pieces);
+    }
     /// The time of impact of x + s·dx against the obstacle held at time t (s ≥ 0, +∞: none).
     double time_of_impact(const Eigen::Vector3d& x, const Eigen::Vector3d& dx, double time) const
     {
@@ -56,6 +76,14 @@ private:
     Eigen::Vector3d velocity_;
     double friction_;
 };
+
+/// Conservative advancement along p + s·dp for an obstacle whose d₀ is 1-Lipschitz (|∇d₀| ≤ 1: a
+/// box's, a mesh's): from s = 0, s ← s + d₀(p + s dp)/|dp| — the path cannot lose more distance
+/// than its length, so no s it reaches lies beyond the first zero of d₀ — stopped at the first s
+/// where d₀ has fallen to 5 % of its start (or after 100 advances); +∞ when the path does not reach
+/// the obstacle by s = 2 (callers step at most s = 1); 0 when d₀(p) ≤ 0.
+/// docs/14_contact.md#continuous-collision-detection
+double conservative_time_of_impact(const Obstacle& obstacle, const Eigen::Vector3d& p, const Eigen::Vector3d& dp);
 
 /// The half-space {x : n·(x − p) < 0} below the plane through p with unit normal n (a floor, a
 /// slope): d = n·(x − p), ∇d = n, ∇²d = 0; time of impact d/(−n·dx) when n·dx < 0.
@@ -97,9 +125,7 @@ private:
 /// q = Rᵀ(x − c), with e = |q| − h (per axis): outside d = |max(e, 0)| (the nearest face, edge or
 /// corner), inside d = max eᵢ. ∇d = R (sign(q) ∘ max(e, 0))/d outside; ∇²d = R (P_A − n nᵀ)/d Rᵀ with
 /// P_A the diagonal of the axes where eᵢ > 0 (0 on a face, a cylinder's on an edge, a sphere's at a
-/// corner). Its time of impact is conservative advancement (d is 1-Lipschitz: a path of length
-/// s|dx| cannot lose more than that of distance), stopped when d has fallen to 5 % of its start;
-/// +∞ when the path does not reach the box by s = 2 (callers step at most s = 1).
+/// corner). Its time of impact is conservative advancement (conservative_time_of_impact).
 class Box final : public Obstacle {
 public:
     /// fem::Error for a half extent ≤ 0, a rotation that is not orthonormal with det +1 (to 1e-9),

@@ -19,6 +19,8 @@ struct Settings {
     std::vector<int> friction_updates{1, 3, 0};            ///< lagged friction updates per step swept (slope; 0: until converged)
     double drop_height = 0.05;                             ///< h [m]
     double duration = 0.5;                                 ///< length of each run [s]
+    int mesh_queries = 20000;                              ///< random points a mesh distance is timed on
+    std::vector<double> grid_spacings{0.01, 0.005, 0.0025}; ///< the sampled grids' spacings h [m]
 };
 
 /// The one-line description of a swept configuration, e.g. "dhat 1e-3, kappa adaptive".
@@ -32,5 +34,6 @@ BlockSettings block_settings(const Case& c);
 
 void drop_study(const RunContext& run, const Settings& settings);
 void slope_study(const RunContext& run, const Settings& settings);
+void mesh_study(const RunContext& run, const Settings& settings);
 
 }  // namespace fem::contact::study

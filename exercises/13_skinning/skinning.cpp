@@ -199,44 +199,63 @@ AabbTree::AabbTree(const BarycentricFrames& frames, double tolerance, int leaf_s
     require_tolerance(tolerance, "AabbTree");
     if (leaf_size < 1)
         throw Error(str("AabbTree: leaf_size must be ≥ 1, got ", leaf_size));
-    const Eigen::Index n = frames.tets();
-    boxes_.resize(n);
-    std::vector<Eigen::Vector3d> centroids(n);
-    for (Eigen::Index t = 0; t < n; ++t) {
+    boxes_.resize(frames.tets());
+    for (Eigen::Index t = 0; t < frames.tets(); ++t)
         boxes_[t] = padded_box(frames, static_cast<int>(t), tolerance);
-        centroids[t] = 0.5 * (boxes_[t].row(0) + boxes_[t].row(1)).transpose();
-    }
-    tets_.resize(n);
-    std::iota(tets_.begin(), tets_.end(), 0);
-    nodes_.reserve(2 * n / leaf_size + 2);
-    build(0, static_cast<int>(n), leaf_size, centroids);
+    BoxHierarchy tree = box_hierarchy(boxes_, leaf_size);
+    nodes_ = std::move(tree.nodes);
+    tets_ = std::move(tree.items);
 }
 
-int AabbTree::build(int first, int count, int leaf_size, const std::vector<Eigen::Vector3d>& centroids)
+namespace {
+
+/// The node over items[first … first + count − 1] and, below it, its subtree (box_hierarchy).
+int build_node(BoxHierarchy& tree, int first, int count, int leaf_size,
+               const std::vector<Eigen::Matrix<double, 2, 3>>& boxes, const std::vector<Eigen::Vector3d>& centres)
 {
-    Node node;
+    BoxNode node;
     node.low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
     node.high = -node.low;
     for (int k = first; k < first + count; ++k) {
-        node.low = node.low.cwiseMin(boxes_[tets_[k]].row(0).transpose());
-        node.high = node.high.cwiseMax(boxes_[tets_[k]].row(1).transpose());
+        node.low = node.low.cwiseMin(boxes[tree.items[k]].row(0).transpose());
+        node.high = node.high.cwiseMax(boxes[tree.items[k]].row(1).transpose());
     }
-    const int index = static_cast<int>(nodes_.size());
-    nodes_.push_back(node);
+    const int index = static_cast<int>(tree.nodes.size());
+    tree.nodes.push_back(node);
     if (count <= leaf_size) {
-        nodes_[index].first = first;
-        nodes_[index].count = count;
+        tree.nodes[index].first = first;
+        tree.nodes[index].count = count;
         return index;
     }
     int axis = 0;
     (node.high - node.low).maxCoeff(&axis);
-    const auto begin = tets_.begin() + first, middle = begin + count / 2, end = begin + count;
-    std::nth_element(begin, middle, end, [&](int a, int b) { return centroids[a][axis] < centroids[b][axis]; });
-    const int left = build(first, count / 2, leaf_size, centroids);
-    const int right = build(first + count / 2, count - count / 2, leaf_size, centroids);
-    nodes_[index].left = left;
-    nodes_[index].right = right;
+    const auto begin = tree.items.begin() + first, middle = begin + count / 2, end = begin + count;
+    std::nth_element(begin, middle, end, [&](int a, int b) { return centres[a][axis] < centres[b][axis]; });
+    const int left = build_node(tree, first, count / 2, leaf_size, boxes, centres);
+    const int right = build_node(tree, first + count / 2, count - count / 2, leaf_size, boxes, centres);
+    tree.nodes[index].left = left;
+    tree.nodes[index].right = right;
     return index;
+}
+
+}  // namespace
+
+BoxHierarchy box_hierarchy(const std::vector<Eigen::Matrix<double, 2, 3>>& boxes, int leaf_size)
+{
+    if (leaf_size < 1)
+        throw Error(str("box_hierarchy: leaf_size must be ≥ 1, got ", leaf_size));
+    if (boxes.empty())
+        throw Error("box_hierarchy: no boxes; give at least one");
+    const std::size_t n = boxes.size();
+    std::vector<Eigen::Vector3d> centres(n);
+    for (std::size_t i = 0; i < n; ++i)
+        centres[i] = 0.5 * (boxes[i].row(0) + boxes[i].row(1)).transpose();
+    BoxHierarchy tree;
+    tree.items.resize(n);
+    std::iota(tree.items.begin(), tree.items.end(), 0);
+    tree.nodes.reserve(2 * n / leaf_size + 2);
+    build_node(tree, 0, static_cast<int>(n), leaf_size, boxes, centres);
+    return tree;
 }
 
 Location AabbTree::locate(const Eigen::Vector3d& p) const

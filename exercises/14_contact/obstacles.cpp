@@ -29,6 +29,13 @@ Obstacle::Obstacle(const Eigen::Vector3d& velocity, double friction) : velocity_
         throw Error(str("obstacle: the friction coefficient mu must be a finite number >= 0, got ", friction));
 }
 
+void Obstacle::local_pieces(const Eigen::Vector3d& p, double reach, std::vector<DistancePiece>& pieces) const
+{
+    const double d = local_distance(p);
+    if (d < reach)
+        pieces.push_back(DistancePiece{d, local_gradient(p), local_hessian(p)});
+}
+
 // --- Half-space ------------------------------------------------------------------------------------
 
 HalfSpace::HalfSpace(const Eigen::Vector3d& point, const Eigen::Vector3d& normal, double friction,
@@ -159,8 +166,15 @@ Eigen::Matrix3d Box::local_hessian(const Eigen::Vector3d& p) const
 
 double Box::local_time_of_impact(const Eigen::Vector3d& p, const Eigen::Vector3d& dp) const
 {
-    // Conservative advancement: from s, the path cannot reach the box before s + d(p + s dp)/|dp|.
-    const double start = local_distance(p), length = dp.norm();
+    return conservative_time_of_impact(*this, p, dp);
+}
+
+// --- Conservative advancement ------------------------------------------------------------------------
+
+double conservative_time_of_impact(const Obstacle& obstacle, const Eigen::Vector3d& p, const Eigen::Vector3d& dp)
+{
+    // From s, the path cannot reach the obstacle before s + d(p + s dp)/|dp|.
+    const double start = obstacle.local_distance(p), length = dp.norm();
     if (!(start > 0.0))
         return 0.0;
     if (!(length > 0.0))
@@ -168,7 +182,7 @@ double Box::local_time_of_impact(const Eigen::Vector3d& p, const Eigen::Vector3d
     constexpr double far = 2.0;  // callers step at most s = 1: beyond this, no impact that matters
     double s = 0.0;
     for (int iteration = 0; iteration < 100; ++iteration) {
-        const double d = local_distance(p + s * dp);
+        const double d = obstacle.local_distance(p + s * dp);
         if (d <= 0.05 * start)
             return s;
         s += d / length;

@@ -155,7 +155,10 @@ void ContactPotential::begin_step(dynamics::Body& body, const dynamics::State& s
             FrictionPair pair;
             pair.vertex = v;
             pair.obstacle = o;
-            pair.normal_force = stiffness_ * std::abs(barrier(d, options_.activation_distance).first);
+            std::vector<DistancePiece> pieces;
+            obstacle.pieces(x, lag_time, options_.activation_distance, pieces);
+            for (const DistancePiece& piece : pieces)
+                pair.normal_force += stiffness_ * std::abs(barrier(piece.distance, options_.activation_distance).first);
             pair.coefficient = obstacle.friction();
             pair.tangent = tangent_basis(obstacle.gradient(x, lag_time));
             pair.start = position(state.u, v) + time_step * obstacle.velocity();
@@ -213,11 +216,16 @@ double ContactPotential::barrier_energy(const Eigen::VectorXd& u, double time) c
     double total = 0.0;
     for (int v : surface_)
         for (const auto& obstacle : obstacles_) {
-            const double d = obstacle->distance(position(u, v), time);
+            const Eigen::Vector3d x = position(u, v);
+            const double d = obstacle->distance(x, time);
             if (!(d > 0.0))
                 return infinity;
-            if (d < options_.activation_distance)
-                total += stiffness_ * barrier(d, options_.activation_distance).value;
+            if (!(d < options_.activation_distance))
+                continue;
+            std::vector<DistancePiece> pieces;
+            obstacle->pieces(x, time, options_.activation_distance, pieces);
+            for (const DistancePiece& piece : pieces)
+                total += stiffness_ * barrier(piece.distance, options_.activation_distance).value;
         }
     return total;
 }
@@ -239,11 +247,11 @@ Eigen::VectorXd ContactPotential::barrier_forces(const Eigen::VectorXd& u) const
     Eigen::VectorXd forces = Eigen::VectorXd::Zero(u.size());
     for (int v : surface_)
         for (const auto& obstacle : obstacles_) {
-            const Eigen::Vector3d x = position(u, v);
-            const double d = obstacle->distance(x, time_);
-            if (d < options_.activation_distance)
-                forces.segment<3>(3 * v) -= stiffness_ * barrier(d, options_.activation_distance).first *
-                                            obstacle->gradient(x, time_);
+            std::vector<DistancePiece> pieces;
+            obstacle->pieces(position(u, v), time_, options_.activation_distance, pieces);
+            for (const DistancePiece& piece : pieces)
+                forces.segment<3>(3 * v) -=
+                    stiffness_ * barrier(piece.distance, options_.activation_distance).first * piece.gradient;
         }
     return forces;
 }
@@ -274,13 +282,13 @@ dynamics::SparseMatrix ContactPotential::hessian(const Eigen::VectorXd& u) const
     };
     for (int v : surface_)
         for (const auto& obstacle : obstacles_) {
-            const Eigen::Vector3d x = position(u, v);
-            const double d = obstacle->distance(x, time_);
-            if (!(d < options_.activation_distance))
-                continue;
-            const BarrierValue b = barrier(d, options_.activation_distance);
-            const Eigen::Vector3d n = obstacle->gradient(x, time_);
-            add(v, stiffness_ * (b.second * n * n.transpose() + b.first * obstacle->hessian(x, time_)));
+            std::vector<DistancePiece> pieces;
+            obstacle->pieces(position(u, v), time_, options_.activation_distance, pieces);
+            for (const DistancePiece& piece : pieces) {
+                const BarrierValue b = barrier(piece.distance, options_.activation_distance);
+                const Eigen::Vector3d& n = piece.gradient;
+                add(v, stiffness_ * (b.second * n * n.transpose() + b.first * piece.hessian));
+            }
         }
     for (const FrictionPair& pair : pairs_) {
         const Eigen::Vector2d s = pair.tangent.transpose() * (position(u, pair.vertex) - pair.start);

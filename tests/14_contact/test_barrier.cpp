@@ -4,6 +4,7 @@
 #include "14_contact/barrier.hpp"
 #include "14_contact/contact.hpp"
 #include "14_contact/contact_scenes.hpp"
+#include "14_contact/mesh_obstacle.hpp"
 #include "14_contact/obstacles.hpp"
 
 #include "12_hyperelastic_newton/materials.hpp"
@@ -18,6 +19,7 @@
 
 #include <cmath>
 #include <memory>
+#include <string>
 #include <vector>
 
 using namespace fem;
@@ -200,13 +202,28 @@ TEST_CASE("contact potential: gradient and Hessian of barrier and friction again
     settings.friction = 0.4;
     settings.contact.stiffness = 50.0;
     const double dt = settings.time_step;
-    for (bool sphere : {false, true}) {
+    for (const char* name : {"floor", "sphere", "mesh"}) {
+        const std::string kind = name;
         BlockScene block = block_scene(settings);
         std::vector<std::shared_ptr<const Obstacle>> obstacles{
             std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.4)};
-        if (sphere)  // touching the top face's corner (0.1, 0.1, 0.1002) from above
+        if (kind == "sphere")  // touching the top face's corner (0.1, 0.1, 0.1002) from above
             obstacles = {std::make_shared<Sphere>(Eigen::Vector3d(0.2, 0.2, 0.2), (Eigen::Vector3d(0.1, 0.1, 0.1002) -
                               Eigen::Vector3d(0.2, 0.2, 0.2)).norm() - 4e-4, 0.4)};
+        if (kind == "mesh") {
+            // A shallow four-sided dimple under the corner (0, 0, 0.0002): its lowest vertex right under
+            // it, its rim 4 cm away 0.1 mm higher. The corner feels all four triangles (faces, edges and
+            // the vertex compete within d̂): the sum of their barriers is what P holds.
+            TriMesh dimple;
+            dimple.V.resize(5, 3);
+            dimple.V << 0.0, 0.0, 0.0, 0.04, 0.0, 1e-4, 0.0, 0.04, 1e-4, -0.04, 0.0, 1e-4, 0.0, -0.04, 1e-4;
+            dimple.F.resize(4, 3);
+            dimple.F << 0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 1;
+            obstacles = {std::make_shared<MeshObstacle>(dimple, 0.4)};
+            std::vector<DistancePiece> felt;
+            obstacles[0]->pieces(Eigen::Vector3d(0.0, 0.0, 2e-4), 0.0, settings.contact.activation_distance, felt);
+            REQUIRE(felt.size() == 4);
+        }
         ContactPotential contact(*block.body, obstacles, settings.contact);
         // The state at t: sliding sideways, friction pairs from it; then u displaced a little.
         dynamics::State state = block.state;
@@ -229,7 +246,7 @@ TEST_CASE("contact potential: gradient and Hessian of barrier and friction again
                 g_fd[i] = (contact.energy(u + e) - contact.energy(u - e)) / (2.0 * h);
                 H_fd.col(i) = (contact.gradient(u + e) - contact.gradient(u - e)) / (2.0 * h);
             }
-            INFO((sphere ? "sphere" : "floor") << ", scale " << scale);
+            INFO(kind << ", scale " << scale);
             CHECK((g - g_fd).norm() <= 1e-6 * g.norm());
             // Per vertex block: the Hessian is the PSD projection of the exact one (for the floor and
             // for friction the exact block is PSD already; a sphere's b'∇²d is negative).

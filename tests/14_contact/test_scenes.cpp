@@ -4,6 +4,7 @@
 // docs/14_contact.md#checks
 #include "14_contact/contact.hpp"
 #include "14_contact/contact_scenes.hpp"
+#include "14_contact/mesh_obstacle.hpp"
 #include "14_contact/obstacles.hpp"
 
 #include "12_hyperelastic_newton/newton.hpp"
@@ -208,7 +209,8 @@ namespace {
 
 /// Fires the block at 100 m/s (100 × a drop's ~1 m/s: one step of 1/100 s would carry it 1 m) at
 /// the obstacle, 0.1 m below it, and watches every configuration Newton evaluates for 10 steps.
-void fire_at(std::shared_ptr<const Obstacle> obstacle)
+/// Returns the lowest z of the block at the end.
+double fire_at(std::shared_ptr<const Obstacle> obstacle)
 {
     BlockSettings settings;
     settings.height = 0.2;
@@ -230,6 +232,7 @@ void fire_at(std::shared_ptr<const Obstacle> obstacle)
     INFO(watched.evaluations << " evaluations");
     CHECK(watched.smallest > 0.0);
     CHECK(watched.smallest < settings.contact.activation_distance);  // it did reach the obstacle
+    return lowest_height(*block.body, block.state.u);
 }
 
 }  // namespace
@@ -243,6 +246,23 @@ TEST_CASE("fired at a ball at 100 times a drop's speed, no vertex gets inside or
 {
     // Under the block's four lower corners; one unchecked step would carry them 1 m past it.
     fire_at(std::make_shared<Sphere>(Eigen::Vector3d(0.05, 0.05, 0.0), 0.08));
+}
+
+TEST_CASE("fired at a triangle mesh at 100 times a drop's speed, no vertex gets through its sheet or onto it",
+          "[ex14.5]")
+{
+    // A tent: the square [-1, 1]² at z = 0 cut into four triangles at a raised apex (0.05, 0.05, 0.02)
+    // under the block's centre; the block's lower corners come down over two of its ridges (edge
+    // regions) and its faces (face regions). An open sheet: its distance is unsigned, nothing stops a
+    // vertex that jumps it but the conservative line search.
+    TriMesh tent;
+    tent.V.resize(5, 3);
+    tent.V << -1.0, -1.0, 0.0, 1.0, -1.0, 0.0, 1.0, 1.0, 0.0, -1.0, 1.0, 0.0, 0.05, 0.05, 0.02;
+    tent.F.resize(4, 3);
+    tent.F << 0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 4;
+    // Still above the sheet (z ≥ 0 everywhere under the block), on the side it came from: a vertex
+    // that had jumped it would be a metre below.
+    CHECK(fire_at(std::make_shared<MeshObstacle>(tent)) > 0.0);
 }
 
 TEST_CASE("a conveyor floor (moving along x) drags a resting block up to its speed by friction", "[ex14.4]")

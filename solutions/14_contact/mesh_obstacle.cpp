@@ -1,0 +1,332 @@
+// Chapter 14: a triangle mesh as an obstacle — the distance to its nearest triangle by chapter 13's
+// AABB tree, and the same distance sampled on a grid. docs/14_contact.md#mesh-obstacles
+#include "14_contact/mesh_obstacle.hpp"
+
+#include "common/error.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+namespace fem::contact {
+namespace {
+
+constexpr double infinity = std::numeric_limits<double>::infinity();
+
+/// The distance from p to the box (rows min and max; 0 inside).
+double box_distance(const Eigen::Vector3d& low, const Eigen::Vector3d& high, const Eigen::Vector3d& p)
+{
+    return (low - p).cwiseMax(p - high).cwiseMax(0.0).norm();
+}
+
+}  // namespace
+
+TrianglePoint closest_triangle_point(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                     const Eigen::Vector3d& c)
+{
+    TrianglePoint closest;
+    // BEGIN EXERCISE 14.5 closest_triangle_point #distance-to-a-triangle
+    // HINT: With n = (b − a) × (c − a), project p onto the plane: q = p − ((p − a)·n) n/|n|². q is inside
+    // HINT: when the three areas ((b − a) × (q − a))·n, ((c − b) × (q − b))·n, ((a − c) × (q − c))·n are ≥ 0:
+    // HINT: the face. Otherwise the nearest point is on the border: for each edge i → j = (i + 1) mod 3,
+    // HINT: t = clamp((p − xᵢ)·(xⱼ − xᵢ)/|xⱼ − xᵢ|², 0, 1); keep the nearest xᵢ + t (xⱼ − xᵢ): a corner
+    // HINT: (i at t = 0, j at t = 1) or the edge i.
+    const std::array<Eigen::Vector3d, 3> x{a, b, c};
+    const Eigen::Vector3d n = (b - a).cross(c - a);
+    const Eigen::Vector3d q = p - ((p - a).dot(n) / n.squaredNorm()) * n;
+    bool inside = true;
+    for (int i = 0; i < 3; ++i)
+        inside = inside && (x[(i + 1) % 3] - x[i]).cross(q - x[i]).dot(n) >= 0.0;
+    if (inside) {
+        closest.point = q;
+        return closest;
+    }
+    double nearest = infinity;
+    for (int i = 0; i < 3; ++i) {
+        const int j = (i + 1) % 3;
+        const Eigen::Vector3d edge = x[j] - x[i];
+        const double t = std::clamp((p - x[i]).dot(edge) / edge.squaredNorm(), 0.0, 1.0);
+        const Eigen::Vector3d point = t <= 0.0 ? x[i] : t >= 1.0 ? x[j] : Eigen::Vector3d(x[i] + t * edge);
+        const double distance = (p - point).squaredNorm();
+        if (distance < nearest) {
+            nearest = distance;
+            closest.point = point;
+            closest.feature = t > 0.0 && t < 1.0 ? TriangleFeature::edge : TriangleFeature::vertex;
+            closest.corner = t < 1.0 ? i : j;
+        }
+    }
+    // END EXERCISE
+    return closest;
+}
+
+// --- The mesh obstacle ------------------------------------------------------------------------------
+
+MeshObstacle::MeshObstacle(TriMesh surface, double friction, const Eigen::Vector3d& velocity, const std::string& what)
+    : Obstacle(velocity, friction), surface_(std::move(surface))
+{
+    validate(surface_, what);
+    boxes_.resize(surface_.F.rows());
+    for (Eigen::Index f = 0; f < surface_.F.rows(); ++f) {
+        Eigen::Matrix<double, 2, 3>& box = boxes_[f];
+        box.row(0) = box.row(1) = surface_.V.row(surface_.F(f, 0));
+        for (int k = 1; k < 3; ++k) {
+            box.row(0) = box.row(0).cwiseMin(surface_.V.row(surface_.F(f, k)));
+            box.row(1) = box.row(1).cwiseMax(surface_.V.row(surface_.F(f, k)));
+        }
+    }
+    tree_ = skin::box_hierarchy(boxes_, 4);
+}
+
+TrianglePoint MeshObstacle::closest_on(int f, const Eigen::Vector3d& p) const
+{
+    return closest_triangle_point(p, surface_.V.row(surface_.F(f, 0)).transpose(),
+                                  surface_.V.row(surface_.F(f, 1)).transpose(), surface_.V.row(surface_.F(f, 2)).transpose());
+}
+
+MeshObstacle::Nearest MeshObstacle::nearest(const Eigen::Vector3d& p) const
+{
+    Nearest best;
+    best.distance = infinity;
+    std::array<int, 128> stack;  // a median split keeps the depth near log2(#F / 4): 128 is never reached
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        const skin::BoxNode& node = tree_.nodes[stack[--top]];
+        if (box_distance(node.low, node.high, p) >= best.distance)
+            continue;
+        if (node.left < 0) {
+            for (int k = node.first; k < node.first + node.count; ++k) {
+                const int f = tree_.items[k];
+                if (box_distance(boxes_[f].row(0).transpose(), boxes_[f].row(1).transpose(), p) >= best.distance)
+                    continue;
+                const TrianglePoint closest = closest_on(f, p);
+                const double distance = (p - closest.point).norm();
+                if (distance < best.distance)
+                    best = Nearest{f, closest, distance};
+            }
+            continue;
+        }
+        const skin::BoxNode &left = tree_.nodes[node.left], &right = tree_.nodes[node.right];
+        const bool left_first = box_distance(left.low, left.high, p) <= box_distance(right.low, right.high, p);
+        stack[top++] = left_first ? node.right : node.left;  // the nearer child is popped first
+        stack[top++] = left_first ? node.left : node.right;
+    }
+    return best;
+}
+
+MeshObstacle::Nearest MeshObstacle::nearest_brute_force(const Eigen::Vector3d& p) const
+{
+    Nearest best;
+    best.distance = infinity;
+    for (Eigen::Index f = 0; f < surface_.F.rows(); ++f) {
+        const TrianglePoint closest = closest_on(static_cast<int>(f), p);
+        const double distance = (p - closest.point).norm();
+        if (distance < best.distance)
+            best = Nearest{static_cast<int>(f), closest, distance};
+    }
+    return best;
+}
+
+std::vector<int> MeshObstacle::triangles_meeting(const Eigen::Vector3d& low, const Eigen::Vector3d& high) const
+{
+    std::vector<int> found, stack{0};
+    while (!stack.empty()) {
+        const skin::BoxNode& node = tree_.nodes[stack.back()];
+        stack.pop_back();
+        if ((node.low.array() > high.array()).any() || (node.high.array() < low.array()).any())
+            continue;
+        if (node.left >= 0) {
+            stack.push_back(node.left);
+            stack.push_back(node.right);
+            continue;
+        }
+        for (int k = node.first; k < node.first + node.count; ++k) {
+            const int f = tree_.items[k];
+            if (!((boxes_[f].row(0).transpose().array() > high.array()).any() ||
+                  (boxes_[f].row(1).transpose().array() < low.array()).any()))
+                found.push_back(f);
+        }
+    }
+    return found;
+}
+
+bool MeshObstacle::crosses(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1) const
+{
+    const auto volume = [](const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                           const Eigen::Vector3d& c) { return (a - p).dot((b - p).cross(c - p)); };
+    for (int f : triangles_meeting(x0.cwiseMin(x1), x0.cwiseMax(x1))) {
+        const Eigen::Vector3d a = surface_.V.row(surface_.F(f, 0)), b = surface_.V.row(surface_.F(f, 1)),
+                              c = surface_.V.row(surface_.F(f, 2));
+        const double v0 = volume(x0, a, b, c), v1 = volume(x1, a, b, c);
+        if ((v0 > 0.0 && v1 > 0.0) || (v0 < 0.0 && v1 < 0.0))
+            continue;  // both ends on one side of the triangle's plane
+        const double ab = volume(x0, x1, a, b), bc = volume(x0, x1, b, c), ca = volume(x0, x1, c, a);
+        if ((ab >= 0.0 && bc >= 0.0 && ca >= 0.0) || (ab <= 0.0 && bc <= 0.0 && ca <= 0.0))
+            return true;
+    }
+    return false;
+}
+
+double MeshObstacle::local_distance(const Eigen::Vector3d& p) const
+{
+    return nearest(p).distance;
+}
+
+DistancePiece MeshObstacle::piece(int f, const TrianglePoint& closest, const Eigen::Vector3d& p) const
+{
+    DistancePiece piece;
+    piece.distance = (p - closest.point).norm();
+    if (!(piece.distance > 0.0)) {
+        piece.gradient = Eigen::Vector3d::UnitZ();  // on the triangle, where the barrier never looks
+        return piece;
+    }
+    const Eigen::Vector3d g = (p - closest.point) / piece.distance;
+    piece.gradient = g;
+    if (closest.feature == TriangleFeature::face)
+        return piece;  // a plane: ∇²d = 0
+    piece.hessian = Eigen::Matrix3d::Identity() - g * g.transpose();
+    if (closest.feature == TriangleFeature::edge) {
+        const int i = closest.corner, j = (i + 1) % 3;
+        const Eigen::Vector3d e = (surface_.V.row(surface_.F(f, j)) - surface_.V.row(surface_.F(f, i))).transpose().normalized();
+        piece.hessian -= e * e.transpose();
+    }
+    piece.hessian /= piece.distance;
+    return piece;
+}
+
+Eigen::Vector3d MeshObstacle::local_gradient(const Eigen::Vector3d& p) const
+{
+    const Nearest n = nearest(p);
+    return piece(n.triangle, n.closest, p).gradient;
+}
+
+Eigen::Matrix3d MeshObstacle::local_hessian(const Eigen::Vector3d& p) const
+{
+    const Nearest n = nearest(p);
+    return piece(n.triangle, n.closest, p).hessian;
+}
+
+void MeshObstacle::local_pieces(const Eigen::Vector3d& p, double reach, std::vector<DistancePiece>& pieces) const
+{
+    for (int f : triangles_meeting(p.array() - reach, p.array() + reach)) {
+        const TrianglePoint closest = closest_on(f, p);
+        if ((p - closest.point).norm() < reach)
+            pieces.push_back(piece(f, closest, p));
+    }
+}
+
+double MeshObstacle::local_time_of_impact(const Eigen::Vector3d& p, const Eigen::Vector3d& dp) const
+{
+    if (!(local_distance(p) > 0.0))
+        return 0.0;
+    double first = infinity;
+    // BEGIN EXERCISE 14.6 mesh_time_of_impact #continuous-collision-detection
+    // HINT: Möller–Trumbore for the triangles whose boxes meet the path's box (triangles_meeting): with
+    // HINT: e₁ = b − a, e₂ = c − a, h = dp × e₂, det = e₁·h, r = p − a, q = r × e₁, the path meets the
+    // HINT: triangle's plane at s = (e₂·q)/det with barycentric u = (r·h)/det, v = (dp·q)/det. Keep the
+    // HINT: smallest s in [0, 2] with u, v ≥ −1e-9 and u + v ≤ 1 + 1e-9 (each triangle grown a little: a path
+    // HINT: through a shared edge is caught whatever the round-off). A path parallel to a
+    // HINT: triangle's plane (|det| ≤ 1e-12 |e₁||e₂||dp|) misses it when p is off the plane by more
+    // HINT: than 1e-9 |dp|; in the plane, answer conservative_time_of_impact instead.
+    constexpr double far = 2.0;      // callers step at most s = 1: beyond this, no impact that matters
+    constexpr double margin = 1e-9;  // each triangle tested grown by this fraction at its edges
+    const Eigen::Vector3d end = p + far * dp;
+    for (int f : triangles_meeting(p.cwiseMin(end), p.cwiseMax(end))) {
+        const Eigen::Vector3d a = surface_.V.row(surface_.F(f, 0)), b = surface_.V.row(surface_.F(f, 1)),
+                              c = surface_.V.row(surface_.F(f, 2));
+        const Eigen::Vector3d e1 = b - a, e2 = c - a, h = dp.cross(e2);
+        const double det = e1.dot(h);
+        const Eigen::Vector3d r = p - a;
+        if (!(std::abs(det) > 1e-12 * e1.norm() * e2.norm() * dp.norm())) {
+            // Parallel to the plane: off it (by more than the path could close at this det), never
+            // meets it; in it, no root to solve for: the conservative answer.
+            if (std::abs(r.dot(e1.cross(e2).normalized())) > 1e-9 * dp.norm())
+                continue;
+            return conservative_time_of_impact(*this, p, dp);
+        }
+        const Eigen::Vector3d q = r.cross(e1);
+        const double u = r.dot(h) / det, v = dp.dot(q) / det, s = e2.dot(q) / det;
+        if (u >= -margin && v >= -margin && u + v <= 1.0 + margin && s >= 0.0 && s <= far)
+            first = std::min(first, s);
+    }
+    // END EXERCISE
+    return first;
+}
+
+// --- The sampled grid --------------------------------------------------------------------------------
+
+DistanceGrid::DistanceGrid(const MeshObstacle& mesh, double spacing, double margin)
+{
+    if (!(std::isfinite(spacing) && spacing > 0.0))
+        throw Error(str("DistanceGrid: the spacing must be a finite number > 0 [m], got ", spacing));
+    if (!(std::isfinite(margin) && margin >= 0.0))
+        throw Error(str("DistanceGrid: the margin must be a finite number >= 0 [m], got ", margin));
+    const MatrixX3d& V = mesh.surface().V;
+    low_ = V.colwise().minCoeff().transpose().array() - margin;
+    high_ = V.colwise().maxCoeff().transpose().array() + margin;
+    const Eigen::Vector3d extent = high_ - low_;
+    double nodes = 1.0;
+    for (int axis = 0; axis < 3; ++axis) {
+        const double cells = std::max(1.0, std::ceil(extent[axis] / spacing));
+        nodes *= cells + 1.0;
+        if (nodes > 5e7)
+            throw Error(str("DistanceGrid: a spacing of ", spacing, " m over a box of ", extent.transpose(),
+                            " m needs more than 5e7 nodes; use a larger spacing"));
+        dims_[axis] = static_cast<int>(cells) + 1;
+        spacing_[axis] = extent[axis] > 0.0 ? extent[axis] / cells : spacing;
+    }
+    values_.resize(static_cast<std::size_t>(nodes));
+    std::size_t index = 0;
+    for (int k = 0; k < dims_.z(); ++k)
+        for (int j = 0; j < dims_.y(); ++j)
+            for (int i = 0; i < dims_.x(); ++i)
+                values_[index++] = mesh.local_distance(low_ + Eigen::Vector3d(i, j, k).cwiseProduct(spacing_));
+}
+
+void DistanceGrid::locate(const Eigen::Vector3d& p, Eigen::Vector3i& cell, Eigen::Vector3d& t) const
+{
+    for (int axis = 0; axis < 3; ++axis) {
+        const double x = std::clamp((p[axis] - low_[axis]) / spacing_[axis], 0.0, double(dims_[axis] - 1));
+        cell[axis] = std::min(static_cast<int>(x), dims_[axis] - 2);
+        t[axis] = x - cell[axis];
+    }
+}
+
+double DistanceGrid::distance(const Eigen::Vector3d& p) const
+{
+    Eigen::Vector3i c;
+    Eigen::Vector3d t;
+    locate(p, c, t);
+    double value = 0.0;
+    for (int corner = 0; corner < 8; ++corner) {
+        const int di = corner & 1, dj = (corner >> 1) & 1, dk = (corner >> 2) & 1;
+        const double weight = (di ? t.x() : 1.0 - t.x()) * (dj ? t.y() : 1.0 - t.y()) * (dk ? t.z() : 1.0 - t.z());
+        value += weight * node(c.x() + di, c.y() + dj, c.z() + dk);
+    }
+    return value + (p - p.cwiseMax(low_).cwiseMin(high_)).norm();
+}
+
+Eigen::Vector3d DistanceGrid::gradient(const Eigen::Vector3d& p) const
+{
+    Eigen::Vector3i c;
+    Eigen::Vector3d t;
+    locate(p, c, t);
+    Eigen::Vector3d gradient = Eigen::Vector3d::Zero();
+    for (int corner = 0; corner < 8; ++corner) {
+        const int d[3] = {corner & 1, (corner >> 1) & 1, (corner >> 2) & 1};
+        const double value = node(c.x() + d[0], c.y() + d[1], c.z() + d[2]);
+        for (int axis = 0; axis < 3; ++axis) {
+            double weight = (d[axis] ? 1.0 : -1.0) / spacing_[axis];
+            for (int other = 0; other < 3; ++other)
+                if (other != axis)
+                    weight *= d[other] ? t[other] : 1.0 - t[other];
+            gradient[axis] += weight * value;
+        }
+    }
+    return gradient;
+}
+
+}  // namespace fem::contact
