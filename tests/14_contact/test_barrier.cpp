@@ -195,69 +195,85 @@ TEST_CASE("continuous collision: no point of a randomised safe step is inside an
     CHECK(cut > 20);  // the fuzz reaches the cut, not only free steps
 }
 
-TEST_CASE("contact potential: gradient and Hessian of barrier and friction against central differences", "[ex14.4]")
+namespace {
+
+/// The block of the checks 0.2 mm above the obstacle of `kind` ("floor", "sphere", "mesh"), sliding:
+/// the contact potential's gradient and Hessian (barrier and friction, μ = 0.4) against central
+/// differences of its energy and gradient, inside ε_v Δt, near it and beyond it.
+void check_contact_derivatives(const std::string& kind)
 {
     BlockSettings settings;
     settings.height = 2e-4;
     settings.friction = 0.4;
     settings.contact.stiffness = 50.0;
     const double dt = settings.time_step;
-    for (const char* name : {"floor", "sphere", "mesh"}) {
-        const std::string kind = name;
-        BlockScene block = block_scene(settings);
-        std::vector<std::shared_ptr<const Obstacle>> obstacles{
-            std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.4)};
-        if (kind == "sphere")  // touching the top face's corner (0.1, 0.1, 0.1002) from above
-            obstacles = {std::make_shared<Sphere>(Eigen::Vector3d(0.2, 0.2, 0.2), (Eigen::Vector3d(0.1, 0.1, 0.1002) -
-                              Eigen::Vector3d(0.2, 0.2, 0.2)).norm() - 4e-4, 0.4)};
-        if (kind == "mesh") {
-            // A shallow four-sided dimple under the corner (0, 0, 0.0002): its lowest vertex right under
-            // it, its rim 4 cm away 0.1 mm higher. The corner feels all four triangles (faces, edges and
-            // the vertex compete within d̂): the sum of their barriers is what P holds.
-            TriMesh dimple;
-            dimple.V.resize(5, 3);
-            dimple.V << 0.0, 0.0, 0.0, 0.04, 0.0, 1e-4, 0.0, 0.04, 1e-4, -0.04, 0.0, 1e-4, 0.0, -0.04, 1e-4;
-            dimple.F.resize(4, 3);
-            dimple.F << 0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 1;
-            obstacles = {std::make_shared<MeshObstacle>(dimple, 0.4)};
-            std::vector<DistancePiece> felt;
-            obstacles[0]->pieces(Eigen::Vector3d(0.0, 0.0, 2e-4), 0.0, settings.contact.activation_distance, felt);
-            REQUIRE(felt.size() == 4);
-        }
-        ContactPotential contact(*block.body, obstacles, settings.contact);
-        // The state at t: sliding sideways, friction pairs from it; then u displaced a little.
-        dynamics::State state = block.state;
-        contact.begin_step(*block.body, state, dt);
-        REQUIRE(!contact.friction_pairs().empty());
-        const Eigen::Index n = state.u.size();
-        for (double scale : {1e-7, 3e-6, 1e-4}) {  // inside ε_v Δt = 1e-5, near it, beyond it (sliding)
-            Eigen::VectorXd u = scale * random_vector(n, 7);
-            for (Eigen::Index i = 2; i < n; i += 3)
-                u[i] = 1e-5 * random_vector(n, 8)[i];  // keep within d̂
-            REQUIRE(std::isfinite(contact.energy(u)));
-            const Eigen::VectorXd g = contact.gradient(u);
-            const Eigen::MatrixXd H = Eigen::MatrixXd(contact.hessian(u));
-            Eigen::VectorXd g_fd(n);
-            Eigen::MatrixXd H_fd(n, n);
-            const double h = 1e-9;
-            for (Eigen::Index i = 0; i < n; ++i) {
-                Eigen::VectorXd e = Eigen::VectorXd::Zero(n);
-                e[i] = h;
-                g_fd[i] = (contact.energy(u + e) - contact.energy(u - e)) / (2.0 * h);
-                H_fd.col(i) = (contact.gradient(u + e) - contact.gradient(u - e)) / (2.0 * h);
-            }
-            INFO(kind << ", scale " << scale);
-            CHECK((g - g_fd).norm() <= 1e-6 * g.norm());
-            // Per vertex block: the Hessian is the PSD projection of the exact one (for the floor and
-            // for friction the exact block is PSD already; a sphere's b'∇²d is negative).
-            for (Eigen::Index v = 0; v < n / 3; ++v) {
-                const Eigen::Matrix3d exact = H_fd.block<3, 3>(3 * v, 3 * v);
-                const Eigen::Matrix3d projected = hyper::project_to_psd<3>(exact, hyper::Projection::clamp);
-                CHECK((H.block<3, 3>(3 * v, 3 * v) - projected).norm() <= 1e-5 * (1.0 + exact.norm()));
-            }
-            CHECK(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(H).eigenvalues().minCoeff() >= -1e-8 * H.norm());
-        }
+    BlockScene block = block_scene(settings);
+    std::vector<std::shared_ptr<const Obstacle>> obstacles{
+        std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.4)};
+    if (kind == "sphere")  // touching the top face's corner (0.1, 0.1, 0.1002) from above
+        obstacles = {std::make_shared<Sphere>(Eigen::Vector3d(0.2, 0.2, 0.2), (Eigen::Vector3d(0.1, 0.1, 0.1002) -
+                          Eigen::Vector3d(0.2, 0.2, 0.2)).norm() - 4e-4, 0.4)};
+    if (kind == "mesh") {
+        // A shallow four-sided dimple under the corner (0, 0, 0.0002): its lowest vertex right under
+        // it, its rim 4 cm away 0.1 mm higher. The corner feels all four triangles (faces, edges and
+        // the vertex compete within d̂): the sum of their barriers is what P holds.
+        TriMesh dimple;
+        dimple.V.resize(5, 3);
+        dimple.V << 0.0, 0.0, 0.0, 0.04, 0.0, 1e-4, 0.0, 0.04, 1e-4, -0.04, 0.0, 1e-4, 0.0, -0.04, 1e-4;
+        dimple.F.resize(4, 3);
+        dimple.F << 0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 1;
+        obstacles = {std::make_shared<MeshObstacle>(dimple, 0.4)};
+        std::vector<DistancePiece> felt;
+        obstacles[0]->pieces(Eigen::Vector3d(0.0, 0.0, 2e-4), 0.0, settings.contact.activation_distance, felt);
+        REQUIRE(felt.size() == 4);
     }
+    ContactPotential contact(*block.body, obstacles, settings.contact);
+    // The state at t: sliding sideways, friction pairs from it; then u displaced a little.
+    dynamics::State state = block.state;
+    contact.begin_step(*block.body, state, dt);
+    REQUIRE(!contact.friction_pairs().empty());
+    const Eigen::Index n = state.u.size();
+    for (double scale : {1e-7, 3e-6, 1e-4}) {  // inside ε_v Δt = 1e-5, near it, beyond it (sliding)
+        Eigen::VectorXd u = scale * random_vector(n, 7);
+        for (Eigen::Index i = 2; i < n; i += 3)
+            u[i] = 1e-5 * random_vector(n, 8)[i];  // keep within d̂
+        REQUIRE(std::isfinite(contact.energy(u)));
+        const Eigen::VectorXd g = contact.gradient(u);
+        const Eigen::MatrixXd H = Eigen::MatrixXd(contact.hessian(u));
+        Eigen::VectorXd g_fd(n);
+        Eigen::MatrixXd H_fd(n, n);
+        const double h = 1e-9;
+        for (Eigen::Index i = 0; i < n; ++i) {
+            Eigen::VectorXd e = Eigen::VectorXd::Zero(n);
+            e[i] = h;
+            g_fd[i] = (contact.energy(u + e) - contact.energy(u - e)) / (2.0 * h);
+            H_fd.col(i) = (contact.gradient(u + e) - contact.gradient(u - e)) / (2.0 * h);
+        }
+        INFO(kind << ", scale " << scale);
+        CHECK((g - g_fd).norm() <= 1e-6 * g.norm());
+        // Per vertex block: the Hessian is the PSD projection of the exact one (for the floor and
+        // for friction the exact block is PSD already; a sphere's b'∇²d is negative).
+        for (Eigen::Index v = 0; v < n / 3; ++v) {
+            const Eigen::Matrix3d exact = H_fd.block<3, 3>(3 * v, 3 * v);
+            const Eigen::Matrix3d projected = hyper::project_to_psd<3>(exact, hyper::Projection::clamp);
+            CHECK((H.block<3, 3>(3 * v, 3 * v) - projected).norm() <= 1e-5 * (1.0 + exact.norm()));
+        }
+        CHECK(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(H).eigenvalues().minCoeff() >= -1e-8 * H.norm());
+    }
+}
+
+}  // namespace
+
+TEST_CASE("contact potential: gradient and Hessian of barrier and friction against central differences", "[ex14.4]")
+{
+    check_contact_derivatives("floor");
+    check_contact_derivatives("sphere");
+}
+
+TEST_CASE("contact potential on a mesh: the barriers summed over the triangles within dhat, against central "
+          "differences", "[ex14.5]")
+{
+    check_contact_derivatives("mesh");
 }
 
 TEST_CASE("adaptive kappa: the balancing stiffness minimises the norm of g + kappa h, kappa_min ties the barrier to the mass",

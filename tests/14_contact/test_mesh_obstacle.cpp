@@ -213,7 +213,7 @@ TEST_CASE("mesh obstacle: degenerate and empty meshes are refused, naming the tr
     CHECK_THROWS_WITH(MeshObstacle(empty), Catch::Contains("empty"));
 }
 
-TEST_CASE("sampled distance grid: exact at its nodes, within sqrt(3) h everywhere, and finer with h")
+TEST_CASE("sampled distance grid: exact at its nodes, within sqrt(3) h everywhere, and finer with h", "[ex14.5]")
 {
     const MeshObstacle mesh(bowl());
     double previous = 0.0;
