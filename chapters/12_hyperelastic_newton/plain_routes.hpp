@@ -36,12 +36,12 @@ public:
     std::string name() const override { return material_->name() + " (plain)"; }
     /// U(u) and f(u) = −Σ_t E_tᵀ V_t Bᵀ vec(P(H_t)).
     double evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& forces) override;
-    /// U(u) alone (the line search's test; +∞ where the material is).
-    double energy(const Eigen::VectorXd& u) override;
     /// K(u) = Σ_t E_tᵀ V_t Bᵀ (∂P/∂F) B E_t (3n×3n, both triangles), from triplets.
     const dynamics::SparseMatrix& stiffness(const Eigen::VectorXd& u) override;
     /// The same with every ∂P/∂F's negative eigenvalues set to zero (PSD).
     const dynamics::SparseMatrix& definite_stiffness(const Eigen::VectorXd& u) override;
+    /// U(u) alone (the line search's test; +∞ where the material is).
+    double energy(const Eigen::VectorXd& u) override;
     bool constant_stiffness() const override { return false; }
     /// Zero for every tet: the plain route is timed, not drawn.
     Eigen::VectorXd von_mises_stress(const Eigen::VectorXd& u) const override;
