@@ -32,6 +32,19 @@ using Matrix12d = Eigen::Matrix<double, 12, 12>;
 /// vec(F), row-major (9): vec[3a + b] = F(a, b).
 Vector9d flatten(const Eigen::Matrix3d& F);
 
+/// How a symmetric matrix is made positive semi-definite (docs/12_hyperelastic_newton.md#definiteness).
+enum class Projection {
+    clamp,     ///< negative eigenvalues set to 0
+    absolute,  ///< negative eigenvalues replaced by their absolute values
+};
+
+/// Where the eigensystem of ∂P/∂F comes from when it is projected
+/// (docs/12_hyperelastic_newton.md#the-analytic-eigensystem).
+enum class Eigensolver {
+    numerical,  ///< Eigen's iterative solver on the 9×9 (project_to_psd<9>): any material
+    analytic,   ///< closed form in F's singular values (stable_neo_hookean_eigensystem)
+};
+
 /// An energy density ψ(F) [J/m³] with its stress and stress derivative.
 /// docs/12_hyperelastic_newton.md#energy-densities
 class Material {
@@ -48,6 +61,10 @@ public:
     virtual Eigen::Matrix3d first_piola(const Eigen::Matrix3d& H) const = 0;
     /// ∂P/∂F (9×9, row-major vec on both sides) at F = I + H. fem::Error where the material is undefined.
     virtual Matrix9d piola_derivative(const Eigen::Matrix3d& H) const = 0;
+    /// ∂P/∂F made positive semi-definite by `projection` (docs/12_hyperelastic_newton.md#definiteness):
+    /// here project_to_psd<9>(piola_derivative(H)); a material with a closed-form eigensystem of
+    /// ∂P/∂F rebuilds it from that instead. fem::Error where the material is undefined.
+    virtual Matrix9d projected_piola_derivative(const Eigen::Matrix3d& H, Projection projection) const;
     const elastic::Lame& lame() const { return lame_; }
 
 private:
@@ -100,13 +117,44 @@ Eigen::Matrix3d neo_hookean_stress_change(const elastic::Lame& lame, const Eigen
 /// docs/12_hyperelastic_newton.md#stable-neo-hookean
 class StableNeoHookean final : public Material {
 public:
-    using Material::Material;
+    /// eigensolver: how projected_piola_derivative finds the eigensystem of ∂P/∂F (the closed form
+    /// by default; numerical only to compare the two).
+    explicit StableNeoHookean(const elastic::Lame& lame, Eigensolver eigensolver = Eigensolver::analytic)
+        : Material(lame), eigensolver_(eigensolver)
+    {
+    }
     std::string name() const override { return "stable-neo-hookean"; }
     bool defined_when_inverted() const override { return true; }
     double energy_density(const Eigen::Matrix3d& H) const override;
     Eigen::Matrix3d first_piola(const Eigen::Matrix3d& H) const override;
     Matrix9d piola_derivative(const Eigen::Matrix3d& H) const override;
+    /// Q max(Λ, 0) Qᵀ (clamp) or Q |Λ| Qᵀ (absolute) from stable_neo_hookean_eigensystem, or from
+    /// project_to_psd<9> when constructed with Eigensolver::numerical.
+    Matrix9d projected_piola_derivative(const Eigen::Matrix3d& H, Projection projection) const override;
+
+private:
+    Eigensolver eigensolver_;
 };
+
+/// The eigenpairs of a symmetric 9×9: ∂P/∂F = Q diag(values) Qᵀ, Q = vectors orthogonal, its
+/// columns vec(Q_k) (row-major, as flatten).
+struct Eigensystem9 {
+    Vector9d values;
+    Matrix9d vectors;
+};
+
+/// The eigensystem of the course's stable neo-Hookean ∂P/∂F = ∂²ψ/∂F² at F = I + H in closed form
+/// (Smith, de Goes, Kim 2019, "Analytic eigensystems for isotropic distortion energies", ACM TOG
+/// 38(1); Kim, Eberle, Dynamic Deformables, SIGGRAPH 2020 course). With the signed SVD
+/// F = U Σ Vᵀ (U, V rotations, σ₂ < 0 when det F < 0), u_i, v_i their columns, w = λ̂(J − 1) − μ,
+/// and (i, j, k) each of (1, 2, 0), (2, 0, 1), (0, 1, 2):
+///     twist k:   Q = (u_i v_jᵀ − u_j v_iᵀ)/√2,  eigenvalue μ + w σ_k   (columns 0–2)
+///     flip k:    Q = (u_i v_jᵀ + u_j v_iᵀ)/√2,  eigenvalue μ − w σ_k   (columns 3–5)
+///     scaling:   Q = Σ_m z_m u_m v_mᵀ for each eigenpair (a, z) of the 3×3 ∂²ψ/∂σ²,
+///                A_ii = μ + λ̂ (σ_j σ_k)², A_ij = λ̂ σ_i σ_j σ_k² + w σ_k   (columns 6–8).
+/// No formula divides by σ_i − σ_j: repeated singular values (F = I) need no special case.
+/// fem::Error for a non-finite H. docs/12_hyperelastic_newton.md#the-analytic-eigensystem
+Eigensystem9 stable_neo_hookean_eigensystem(const elastic::Lame& lame, const Eigen::Matrix3d& H);
 
 /// Stable neo-Hookean as Smith, de Goes and Kim 2018 write it (their final energy, with the log
 /// term that makes it rest-stable and their Lamé reparametrisation), minus its value at rest:
@@ -148,12 +196,6 @@ double volume_change(const Eigen::Matrix3d& H);
 
 /// cofactor(I + H) − I = tr H · I − Hᵀ + cofactor(H), without the cancellation.
 Eigen::Matrix3d cofactor_change(const Eigen::Matrix3d& H);
-
-/// How a symmetric matrix is made positive semi-definite (docs/12_hyperelastic_newton.md#definiteness).
-enum class Projection {
-    clamp,     ///< negative eigenvalues set to 0
-    absolute,  ///< negative eigenvalues replaced by their absolute values
-};
 
 /// The nearest positive semi-definite matrix by an eigen-decomposition of the symmetric part of
 /// A = Q Λ Qᵀ: Q max(Λ, 0) Qᵀ (clamp) or Q |Λ| Qᵀ (absolute). 3×3 (chapter 14's contact blocks), 9×9 or

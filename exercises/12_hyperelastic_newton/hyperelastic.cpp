@@ -33,8 +33,8 @@ Matrix12d element_hessian(const Material& material, double volume, const tet::Ja
 {
     Matrix12d hessian;
     // EXERCISE 12.5 (element_hessian): see docs/12_hyperelastic_newton.md#element-forces-and-hessians
-    // HINT: dP = material.piola_derivative(H), made PSD by project_to_psd<9> when projection is set;
-    // HINT: then V Bᵀ dP B.
+    // HINT: dP = material.piola_derivative(H), or material.projected_piola_derivative(H, *projection)
+    // HINT: (PSD) when projection is set; then V Bᵀ dP B.
     throw fem::NotImplemented("12.5", "element_hessian", "docs/12_hyperelastic_newton.md#element-forces-and-hessians");
     return hessian;
 }

@@ -32,11 +32,9 @@ Matrix12d element_hessian(const Material& material, double volume, const tet::Ja
 {
     Matrix12d hessian;
     // BEGIN EXERCISE 12.5 element_hessian #element-forces-and-hessians
-    // HINT: dP = material.piola_derivative(H), made PSD by project_to_psd<9> when projection is set;
-    // HINT: then V Bᵀ dP B.
-    Matrix9d dP = material.piola_derivative(H);
-    if (projection)
-        dP = project_to_psd<9>(dP, *projection);
+    // HINT: dP = material.piola_derivative(H), or material.projected_piola_derivative(H, *projection)
+    // HINT: (PSD) when projection is set; then V Bᵀ dP B.
+    const Matrix9d dP = projection ? material.projected_piola_derivative(H, *projection) : material.piola_derivative(H);
     // Bᵀ dP B using only B's 36 nonzeros of 108, B(3a + b, 3i + a) = ∇φᵢ(b) = g(i, b): first
     // W = dP B (column 3j + c is Σ_d g(j, d) dP(:, 3c + d)), then row 3i + a of Bᵀ W is
     // Σ_b g(i, b) W(3a + b, :). A third of the dense product's work, and no general GEMM.

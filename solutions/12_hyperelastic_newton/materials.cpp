@@ -5,6 +5,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <Eigen/LU>
+#include <Eigen/SVD>
 
 #include <cmath>
 #include <limits>
@@ -283,6 +284,59 @@ Matrix9d StableNeoHookean::piola_derivative(const Eigen::Matrix3d& H) const
     return stable_derivative(lame().mu, lame().lambda + lame().mu, H);
 }
 
+Eigensystem9 stable_neo_hookean_eigensystem(const elastic::Lame& lame, const Eigen::Matrix3d& H)
+{
+    require_finite(H, "stable-neo-hookean");
+    const double mu = lame.mu, lambda_hat = lame.lambda + lame.mu;
+    const double w = lambda_hat * volume_change(H) - mu;  // ∂ψ/∂J = λ̂(J − 1) − μ, J − 1 exact in H
+    // The signed SVD: U, V rotations, the sign of det F on σ₂ (a reflection moved into Σ).
+    const Eigen::JacobiSVD<Eigen::Matrix3d> svd(Eigen::Matrix3d::Identity() + H, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    Eigen::Matrix3d U = svd.matrixU(), V = svd.matrixV();
+    Eigen::Vector3d sigma = svd.singularValues();
+    if (U.determinant() < 0.0) {
+        U.col(2) *= -1.0;
+        sigma[2] *= -1.0;
+    }
+    if (V.determinant() < 0.0) {
+        V.col(2) *= -1.0;
+        sigma[2] *= -1.0;
+    }
+    Eigensystem9 system;
+    const double root_half = std::sqrt(0.5);
+    for (int k = 0; k < 3; ++k) {
+        const int i = (k + 1) % 3, j = (k + 2) % 3;
+        const Eigen::Matrix3d ij = U.col(i) * V.col(j).transpose(), ji = U.col(j) * V.col(i).transpose();
+        system.values[k] = mu + w * sigma[k];      // twist: (∂ψ/∂σ_i + ∂ψ/∂σ_j)/(σ_i + σ_j)
+        system.vectors.col(k) = root_half * flatten(ij - ji);
+        system.values[3 + k] = mu - w * sigma[k];  // flip: (∂ψ/∂σ_i − ∂ψ/∂σ_j)/(σ_i − σ_j)
+        system.vectors.col(3 + k) = root_half * flatten(ij + ji);
+    }
+    // The scaling block ∂²ψ/∂σ² of ψ(σ) = (μ/2)(Σσ² − 3) − μ(J − 1) + (λ̂/2)(J − 1)², J = σ₀σ₁σ₂.
+    const Eigen::Vector3d g(sigma[1] * sigma[2], sigma[2] * sigma[0], sigma[0] * sigma[1]);  // ∂J/∂σ
+    Eigen::Matrix3d A = mu * Eigen::Matrix3d::Identity() + lambda_hat * g * g.transpose();
+    for (int k = 0; k < 3; ++k) {
+        const int i = (k + 1) % 3, j = (k + 2) % 3;
+        A(i, j) += w * sigma[k];  // w ∂²J/∂σ_i∂σ_j
+        A(j, i) += w * sigma[k];
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> scaling(A);
+    for (int m = 0; m < 3; ++m) {
+        const Eigen::Vector3d z = scaling.eigenvectors().col(m);
+        system.values[6 + m] = scaling.eigenvalues()[m];
+        system.vectors.col(6 + m) = flatten(U * z.asDiagonal() * V.transpose());
+    }
+    return system;
+}
+
+Matrix9d StableNeoHookean::projected_piola_derivative(const Eigen::Matrix3d& H, Projection projection) const
+{
+    if (eigensolver_ == Eigensolver::numerical)
+        return Material::projected_piola_derivative(H, projection);
+    const Eigensystem9 system = stable_neo_hookean_eigensystem(lame(), H);
+    const Vector9d values = projection == Projection::clamp ? Vector9d(system.values.cwiseMax(0.0)) : Vector9d(system.values.cwiseAbs());
+    return system.vectors * values.asDiagonal() * system.vectors.transpose();
+}
+
 // The paper's energy μ'/2 (I_C − 3) − μ'/2 ln(I_C + 1) + λ'/2 (J − α)², α = 1 + 3μ'/(4λ'), with
 // μ' = 4μ/3 = 4/3 · (the shared part's μ): it is the shared part with λ̂ = λ' plus
 // (μ'/2)(x/4 − ln(1 + x/4)), x = I_C − 3, minus its value at rest.
@@ -358,6 +412,11 @@ std::unique_ptr<Material> make_material(std::string_view name, double youngs_mod
     for (const Registered& entry : registry)
         names += str(names.empty() ? "" : ", ", entry.name);
     throw Error(str("unknown material '", name, "'; choose one of: ", names));
+}
+
+Matrix9d Material::projected_piola_derivative(const Eigen::Matrix3d& H, Projection projection) const
+{
+    return project_to_psd<9>(piola_derivative(H), projection);
 }
 
 template <int N>
