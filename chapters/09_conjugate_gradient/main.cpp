@@ -8,7 +8,8 @@
 //      times, residual histories; IC(0) breakdown and the diagonal shift;
 //   4. speed against error: every iterative solver against the tolerance, and every direct one,
 //      on 2D/3D Laplacians and the elastic box from ~1k to ≥150k unknowns; the crossover where
-//      iterative beats direct; our PCG (Jacobi) against Eigen's ConjugateGradient;
+//      iterative beats direct; our PCG against Eigen's ConjugateGradient, Jacobi against its
+//      diagonal preconditioner and IC(0) against its IncompleteCholesky, timed in alternation;
 //   5. hard cases: indefinite and singular matrices through every solver;
 //   6. pictures: the CG error on a grid after k iterations, the sagging box (VTK + PNG).
 //
@@ -441,23 +442,42 @@ std::vector<Measurement> sweep_ours(const Problem& p, const sparse::CsrMatrix& c
     return rows;
 }
 
-/// Eigen's ConjugateGradient (diagonal preconditioner, its defaults) to the tolerance tau, once:
-/// the time of compute() and solve(), and what it reached.
-Measurement run_eigen_cg(const Problem& p, const Eigen::VectorXd& reference, double tau)
+/// The peer of each of our preconditioners in Eigen: its ConjugateGradient with the diagonal
+/// preconditioner (reading the lower triangle, its default), or with its IncompleteCholesky
+/// (reading both triangles: Lower|Upper, the fast product).
+enum class EigenPreconditioner { diagonal, incomplete_cholesky };
+
+/// Eigen's ConjugateGradient with `preconditioner` (its defaults otherwise) to the tolerance tau,
+/// once: the time of compute() and solve(), and what it reached.
+Measurement run_eigen_cg(const Problem& p, const Eigen::VectorXd& reference, double tau,
+                         EigenPreconditioner preconditioner = EigenPreconditioner::diagonal)
 {
-    Eigen::ConjugateGradient<Eigen::SparseMatrix<double>> cg;
-    cg.setTolerance(tau);
     Measurement row;
-    Timer timer;
-    cg.compute(p.A);
-    const Eigen::VectorXd x = cg.solve(p.b);
-    row.seconds = timer.seconds();
-    row.reached = cg.info() == Eigen::Success;
+    Eigen::VectorXd x;
+    const auto solve = [&](auto& cg) {
+        cg.setTolerance(tau);
+        Timer timer;
+        cg.compute(p.A);
+        row.setup = timer.seconds();
+        x = cg.solve(p.b);
+        row.seconds = timer.seconds();
+        row.reached = cg.info() == Eigen::Success;
+        row.iterations = static_cast<int>(cg.iterations());
+    };
+    if (preconditioner == EigenPreconditioner::diagonal) {
+        Eigen::ConjugateGradient<Eigen::SparseMatrix<double>> cg;
+        solve(cg);
+        row.solver = "Eigen CG (diagonal)";
+    } else {
+        Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
+                                 Eigen::IncompleteCholesky<double>>
+            cg;
+        solve(cg);
+        row.solver = "Eigen CG (IncompleteCholesky)";
+    }
     row.problem = p.label;
     row.unknowns = static_cast<int>(p.A.rows());
-    row.solver = "Eigen CG (diagonal)";
     row.tolerance = tau;
-    row.iterations = static_cast<int>(cg.iterations());
     row.residual = (p.b - p.A * x).norm() / p.b.norm();
     row.error = relative_error(x, reference);
     return row;
@@ -483,30 +503,32 @@ std::vector<Measurement> sweep_eigen(const Problem& p, const Eigen::VectorXd& re
     return rows;
 }
 
-/// The performance goal, measured fairly on a shared machine: our PCG (Jacobi, on the stored lower
-/// triangle, the preconditioner built inside the timing) and Eigen's CG at the comparison
-/// tolerance, run in alternation so that both meet the same load, each the best of its runs.
-std::pair<Measurement, Measurement> race_jacobi_against_eigen(const Problem& p, const sparse::CsrMatrix& csr,
-                                                              const Eigen::VectorXd& reference,
-                                                              const Settings& settings)
+/// The performance goal, measured fairly on a shared machine: our PCG with `ours` ("PCG-Jacobi" or
+/// "PCG-IC0", on the stored lower triangle, the preconditioner built inside the timing) and Eigen's
+/// CG with its peer preconditioner at the comparison tolerance, run in alternation so that both
+/// meet the same load, each the best of its runs.
+std::pair<Measurement, Measurement> race_against_eigen(const Problem& p, const sparse::CsrMatrix& csr,
+                                                       const Eigen::VectorXd& reference, const Settings& settings,
+                                                       const std::string& ours_name, EigenPreconditioner peer)
 {
     const SymmetricCsrOperator A(csr);
     Measurement ours, eigen;
     Timer budget;
     for (int repeat = 0; repeat < 20; ++repeat) {
         Timer timer;
-        const JacobiPreconditioner jacobi(diagonal(csr));
+        const OurMethod method = make_method(ours_name, csr);
         CgSettings cg_settings;
         cg_settings.relative_tolerance = comparison_tolerance;
         Eigen::VectorXd x;
-        const CgResult result = preconditioned_conjugate_gradient(A, jacobi, p.b, x, cg_settings);
+        const CgResult result = run_method(A, method, p.b, x, cg_settings);
         const double seconds = timer.seconds();
         if (repeat == 0 || seconds < ours.seconds) {
             ours.seconds = seconds;
+            ours.setup = method.setup_seconds;
             ours.iterations = result.iterations;
             ours.reached = result.converged;
         }
-        const Measurement row = run_eigen_cg(p, reference, comparison_tolerance);
+        const Measurement row = run_eigen_cg(p, reference, comparison_tolerance, peer);
         if (repeat == 0 || row.seconds < eigen.seconds)
             eigen = row;
         if (budget.seconds() >= settings.seconds)
@@ -579,10 +601,12 @@ void speed_against_error_study(const RunContext& run, const Settings& settings)
                    {"fastest iterative [measured]", Format::text}, {"iterative time [s]", Format::scientific, 2},
                    {"iterative / direct [measured]", Format::fixed, 2},
                    {"solves to amortise [measured]", Format::fixed, 1}});
-    Table versus(str("Our PCG (Jacobi) against Eigen's ConjugateGradient (diagonal), tolerance ", comparison_tolerance,
-                     ", timed in alternation"),
-                 {{"problem", Format::text}, {"unknowns", Format::integer}, {"ours iterations", Format::integer},
-                  {"Eigen iterations", Format::integer}, {"ours time [s]", Format::scientific, 2},
+    Table versus(str("Our PCG against Eigen's ConjugateGradient with the peer preconditioner, tolerance ",
+                     comparison_tolerance, ", timed in alternation (preconditioner setup included)"),
+                 {{"problem", Format::text}, {"unknowns", Format::integer},
+                  {"preconditioner (ours / Eigen)", Format::text}, {"ours iterations", Format::integer},
+                  {"Eigen iterations", Format::integer}, {"ours setup [s]", Format::scientific, 2},
+                  {"Eigen setup [s]", Format::scientific, 2}, {"ours time [s]", Format::scientific, 2},
                   {"Eigen time [s]", Format::scientific, 2}, {"ours / Eigen [measured]", Format::fixed, 2}});
 
     for (const auto& [key, sizes] : problems) {
@@ -622,7 +646,10 @@ void speed_against_error_study(const RunContext& run, const Settings& settings)
             }
             // Eigen's CG: at the comparison tolerance in the race with our PCG (Jacobi); at the other
             // tolerances on problems up to eigen_sweep_max unknowns.
-            const auto [ours_race, eigen_race] = race_jacobi_against_eigen(p, csr, reference, settings);
+            const auto [ours_race, eigen_race] = race_against_eigen(p, csr, reference, settings, "PCG-Jacobi",
+                                                                    EigenPreconditioner::diagonal);
+            const auto [ours_ic, eigen_ic] = race_against_eigen(p, csr, reference, settings, "PCG-IC0",
+                                                                EigenPreconditioner::incomplete_cholesky);
             const bool eigen_sweep = p.A.rows() <= settings.eigen_sweep_max;
             std::vector<double> other_tolerances;
             if (eigen_sweep)
@@ -681,10 +708,14 @@ void speed_against_error_study(const RunContext& run, const Settings& settings)
                 summary.add_row({p.label, double(p.A.rows()), best_direct->solver, best_direct->seconds,
                                  std::string("none reached the tolerance"), 0.0, 0.0, 0.0});
             }
-            versus.add_row({p.label, double(p.A.rows()), double(ours_race.iterations), double(eigen_race.iterations),
-                            ours_race.seconds, eigen_race.seconds,
-                            ours_race.reached && eigen_race.reached ? Cell(ours_race.seconds / eigen_race.seconds)
-                                                                    : Cell(std::string("cap hit"))});
+            const auto add_race = [&](const std::string& pair, const Measurement& ours, const Measurement& eigen) {
+                versus.add_row({p.label, double(p.A.rows()), pair, double(ours.iterations), double(eigen.iterations),
+                                ours.setup, eigen.setup, ours.seconds, eigen.seconds,
+                                ours.reached && eigen.reached ? Cell(ours.seconds / eigen.seconds)
+                                                              : Cell(std::string("cap hit"))});
+            };
+            add_race("Jacobi / diagonal", ours_race, eigen_race);
+            add_race("IC(0) / IncompleteCholesky", ours_ic, eigen_ic);
 
             // The work-precision chart: the largest size with Eigen's whole sweep.
             if (eigen_sweep) {
