@@ -8,6 +8,7 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -74,6 +75,28 @@ TEST_CASE("obstacles in the scene file: each type's fields, and chapter 14's obs
     CHECK(make_obstacle(scene.obstacles[2])->distance(Eigen::Vector3d(3.0, 1.0, 0.25), 0.0) == Approx(0.75).epsilon(1e-15));
     // A scene without obstacles has none, and its runs meet none.
     CHECK(read_scene(gallery / "cantilever.toml").obstacles.empty());
+}
+
+TEST_CASE("a mesh obstacle: its file found in data/, placed by scale then translate, and read by the runner's input list",
+          "[scenes][contact]")
+{
+    // The bowl (its lowest vertex at the origin, R = 0.15 m) scaled by 2 and moved to (0.05, 0.05, −0.5).
+    const std::filesystem::path file = drop_scene(
+        "obstacle_mesh", "type = \"mesh\"\nfile = \"bowl.obj\"\nscale = 2.0\ntranslate = [0.05, 0.05, -0.5]\nfriction = 0.3\n");
+    const SceneSpec scene = read_scene(file);
+    REQUIRE(scene.obstacles.size() == 1);
+    const ObstacleSpec& bowl = scene.obstacles[0];
+    CHECK(bowl.kind == ObstacleSpec::Kind::mesh);
+    CHECK(bowl.file.filename() == "bowl.obj");
+    CHECK(bowl.scale == 2.0);
+    CHECK(bowl.surface.V.row(0) == Eigen::RowVector3d(0.05, 0.05, -0.5));  // the lowest vertex, placed
+    CHECK(bowl.surface.V.col(0).maxCoeff() - bowl.surface.V.col(0).minCoeff() == Approx(2.0 * 2.0 * 0.15 * std::sin(70.0 * std::acos(-1.0) / 180.0)).epsilon(1e-12));
+    const auto made = make_obstacle(bowl);
+    CHECK(made->friction() == 0.3);
+    // 0.1 m straight below the lowest vertex: that vertex is the nearest point (the bowl curves up).
+    CHECK(made->distance(Eigen::Vector3d(0.05, 0.05, -0.6), 0.0) == Approx(0.1).epsilon(1e-12));
+    const auto files = input_files(scene);
+    CHECK(std::find(files.begin(), files.end(), bowl.file) != files.end());
 }
 
 TEST_CASE("an obstacle override is checked like the file and named by its option", "[scenes][contact]")
