@@ -54,7 +54,7 @@ TEST_CASE("plain Newton step: dense element products, triplets and a fresh Simpl
     CHECK((plain_state.v - our_state.v).lpNorm<Eigen::Infinity>() <= 1e-9 * our_state.v.lpNorm<Eigen::Infinity>());
 }
 
-TEST_CASE("plain hyperelastic model: energy, forces, Hessian and definite Hessian of the chapter's model; the Hessian "
+TEST_CASE("plain hyperelastic model: energy, forces, Hessian and definite Hessian of the chapter's model, the Hessian "
           "against central differences of the forces", "[plain-route]")
 {
     const dynamics::Scene scene = soft_beam();
