@@ -40,8 +40,8 @@ std::string frame_title(const SceneSpec& scene, const std::string& models, doubl
 
 /// The shapes the scene's obstacles are drawn as at time t (fig::Prop, grey), each moved by t·w:
 /// a half-space as the square of its plane under body_box (the box's corners projected on the plane,
-/// grown by half the box's diagonal each way: the floor or slope where the body moves), a sphere as
-/// a fine triangulated ball, a box as its 12 triangles. body_box: (xmin, xmax, ymin, ymax, zmin,
+/// grown by a fifth of the box's diagonal each way: the floor or slope where the body moves), a sphere as
+/// a fine triangulated ball, a box as its 12 triangles, a mesh as its triangles. body_box: (xmin, xmax, ymin, ymax, zmin,
 /// zmax) of the body's motion [m]. docs/scenes.md#outputs
 std::vector<fig::Prop> obstacle_props(const SceneSpec& scene, const std::array<double, 6>& body_box, double time);
 

@@ -95,7 +95,7 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> plane_axes(const Eigen::Vector3d& n)
 }
 
 /// The square of the plane through p with unit normal n under box: its corners projected, grown by
-/// half its diagonal each way (two triangles).
+/// a fifth of its diagonal each way (two triangles).
 io::MeshData plane_patch(const Eigen::Vector3d& p, const Eigen::Vector3d& n, const std::array<double, 6>& box)
 {
     const auto [u, v] = plane_axes(n);
@@ -107,7 +107,7 @@ io::MeshData plane_patch(const Eigen::Vector3d& p, const Eigen::Vector3d& n, con
         lo_v = std::min(lo_v, v.dot(c - p));
         hi_v = std::max(hi_v, v.dot(c - p));
     }
-    const double margin = 0.5 * Eigen::Vector3d(box[1] - box[0], box[3] - box[2], box[5] - box[4]).norm();
+    const double margin = 0.2 * Eigen::Vector3d(box[1] - box[0], box[3] - box[2], box[5] - box[4]).norm();
     io::MeshData patch;
     patch.points.resize(4, 3);
     int row = 0;
@@ -165,16 +165,22 @@ std::vector<fig::Prop> obstacle_props(const SceneSpec& scene, const std::array<d
     for (const ObstacleSpec& obstacle : scene.obstacles) {
         const Eigen::Vector3d shift = time * obstacle.velocity;
         fig::Prop prop;
-        // One case per kind of obstacle (a kind not drawn yet is left out of the picture).
-        if (obstacle.kind == ObstacleSpec::Kind::half_space)
+        switch (obstacle.kind) {  // one case per kind of obstacle
+        case ObstacleSpec::Kind::half_space:
             prop.shape = plane_patch(obstacle.point + shift, obstacle.normal.normalized(), body_box);
-        else if (obstacle.kind == ObstacleSpec::Kind::sphere)
+            break;
+        case ObstacleSpec::Kind::sphere:
             prop.shape = ball(obstacle.center + shift, obstacle.radius);
-        else if (obstacle.kind == ObstacleSpec::Kind::box)
+            break;
+        case ObstacleSpec::Kind::box:
             prop.shape = box_surface(obstacle.center + shift, obstacle.size,
                                      Eigen::AngleAxisd(obstacle.angle, obstacle.axis.normalized()).toRotationMatrix());
-        else
-            continue;
+            break;
+        case ObstacleSpec::Kind::mesh:  // its triangles, placed already
+            prop.shape.points = obstacle.surface.V.rowwise() + shift.transpose();
+            prop.shape.cells = obstacle.surface.F;
+            break;
+        }
         props.push_back(std::move(prop));
     }
     return props;

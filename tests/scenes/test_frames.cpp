@@ -132,8 +132,8 @@ TEST_CASE("obstacle_props: a floor patch under the body's box, a ball where it i
         REQUIRE(props.size() == 2);
         const MatrixX3d& patch = props[0].shape.points;
         CHECK(patch.col(2).cwiseAbs().maxCoeff() < 1e-15);  // on the plane z = 0
-        // The box's footprint grown by half its diagonal, sqrt(0.03)/2, each way.
-        const double margin = 0.5 * std::sqrt(0.03);
+        // The box's footprint grown by a fifth of its diagonal, sqrt(0.03)/5, each way.
+        const double margin = 0.2 * std::sqrt(0.03);
         CHECK(patch.col(0).minCoeff() == Approx(-0.05 - margin));
         CHECK(patch.col(1).maxCoeff() == Approx(0.05 + margin));
         // The ball: every point at its radius from its centre at time t, (0.05 t, 0, −0.1).
@@ -142,6 +142,24 @@ TEST_CASE("obstacle_props: a floor patch under the body's box, a ball where it i
         CHECK(((ball.rowwise() - centre).rowwise().norm().array() - 0.08).abs().maxCoeff() < 1e-12);
         CHECK(ball.col(0).mean() == Approx(0.05 * t).margin(1e-12));
     }
+}
+
+TEST_CASE("obstacle_props: a mesh obstacle is its own triangles where it stands at the frame's time", "[scenes]")
+{
+    SceneSpec scene;
+    ObstacleSpec mesh;
+    mesh.kind = ObstacleSpec::Kind::mesh;
+    mesh.surface.V.resize(3, 3);
+    mesh.surface.V << 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0;
+    mesh.surface.F.resize(1, 3);
+    mesh.surface.F << 0, 1, 2;
+    mesh.velocity = Eigen::Vector3d(0.0, 0.0, -0.5);
+    scene.obstacles.push_back(mesh);
+    const std::vector<fig::Prop> props = obstacle_props(scene, {0.0, 1.0, 0.0, 1.0, 0.0, 1.0}, 2.0);
+    REQUIRE(props.size() == 1);
+    CHECK(props[0].shape.cells == MatrixXiR(mesh.surface.F));
+    CHECK(props[0].shape.points.col(2).isConstant(-1.0));  // moved by t w = (0, 0, -1)
+    CHECK(props[0].shape.points.leftCols(2) == mesh.surface.V.leftCols(2));
 }
 
 TEST_CASE("the caption: scene, the model in use, the time and the slow motion the video plays at", "[scenes]")
