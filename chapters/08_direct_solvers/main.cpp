@@ -3,6 +3,8 @@
 // Eigen's AMD, CHOLMOD's choice) on 2D/3D Laplacians and the stiffness matrix of a box; our sparse
 // Cholesky (up-looking and supernodal) against Eigen's SimplicialLLT and CHOLMOD's supernodal
 // factorization on the same matrices: analysis, factor and solve times, nnz(L), residual and error;
+// the kernels against the hardware: the factorization's rate against the BLAS's dgemm on the
+// shapes of its supernodes, our solve against CHOLMOD's, each pair timed in alternation;
 // factor once / solve many; the cases where a direct solver must refuse.
 //
 // Sample runs:
@@ -11,7 +13,7 @@
 //   ch08_direct_solvers --max-unknowns 60000   skip the largest matrices
 //
 // Writes: tables dense_table.csv, hilbert_table.csv, ordering_table.csv, speed_table.csv,
-// goals_table.csv, supernodes_table.csv, solve_many_table.csv, failures_table.csv;
+// goals_table.csv, supernodes_table.csv, kernels_table.csv, solve_many_table.csv, failures_table.csv;
 // charts (PNG + CSV) dense_times, hilbert_errors, fill_growth, factor_times, solve_times;
 // the patterns of L for four orderings (factor_patterns.vti/.png) and the box under gravity solved
 // with our Cholesky (box_displacement.vtu/.png). docs/08_direct_solvers.md
@@ -20,6 +22,7 @@
 #include "08_direct_solvers/model_problems.hpp"
 #include "08_direct_solvers/orderings.hpp"
 #include "08_direct_solvers/sparse_cholesky.hpp"
+#include "08_direct_solvers/supernodal.hpp"
 
 #include "06_assembly/assembly.hpp"
 #include "07_sparse_storage/sparse_formats.hpp"
@@ -38,12 +41,15 @@
 
 #ifdef FEM_HAVE_CHOLMOD
 #include <Eigen/CholmodSupport>
+#endif
+#ifdef __linux__
 #include <dlfcn.h>
 #endif
 
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <utility>
 #include <iostream>
 #include <limits>
 #include <map>
@@ -70,6 +76,109 @@ double timed(Work&& work)
     return best_time(std::forward<Work>(work), 0.3, 5);
 }
 
+/// The best times of two pieces of work run in alternation (a, b, a, b, …), so that the load of
+/// the rest of the machine hits both alike: rounds stop after min_seconds or max_rounds. Without
+/// b, only a is timed (second = 0).
+std::pair<double, double> alternating_best_times(const std::function<void()>& a, const std::function<void()>& b,
+                                                 double min_seconds = 0.3, int max_rounds = 5)
+{
+    double best_a = 1e300, best_b = b ? 1e300 : 0.0;
+    Timer total;
+    for (int round = 0; round < max_rounds && (round == 0 || total.seconds() < min_seconds); ++round) {
+        Timer once;
+        a();
+        best_a = std::min(best_a, once.seconds());
+        if (b) {
+            once.restart();
+            b();
+            best_b = std::min(best_b, once.seconds());
+        }
+    }
+    return {best_a, best_b};
+}
+
+// --- One core's dense matrix product, the yardstick of the supernodal factorization -------------
+
+/// C ← C − A Bᵀ in the BLAS's dgemm (column-major, Fortran calling convention).
+using Dgemm = void (*)(const char* transa, const char* transb, const int* m, const int* n, const int* k,
+                       const double* alpha, const double* a, const int* lda, const double* b, const int* ldb,
+                       const double* beta, double* c, const int* ldc);
+
+/// The BLAS's dgemm if the process has one (CHOLMOD links OpenBLAS on Debian, which picks the
+/// processor's best kernel at run time), else nullptr: Eigen's own product is compiled for baseline
+/// x86-64 (SSE2, no FMA) and would understate what one core can do.
+Dgemm blas_dgemm()
+{
+#ifdef __linux__
+    return reinterpret_cast<Dgemm>(dlsym(RTLD_DEFAULT, "dgemm_"));
+#else
+    return nullptr;
+#endif
+}
+
+/// A dense product of a supernode's dimensions: its m rows, ns columns.
+struct SupernodeShape {
+    int m = 0, ns = 0;
+};
+
+/// Three supernodes that stand for the flops of the factorization: the supernodes sorted by their
+/// number of rows m, the one at which the running sum of flops (Σ over the supernode's columns j of
+/// count_j² = Σ_{i<ns} (m − i)²) passes 1/6, 1/2 and 5/6 of the total. Each represents a third of
+/// the flops. perm is the ordering SparseCholesky used (its tree is then postordered).
+std::vector<SupernodeShape> flop_weighted_shapes(const sparse::CscMatrix& A, const Permutation& perm)
+{
+    const SymbolicCholesky symbolic = symbolic_cholesky(A, perm);
+    const SupernodalCholesky supernodes(symbolic, symmetric_permutation(A, perm));
+    std::vector<std::pair<SupernodeShape, double>> all;
+    double total = 0.0;
+    for (int s = 0; s < supernodes.supernodes(); ++s) {
+        const int ns = supernodes.first(s + 1) - supernodes.first(s);
+        const int m = supernodes.rows(s);
+        double flops = 0.0;
+        for (int i = 0; i < ns; ++i)
+            flops += double(m - i) * double(m - i);
+        all.push_back({{m, ns}, flops});
+        total += flops;
+    }
+    std::stable_sort(all.begin(), all.end(), [](const auto& a, const auto& b) { return a.first.m < b.first.m; });
+    std::vector<SupernodeShape> shapes;
+    double sum = 0.0;
+    std::size_t next = 0;
+    for (const auto& [shape, flops] : all) {
+        sum += flops;
+        while (next < 3 && sum >= total * (2.0 * double(next) + 1.0) / 6.0) {
+            shapes.push_back(shape);
+            ++next;
+        }
+    }
+    return shapes;
+}
+
+/// The GEMM rate in GFLOP/s of C ← C − B Bᵀ (C m×m, B m×ns, 2 m² ns flops) through dgemm, on the
+/// shapes in turn, each dimension capped at gemm_cap (one core's rate no longer grows there, and
+/// the cap bounds the time and memory of the yardstick), repeated so that each timing covers at
+/// least 2·10⁷ flops; one call per shape (the caller alternates it with the factorization and
+/// keeps the best). Returns the rate of the mix in which each shape does an equal share of the
+/// flops: 1 / mean(1 / rate).
+double gemm_mix_rate(Dgemm dgemm, const std::vector<SupernodeShape>& shapes)
+{
+    constexpr int gemm_cap = 2048;
+    double seconds_per_flop = 0.0;
+    for (const SupernodeShape& shape : shapes) {
+        const int m = std::min(shape.m, gemm_cap), ns = std::min(shape.ns, gemm_cap);
+        const Eigen::MatrixXd B = Eigen::MatrixXd::Constant(m, ns, 1e-3);
+        Eigen::MatrixXd C = Eigen::MatrixXd::Zero(m, m);
+        const double flops = 2.0 * double(m) * m * ns;
+        const int calls = static_cast<int>(std::max(1.0, std::ceil(2e7 / flops)));
+        const double minus_one = -1.0, one = 1.0;
+        Timer timer;
+        for (int call = 0; call < calls; ++call)
+            dgemm("N", "T", &m, &m, &ns, &minus_one, B.data(), &m, B.data(), &m, &one, C.data(), &m);
+        seconds_per_flop += timer.seconds() / (calls * flops) / double(shapes.size());
+    }
+    return 1e-9 / seconds_per_flop;
+}
+
 // --- CHOLMOD, the reference (not course material) ----------------------------------------------
 
 /// One CHOLMOD supernodal factorization and solve through Eigen's CholmodSupport.
@@ -78,6 +187,7 @@ struct CholmodResult {
     std::string ordering;  ///< the ordering CHOLMOD used
     double nonzeros = 0.0, flops = 0.0;
     double analyse = 0.0, factor = 0.0, solve = 0.0;
+    double other_solve = 0.0;  ///< the solve timed in alternation with CHOLMOD's, if any
     Eigen::VectorXd x;
 };
 
@@ -105,8 +215,9 @@ std::string cholmod_ordering_name(int ordering)
 /// A (lower triangle read) factored by CHOLMOD with its own ordering choice (natural = false), or
 /// in the given numbering (natural = true: A is already permuted). analyse_only skips the
 /// numeric work (for the ordering table).
+/// With other_solve, the solve is timed in alternation with it (best of each: other_solve_time).
 CholmodResult run_cholmod(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b, bool natural,
-                          bool analyse_only = false)
+                          bool analyse_only = false, const std::function<void()>& other_solve = {})
 {
     CholmodResult r;
     Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> chol;
@@ -127,7 +238,7 @@ CholmodResult run_cholmod(const Eigen::SparseMatrix<double>& A, const Eigen::Vec
     r.factor = timed([&] { chol.factorize(A); });
     if (chol.info() != Eigen::Success)
         throw Error("CHOLMOD: the factorization failed (the matrix is not positive definite)");
-    r.solve = timed([&] { r.x = chol.solve(b); });
+    std::tie(r.solve, r.other_solve) = alternating_best_times([&] { r.x = chol.solve(b); }, other_solve);
     return r;
 }
 #endif
@@ -419,9 +530,12 @@ struct OursDetails {
 };
 
 /// Our factorization: construct (order, analyse, factor), then refactor while it is quick (best
-/// time).
+/// time). after_factor, if given, runs after each factorization (work timed in alternation with
+/// it); keep, if given, receives the factorization.
 Measured run_ours(const Problem& p, const Eigen::VectorXd& b, const Eigen::VectorXd& x_ref, CholeskyOptions options,
-                  const std::string& name, OursDetails* details = nullptr)
+                  const std::string& name, OursDetails* details = nullptr,
+                  const std::function<void(const SparseCholesky&)>& after_factor = {},
+                  std::optional<SparseCholesky>* keep = nullptr)
 {
     Measured m;
     m.solver = name;
@@ -431,9 +545,13 @@ Measured run_ours(const Problem& p, const Eigen::VectorXd& b, const Eigen::Vecto
     m.flops = chol.flops();
     m.analyse = chol.times().ordering + chol.times().symbolic;
     m.factor = chol.times().numeric;
+    if (after_factor)
+        after_factor(chol);
     for (int repeat = 0; repeat < 4 && m.factor < 0.2; ++repeat) {
         chol.factorize(p.A);
         m.factor = std::min(m.factor, chol.times().numeric);
+        if (after_factor)
+            after_factor(chol);
     }
     Eigen::VectorXd x;
     m.solve = timed([&] { x = chol.solve(b); });
@@ -441,13 +559,17 @@ Measured run_ours(const Problem& p, const Eigen::VectorXd& b, const Eigen::Vecto
     m.error = (x - x_ref).norm() / x_ref.norm();
     if (details)
         *details = {chol.permutation(), chol.supernodes(), chol.stored_entries()};
+    if (keep)
+        keep->emplace(std::move(chol));
     return m;
 }
 
 /// A CHOLMOD row: with our permutation (the matrix permuted first, CHOLMOD told to keep the order)
 /// or with CHOLMOD's own ordering; "CHOLMOD not installed" without it.
+/// With other_solve, CHOLMOD's solve is timed in alternation with it; *other_time receives its best.
 Measured run_cholmod_row(const Problem& p, const Eigen::VectorXd& b, const Eigen::VectorXd& x_ref,
-                         const Permutation* perm)
+                         const Permutation* perm, const std::function<void()>& other_solve = {},
+                         double* other_time = nullptr)
 {
     Measured m;
     m.solver = "CHOLMOD supernodal";
@@ -464,7 +586,9 @@ Measured run_cholmod_row(const Problem& p, const Eigen::VectorXd& b, const Eigen
         Eigen::VectorXd Pb(p.A.rows);
         for (int k = 0; k < p.A.rows; ++k)
             Pb[k] = b[(*perm)[k]];
-        c = run_cholmod(C, Pb, true);
+        c = run_cholmod(C, Pb, true, false, other_solve);
+        if (other_time)
+            *other_time = c.other_solve;
         for (int k = 0; k < p.A.rows; ++k)
             x[(*perm)[k]] = c.x[k];
     } else {
@@ -483,6 +607,8 @@ Measured run_cholmod_row(const Problem& p, const Eigen::VectorXd& b, const Eigen
     (void)p;
     (void)b;
     (void)x_ref;
+    (void)other_solve;
+    (void)other_time;
     m.status = "CHOLMOD not installed";
 #endif
     return m;
@@ -521,6 +647,14 @@ std::vector<SpeedRecord> speed_study(const RunContext& run, const Settings& sett
                      {{"matrix", Format::text}, {"unknowns", Format::integer}, {"supernodes", Format::integer},
                       {"mean columns per supernode", Format::fixed, 2}, {"stored / nnz(L)", Format::fixed, 3},
                       {"flops per stored entry", Format::fixed, 1}});
+    Table kernels("Kernels against the hardware (one core): our supernodal factorization against dgemm on the "
+                  "supernodes' shapes, our solve against CHOLMOD's (same P); each pair timed in alternation",
+                  {{"matrix", Format::text}, {"unknowns", Format::integer},
+                   {"shapes m x ns at 1/6, 1/2, 5/6 of the flops", Format::text},
+                   {"factor rate [GFLOP/s]", Format::fixed, 2}, {"dgemm rate, those shapes [GFLOP/s]", Format::fixed, 2},
+                   {"factor / dgemm rate [measured]", Format::fixed, 3}, {"ours solve [s]", Format::scientific, 2},
+                   {"CHOLMOD solve [s]", Format::scientific, 2}, {"solve / CHOLMOD [measured]", Format::fixed, 3}});
+    const Dgemm dgemm = blas_dgemm();
     std::vector<SpeedRecord> records;
     for (const char* family : families)
         for (int size : family_sizes(family, run.quick)) {
@@ -532,7 +666,18 @@ std::vector<SpeedRecord> speed_study(const RunContext& run, const Settings& sett
             std::vector<Measured> rows;
             const CholeskyOptions fast{Ordering::nested_dissection, Factorization::supernodal};
             OursDetails details;
-            rows.push_back(run_ours(p, b, x_ref, fast, "ours: supernodal", &details));
+            // The factorization alternates with dgemm on the shapes of its supernodes (best rate of
+            // each); the factor is kept for the solve's race against CHOLMOD's below.
+            std::vector<SupernodeShape> shapes;
+            double gemm_rate = 0.0;
+            const auto gemm_after = [&](const SparseCholesky& chol) {
+                if (shapes.empty())
+                    shapes = flop_weighted_shapes(p.A, chol.permutation());
+                if (dgemm)
+                    gemm_rate = std::max(gemm_rate, gemm_mix_rate(dgemm, shapes));
+            };
+            std::optional<SparseCholesky> kept;
+            rows.push_back(run_ours(p, b, x_ref, fast, "ours: supernodal", &details, gemm_after, &kept));
             const Measured ours = rows.back();
             const Permutation& perm = details.perm;
             supernodes.add_row({p.family, double(p.A.rows), double(details.supernodes),
@@ -557,8 +702,23 @@ std::vector<SpeedRecord> speed_study(const RunContext& run, const Settings& sett
                 skipped.flops = amd.flops;
                 rows.push_back(skipped);
             }
-            rows.push_back(run_cholmod_row(p, b, x_ref, &perm));
+            double ours_solve = 0.0;
+            Eigen::VectorXd x_ours;
+            rows.push_back(run_cholmod_row(p, b, x_ref, &perm, [&] { x_ours = kept->solve(b); }, &ours_solve));
+            kept.reset();
+            const Measured same = rows.back();
+            if (ours_solve > 0.0)
+                rows.front().solve = ours_solve;  // the time of the race, in every table
             rows.push_back(run_cholmod_row(p, b, x_ref, nullptr));
+            std::string shapes_text;
+            for (const SupernodeShape& shape : shapes)
+                shapes_text += str(shapes_text.empty() ? "" : ", ", shape.m, "x", shape.ns);
+            const double rate = ours.flops / ours.factor * 1e-9;
+            const bool raced = same.status == "ok";
+            const Cell none = std::string("-");
+            kernels.add_row({p.family, double(p.A.rows), shapes_text, rate, dgemm ? Cell(gemm_rate) : none,
+                             dgemm ? Cell(rate / gemm_rate) : none, rows.front().solve,
+                             raced ? Cell(same.solve) : none, raced ? Cell(rows.front().solve / same.solve) : none});
             for (const Measured& m : rows) {
                 const bool ran = m.status == "ok";
                 const auto measured = [&](double value) { return ran ? Cell(value) : Cell(std::string("-")); };
@@ -574,6 +734,10 @@ std::vector<SpeedRecord> speed_study(const RunContext& run, const Settings& sett
     table.write_csv(run.file("speed_table.csv"));
     supernodes.print(std::cout);
     supernodes.write_csv(run.file("supernodes_table.csv"));
+    kernels.print(std::cout);
+    std::cout << "goals (measured, never asserted): factor rate >= 0.8 x dgemm's on the same shapes; solve <= 1.0 x "
+                 "CHOLMOD's\n";
+    kernels.write_csv(run.file("kernels_table.csv"));
     return records;
 }
 
