@@ -42,8 +42,9 @@
 #ifdef FEM_HAVE_CHOLMOD
 #include <Eigen/CholmodSupport>
 #endif
-#ifdef __linux__
+#if __has_include(<dlfcn.h>)
 #include <dlfcn.h>
+#define FEM_HAVE_DLSYM 1
 #endif
 
 #include <algorithm>
@@ -109,7 +110,7 @@ using Dgemm = void (*)(const char* transa, const char* transb, const int* m, con
 /// x86-64 (SSE2, no FMA) and would understate what one core can do.
 Dgemm blas_dgemm()
 {
-#ifdef __linux__
+#ifdef FEM_HAVE_DLSYM
     return reinterpret_cast<Dgemm>(dlsym(RTLD_DEFAULT, "dgemm_"));
 #else
     return nullptr;
