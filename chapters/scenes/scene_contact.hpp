@@ -40,6 +40,7 @@ public:
 
     std::string name() const override { return last_contact_ ? newton_.name() + " with contact" : own_.name(); }
     int order() const override { return 1; }
+    bool is_explicit() const override { return !last_contact_ && own_.is_explicit(); }
     /// One step from state (time t) to t + Δt (header comment). A contact step books the obstacles'
     /// work on the body, −(B(u⁺, t + Δt) − B(uᵗ, t)) with B the step's barrier energy
     /// (ContactPotential::barrier_energy), in StepInfo::boundary_work: chapter 10's loop counts it as

@@ -40,6 +40,7 @@ public:
     }
     std::string name() const override { return current().name(); }
     int order() const override { return current().order(); }
+    bool is_explicit() const override { return current().is_explicit(); }
     dynamics::StepInfo step(dynamics::Body& body, double time_step, dynamics::State& state) override
     {
         return current().step(body, time_step, state);
