@@ -44,7 +44,7 @@ double largest_angle(const std::vector<Eigen::Matrix3d>& rotations)
 }  // namespace
 
 TEST_CASE("plain corotational step: JacobiSVD, triplets and a fresh SimplicialLLT give our step to round-off",
-          "[plain-route]")
+          "[plain-route][ex11.6]")
 {
     const dynamics::Scene scene = bent_beam_scene();
     dynamics::Body ours(scene, std::make_unique<CorotationalElasticity>(scene.mesh, scene.material));
@@ -69,7 +69,7 @@ TEST_CASE("plain corotational step: JacobiSVD, triplets and a fresh SimplicialLL
 }
 
 TEST_CASE("plain corotational model: forces and warped stiffness of the chapter's model at a bent state",
-          "[plain-route]")
+          "[plain-route][ex11.6]")
 {
     const dynamics::Scene scene = bent_beam_scene();
     dynamics::Body body(scene, std::make_unique<CorotationalElasticity>(scene.mesh, scene.material));
@@ -90,7 +90,7 @@ TEST_CASE("plain corotational model: forces and warped stiffness of the chapter'
     CHECK_THROWS_AS(plain_model.stiffness(Eigen::VectorXd::Zero(3)), Error);
 }
 
-TEST_CASE("plain Cholesky: solves a step matrix to round-off, refuses an indefinite one", "[plain-route]")
+TEST_CASE("plain Cholesky: solves a step matrix to round-off, refuses an indefinite one", "[plain-route][ex11.6]")
 {
     const dynamics::Scene scene = bent_beam_scene();
     dynamics::Body body(scene, std::make_unique<CorotationalElasticity>(scene.mesh, scene.material));

@@ -34,7 +34,7 @@ std::unique_ptr<plain::PlainHyperelastic> plain_model(const dynamics::Scene& sce
 }  // namespace
 
 TEST_CASE("plain Newton step: dense element products, triplets and a fresh SimplicialLLT give our steps to round-off",
-          "[plain-route]")
+          "[plain-route][ex12.9]")
 {
     const dynamics::Scene scene = soft_beam();
     dynamics::Body ours(scene, make_force_model("stable-neo-hookean", scene.mesh, scene.material));
@@ -55,7 +55,7 @@ TEST_CASE("plain Newton step: dense element products, triplets and a fresh Simpl
 }
 
 TEST_CASE("plain hyperelastic model: energy, forces, Hessian and definite Hessian of the chapter's model, the Hessian "
-          "against central differences of the forces", "[plain-route]")
+          "against central differences of the forces", "[plain-route][ex12.9]")
 {
     const dynamics::Scene scene = soft_beam();
     dynamics::Body body(scene, make_force_model("stable-neo-hookean", scene.mesh, scene.material));
