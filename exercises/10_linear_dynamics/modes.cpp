@@ -164,9 +164,11 @@ PowerIteration power_iteration(const SparseMatrix& K, const Eigen::VectorXd& mas
     for (Eigen::Index i = 0; i < x.size(); ++i)
         x[i] = 1.0 + ((i % 2 == 0) ? 0.5 : -0.5);
     // EXERCISE 10.8 (power_iteration): see docs/10_linear_dynamics.md#the-explicit-stability-limit
-    // HINT: repeat: y = K x; λ = xᵀy / xᵀMx (the Rayleigh quotient, M = diag(masses));
-    // HINT: converged when |λ − λ_previous| ≤ tolerance · λ; x = M⁻¹ y, normalized (‖x‖ = 1).
-    // HINT: Report ω = √λ, the iterations and whether it converged.
+    // HINT: The power method on M⁻¹K (docs/10_linear_dynamics.md#the-explicit-stability-limit): its Rayleigh
+    // HINT: quotient tends to λ_max = ω_max² from below. M is diagonal: `masses` holds its entries, so applying M⁻¹
+    // HINT: is a division and no matrix is built. x arrives holding a start of mixed signs (keep it normalised,
+    // HINT: or it overflows). Converged: λ changed by at most `tolerance` relative to λ since the previous iterate.
+    // HINT: Fill result.omega (in rad/s, not λ), result.iterations, and result.converged (false when the cap is hit).
     throw fem::NotImplemented("10.8", "power_iteration", "docs/10_linear_dynamics.md#the-explicit-stability-limit");
     return result;
 }
@@ -183,8 +185,9 @@ double explicit_stability_limit(double omega, double xi)
     if (!(std::isfinite(xi) && xi >= 0.0))
         throw Error(str("the damping ratio xi must be finite and >= 0, got ", xi));
     // EXERCISE 10.6 (explicit_stability_limit): see docs/10_linear_dynamics.md#the-explicit-stability-limit
-    // HINT: symplectic Euler on q̈ + 2ξω q̇ + ω² q = 0 is stable while (ωΔt)² + 4ξ(ωΔt) ≤ 4:
-    // HINT: Δt_max = (2/ω)(√(1 + ξ²) − ξ); 2/ω without damping.
+    // HINT: The largest Δt at which symplectic Euler keeps one damped mode (ω, ξ) bounded: both eigenvalues of its
+    // HINT: 2×2 map in the unit disc. docs/10_linear_dynamics.md#the-explicit-stability-limit derives the condition
+    // HINT: from the map's trace and determinant; solve it for Δt. Check: 2/ω at ξ = 0, smaller as ξ grows.
     throw fem::NotImplemented("10.6", "explicit_stability_limit", "docs/10_linear_dynamics.md#the-explicit-stability-limit");
 }
 
@@ -193,9 +196,10 @@ Eigen::Matrix2d oscillator_step_matrix(double omega, double xi, double time_step
     require_oscillator(omega, xi, time_step, theta);
     Eigen::Matrix2d G;
     // EXERCISE 10.7 (oscillator_step_matrix): see docs/10_linear_dynamics.md#one-mode-one-oscillator
-    // HINT: substitute q⁺ = q + Δt(θp⁺ + (1−θ)p) into the p-equation and solve for p⁺:
-    // HINT: a p⁺ = −Δtω² q + (1 − θ(1−θ)ω²Δt² − 2(1−θ)ξωΔt) p with a = 1 + 2θξωΔt + θ²ω²Δt².
-    // HINT: Row 1 of G maps (q, p) to q⁺, row 2 to p⁺.
+    // HINT: G is one θ-step acting on (q, p = q̇) of the damped oscillator q̈ + 2ξωq̇ + ω²q = 0: solve the step's
+    // HINT: two equations for p⁺ and q⁺ (docs/10_linear_dynamics.md#one-mode-one-oscillator derives p⁺; the step
+    // HINT: is the θ-method of #the-implicit-step on one mode). Row 1 of G gives q⁺, row 2 p⁺; column 1 multiplies
+    // HINT: q, column 2 p. Check: at θ = 1 and ξ = 0 its eigenvalues are 1/(1 ∓ iωΔt).
     throw fem::NotImplemented("10.7", "oscillator_step_matrix", "docs/10_linear_dynamics.md#one-mode-one-oscillator");
     return G;
 }

@@ -108,8 +108,10 @@ Energies energies(const Body& body, const State& state)
 {
     Energies e;
     // EXERCISE 10.3 (energies): see docs/10_linear_dynamics.md#energy
-    // HINT: kinetic ½ vᵀ M v (kinetic_energy), elastic: the force model's U kept in the state,
-    // HINT: gravitational: the load potential −f_extᵀ u (load_potential).
+    // HINT: The three energies of the state, in joules (docs/10_linear_dynamics.md#energy), into e.kinetic,
+    // HINT: e.elastic and e.gravitational. Helpers: kinetic_energy(M, v) and load_potential(f_ext, u), with M and
+    // HINT: f_ext on `body`. The elastic energy is not recomputed: the force model's U(u) is kept in the state.
+    // HINT: The load potential is zero at rest and negative as the body sags.
     throw fem::NotImplemented("10.3", "energies", "docs/10_linear_dynamics.md#energy");
     return e;
 }
@@ -127,8 +129,10 @@ double theta_step_dissipation(const SparseMatrix& M, const SparseMatrix& K, cons
                         ") must be of one size"));
     double dissipated = 0.0;
     // EXERCISE 10.10 (theta_step_dissipation): see docs/10_linear_dynamics.md#energy
-    // HINT: multiply the step M (v⁺ − v) = −Δt K u_θ by v_θᵀ, use u⁺ − u = Δt v_θ and write
-    // HINT: v_θ = ½(v⁺ + v) + (θ − ½)(v⁺ − v), u_θ likewise; the ½(v⁺ + v) parts give H⁺ − H.
+    // HINT: A derivation exercise: the energy H − H⁺ one θ-step takes out of an undamped, unloaded linear body by
+    // HINT: itself, in `dissipated` (joules), written with M, K and the step's changes of u and v only. Derive it
+    // HINT: as docs/10_linear_dynamics.md#energy does for backward Euler, from the θ-step's momentum equation.
+    // HINT: Check: positive for θ > ½, zero for the midpoint rule.
     throw fem::NotImplemented("10.10", "theta_step_dissipation", "docs/10_linear_dynamics.md#energy");
     return dissipated;
 }
@@ -142,8 +146,9 @@ SparseMatrix step_matrix(const SparseMatrix& M, const SparseMatrix& K, const Dam
         throw Error(str("step matrix: M (", M.rows(), "x", M.cols(), ") and K (", K.rows(), "x", K.cols(),
                         ") must be square and of one size"));
     // EXERCISE 10.1 (step_matrix): see docs/10_linear_dynamics.md#the-implicit-step
-    // HINT: D = α M + β K, so A = M + θΔt D + θ²Δt² K = (1 + θΔt α) M + (θΔt β + θ²Δt²) K:
-    // HINT: one weighted sum of two sparse matrices.
+    // HINT: A is the matrix of the θ-step's linear system for v⁺ (docs/10_linear_dynamics.md#the-implicit-step),
+    // HINT: with Rayleigh damping D = αM + βK (damping.alpha, damping.beta) folded in: one weighted sum of M and
+    // HINT: K, returned as a new sparse matrix. Mind which powers of θ and Δt weight each part.
     throw fem::NotImplemented("10.1", "step_matrix", "docs/10_linear_dynamics.md#the-implicit-step");
 }
 
@@ -240,7 +245,8 @@ Eigen::VectorXd step_right_hand_side(const SparseMatrix& M, const Eigen::VectorX
         throw Error(str("step right-hand side: M is ", M.rows(), "x", M.cols(), ", v, f and f_ext have ", v.size(),
                         ", ", forces.size(), " and ", external_forces.size(), " entries"));
     // EXERCISE 10.2 (step_right_hand_side): see docs/10_linear_dynamics.md#the-implicit-step
-    // HINT: b = M v − Δt [K u − f_ext] = M v + Δt (f + f_ext), with the internal forces f = −K u.
+    // HINT: The lecture's right-hand side b of backward Euler solved for v⁺ (docs/10_linear_dynamics.md#the-implicit-step).
+    // HINT: K is not an argument: `forces` holds the internal forces f(u) = −K u, sign included.
     throw fem::NotImplemented("10.2", "step_right_hand_side", "docs/10_linear_dynamics.md#the-implicit-step");
 }
 
@@ -307,13 +313,18 @@ StepInfo ThetaMethod::step(Body& body, double time_step, State& state)
         solution_ = Eigen::VectorXd::Zero(eliminate ? dofs.size() : dofs.full_size());
     Eigen::VectorXd v_next, v_theta, u_next;
     // EXERCISE 10.4 (theta_step): see docs/10_linear_dynamics.md#the-implicit-step
-    // HINT: velocity_change form: r = velocity_change_right_hand_side(M, v, K v, f, f_ext, D, Δt, θ),
-    // HINT: solve A Δv = r, v⁺ = v + Δv. velocity form: b = step_right_hand_side(M, v, f, f_ext, Δt),
-    // HINT: minus (1 − θ)Δt (D v + θΔt K v) when θ < 1 (damping_times gives D v); solve A v⁺ = b.
-    // HINT: Moving pins: the pinned part x_p of the unknown is known (v⁺_p from pinned_velocity_next,
-    // HINT: less v_p in the Δv form): take A x_p = a M x_p + k K x_p off the right-hand side.
-    // HINT: Solve on the free dofs (eliminate: gather, solve, scatter; keep: zero the pinned rows
-    // HINT: of the right-hand side, solve all 3n), set v⁺_p. Then v_θ = θ v⁺ + (1 − θ) v, u⁺ = u + Δt v_θ.
+    // HINT: One θ-step of a linear body (docs/10_linear_dynamics.md#the-implicit-step): solve A x = rhs with the
+    // HINT: prepared solver_, x being v⁺ (StepForm::velocity, the lecture's b) or Δv = v⁺ − v
+    // HINT: (StepForm::velocity_change, #two-forms-of-one-step), as options_.form says. A is ready: the free dofs
+    // HINT: only when `eliminate` (dofs.gather / dofs.scatter), else all 3n with the pinned rows and columns made
+    // HINT: the identity's (then the right-hand side's pinned entries must be zero). Helpers above:
+    // HINT: velocity_change_right_hand_side, step_right_hand_side (the lecture's b, whole at θ = 1 only: for θ < 1 the docs'
+    // HINT: b has a correction with a damping part and a stiffness part; damping_times gives D v),
+    // HINT: pinned_velocity_next and set_pinned. Moving pins (#moving-pins): the pinned part of x is known, not
+    // HINT: zero (in the Δv form it is a change from v_p); take what A does with it off the right-hand side.
+    // HINT: rhs_ and solution_ are the solver's vectors: solution_ keeps the last answer, the warm start (start it
+    // HINT: afresh when its size does not fit). End with v_next, v_theta (the θ-weighted velocity) and u_next
+    // HINT: (moved with v_theta) filled, 3n each.
     throw fem::NotImplemented("10.4", "theta_step", "docs/10_linear_dynamics.md#the-implicit-step");
 
     info.solver_iterations = solver_->stats().iterations;
@@ -357,10 +368,12 @@ StepInfo SymplecticEuler::step(Body& body, double time_step, State& state)
 
     Eigen::VectorXd v_next, u_next;
     // EXERCISE 10.5 (symplectic_euler_step): see docs/10_linear_dynamics.md#explicit-euler
-    // HINT: a = f + f_ext − D v on the free dofs; lumped: M⁻¹ a is a division by dof_masses();
-    // HINT: consistent: solve M_ff x = a_f with mass_solver_. Then v⁺ = v + Δt M⁻¹ a (pinned dofs
-    // HINT: take their ṽ_p, the body's pin velocity) and u⁺ = u + Δt v⁺ (the NEW velocity: that is
-    // HINT: what makes it symplectic). A consistent M couples the pins' acceleration into the free rows.
+    // HINT: Symplectic Euler (docs/10_linear_dynamics.md#explicit-euler): forces at the old state (state.forces,
+    // HINT: body.external_forces(), and damping_force, already D v), positions moved with the NEW velocity (that
+    // HINT: is what makes it symplectic). Work on the free dofs (dofs.gather / dofs.scatter): lumped, M⁻¹ is a
+    // HINT: division by body.dof_masses(); consistent, mass_solver_ is already prepared with M_ff. The pinned dofs
+    // HINT: end the step at the body's pin velocity (#moving-pins); with a consistent M their acceleration over the
+    // HINT: step reaches the free rows through M_fp (the lumped M has none). Fill v_next and u_next, 3n each.
     throw fem::NotImplemented("10.5", "symplectic_euler_step", "docs/10_linear_dynamics.md#explicit-euler");
 
     info.damping_work = time_step * v_next.dot(damping_force);
@@ -395,9 +408,11 @@ double apply_step_hook(const Simulation::BeforeStep& hook, Body& body, State& st
 {
     double work = 0.0;
     // EXERCISE 10.9 (apply_step_hook): see docs/10_linear_dynamics.md#the-step-hook
-    // HINT: H before the hook (energies(body, state).total()); call the hook. If it says it changed the
-    // HINT: loads or the model, evaluate the model at u again (forces and U into the state): the work
-    // HINT: it put in is H after minus H before. If it changed nothing, it put in nothing.
+    // HINT: Book in `work` the energy a hook puts in (docs/10_linear_dynamics.md#the-step-hook), in joules: the
+    // HINT: jump of H = energies(body, state).total() across the hook, at the same (u, v). The hook is called as
+    // HINT: hook(body, state, step_end), the state read-only, and returns whether it changed the loads or the
+    // HINT: model; only then is anything booked, and then the state's forces and elastic energy are stale until
+    // HINT: the model is evaluated again at u (body.model().evaluate(u, forces) fills the forces and returns U).
     throw fem::NotImplemented("10.9", "apply_step_hook", "docs/10_linear_dynamics.md#the-step-hook");
     return work;
 }

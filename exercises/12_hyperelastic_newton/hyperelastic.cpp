@@ -23,7 +23,10 @@ Vector12d element_forces(const Material& material, double volume, const tet::Jac
 {
     Vector12d forces;
     // EXERCISE 12.4 (element_forces): see docs/12_hyperelastic_newton.md#element-forces-and-hessians
-    // HINT: f_e = −V Bᵀ vec(P): material.first_piola(H), flattened row-major (flatten).
+    // HINT: The tet's elastic forces, the negative gradient of its energy V ψ with vec(F) = B q_e, in `forces`
+    // HINT: (docs/12_hyperelastic_newton.md#element-forces-and-hessians); the stress is material.first_piola(H).
+    // HINT: vec is row-major, as B was built: flatten(P) gives it; P.reshaped() is column-major, i.e. vec(Pᵀ), and
+    // HINT: only a non-symmetric P shows the difference.
     throw fem::NotImplemented("12.4", "element_forces", "docs/12_hyperelastic_newton.md#element-forces-and-hessians");
     return forces;
 }
@@ -33,8 +36,11 @@ Matrix12d element_hessian(const Material& material, double volume, const tet::Ja
 {
     Matrix12d hessian;
     // EXERCISE 12.5 (element_hessian): see docs/12_hyperelastic_newton.md#element-forces-and-hessians
-    // HINT: dP = material.piola_derivative(H), or material.projected_piola_derivative(H, *projection)
-    // HINT: (PSD) when projection is set; then V Bᵀ dP B.
+    // HINT: The tet's Hessian, the second derivative of V ψ with vec(F) = B q_e, in `hessian`
+    // HINT: (docs/12_hyperelastic_newton.md#element-forces-and-hessians). When `projection` is set the caller needs
+    // HINT: it positive semi-definite (#definiteness): take ∂P/∂F from material.projected_piola_derivative(H,
+    // HINT: *projection) instead of material.piola_derivative(H) (a material may project analytically,
+    // HINT: #the-analytic-eigensystem), and project nothing yourself.
     throw fem::NotImplemented("12.5", "element_hessian", "docs/12_hyperelastic_newton.md#element-forces-and-hessians");
     return hessian;
 }

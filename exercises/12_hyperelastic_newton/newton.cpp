@@ -61,9 +61,11 @@ double backward_euler_objective(dynamics::Body& body, const dynamics::State& sta
         return std::numeric_limits<double>::infinity();
     double kinetic = 0.0, work = 0.0, dissipation = 0.0;
     // EXERCISE 12.7 (objective): see docs/12_hyperelastic_newton.md#backward-euler-as-minimisation
-    // HINT: kinetic = ½ (v − q̇ᵗ)ᵀ M (v − q̇ᵗ) (state.v is q̇ᵗ; the notes' qᵗ here is a slip);
-    // HINT: work = Δt vᵀ f_ext; dissipation = (Δt/2) vᵀ D v (damping.times(v) is D v).
-    // HINT: E = kinetic + U(qᵗ + Δt v) − work + dissipation.
+    // HINT: The non-elastic terms of the backward Euler objective E(v), each in joules
+    // HINT: (docs/12_hyperelastic_newton.md#backward-euler-as-minimisation): `kinetic`, about the previous velocity
+    // HINT: state.v (the notes' qᵗ there is a slip: "Where the notes slip"); `work`, the load's work over the
+    // HINT: step, stored positive (the return subtracts it); `dissipation`, half the damping's work with D held
+    // HINT: fixed (damping.times(v) is D v). The elastic term is done above; M and f_ext are on `body`.
     throw fem::NotImplemented("12.7", "objective", "docs/12_hyperelastic_newton.md#backward-euler-as-minimisation");
     if (magnitude != nullptr)
         *magnitude = std::abs(kinetic) + std::abs(elastic) + std::abs(work) + std::abs(dissipation);
@@ -78,8 +80,10 @@ Eigen::VectorXd backward_euler_gradient(dynamics::Body& body, const dynamics::St
     Eigen::VectorXd forces, gradient;
     body.model().evaluate(state.u + time_step * v, forces);
     // EXERCISE 12.8 (gradient): see docs/12_hyperelastic_newton.md#backward-euler-as-minimisation
-    // HINT: ∇E = M (v − q̇ᵗ) − Δt (f(qᵗ + Δt v) + f_ext − D v), with forces = f(qᵗ + Δt v) above
-    // HINT: and D v = damping.times(v).
+    // HINT: The gradient of exercise 12.7's E with respect to v, in `gradient`, 3n entries
+    // HINT: (docs/12_hyperelastic_newton.md#backward-euler-as-minimisation). `forces` above holds f(qᵗ + Δt v),
+    // HINT: the internal forces −∂U/∂q: mind their sign and the chain rule's Δt. damping.times(v) is D v. It
+    // HINT: vanishes at chapter 10's backward Euler step.
     throw fem::NotImplemented("12.8", "gradient", "docs/12_hyperelastic_newton.md#backward-euler-as-minimisation");
     return gradient;
 }
@@ -200,10 +204,13 @@ NewtonResult newton_minimize(const NewtonProblem& problem, Eigen::VectorXd x0, c
             // E is a sum of terms that cancel; differences below its round-off carry no information.
             const double noise = objective_round_off * magnitude;
             // EXERCISE 12.9 (line_search): see docs/12_hyperelastic_newton.md#newton-with-line-search
-            // HINT: objective = problem.objective(x + α d, &magnitude) (+∞ never passes); while it is
-            // HINT: above start + c α slope + noise (c is options.armijo): α ← shrink · α, and throw
-            // HINT: fem::Error once α falls below options.smallest_step. The accepted trial's objective
-            // HINT: and magnitude stay in `objective` and `magnitude`: the next iteration starts there.
+            // HINT: Armijo backtracking (docs/12_hyperelastic_newton.md#newton-with-line-search): `alpha` arrives as the
+            // HINT: first trial (1, or the largest safe step: do not reset it); shrink it by options.shrink until E at
+            // HINT: x + α d lies below `start` by at least options.armijo's share of the decrease `slope` (∇Eᵀd < 0)
+            // HINT: predicts for that α, `noise` (E's round-off) allowed. The notes' target leaves α out: their fourth
+            // HINT: slip. problem.objective(y, &magnitude) is +∞ where the material is undefined. Throw fem::Error once α
+            // HINT: falls below options.smallest_step. The accepted trial's E and magnitude must end in `objective` and
+            // HINT: `magnitude` (the next iteration starts there), its α in `alpha`.
             throw fem::NotImplemented("12.9", "line_search", "docs/12_hyperelastic_newton.md#newton-with-line-search");
         }
         result.step_lengths.push_back(alpha);

@@ -21,7 +21,10 @@ Vector12d element_forces(const Material& material, double volume, const tet::Jac
 {
     Vector12d forces;
     // BEGIN EXERCISE 12.4 element_forces #element-forces-and-hessians
-    // HINT: f_e = −V Bᵀ vec(P): material.first_piola(H), flattened row-major (flatten).
+    // HINT: The tet's elastic forces, the negative gradient of its energy V ψ with vec(F) = B q_e, in `forces`
+    // HINT: (docs/12_hyperelastic_newton.md#element-forces-and-hessians); the stress is material.first_piola(H).
+    // HINT: vec is row-major, as B was built: flatten(P) gives it; P.reshaped() is column-major, i.e. vec(Pᵀ), and
+    // HINT: only a non-symmetric P shows the difference.
     forces = -volume * (B.transpose() * flatten(material.first_piola(H)));
     // END EXERCISE
     return forces;
@@ -32,8 +35,11 @@ Matrix12d element_hessian(const Material& material, double volume, const tet::Ja
 {
     Matrix12d hessian;
     // BEGIN EXERCISE 12.5 element_hessian #element-forces-and-hessians
-    // HINT: dP = material.piola_derivative(H), or material.projected_piola_derivative(H, *projection)
-    // HINT: (PSD) when projection is set; then V Bᵀ dP B.
+    // HINT: The tet's Hessian, the second derivative of V ψ with vec(F) = B q_e, in `hessian`
+    // HINT: (docs/12_hyperelastic_newton.md#element-forces-and-hessians). When `projection` is set the caller needs
+    // HINT: it positive semi-definite (#definiteness): take ∂P/∂F from material.projected_piola_derivative(H,
+    // HINT: *projection) instead of material.piola_derivative(H) (a material may project analytically,
+    // HINT: #the-analytic-eigensystem), and project nothing yourself.
     const Matrix9d dP = projection ? material.projected_piola_derivative(H, *projection) : material.piola_derivative(H);
     // Bᵀ dP B using only B's 36 nonzeros of 108, B(3a + b, 3i + a) = ∇φᵢ(b) = g(i, b): first
     // W = dP B (column 3j + c is Σ_d g(j, d) dP(:, 3c + d)), then row 3i + a of Bᵀ W is

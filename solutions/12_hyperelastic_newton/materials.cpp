@@ -100,8 +100,10 @@ Eigen::Matrix3d second_piola(const elastic::Lame& lame, const Eigen::Matrix3d& H
 {
     Eigen::Matrix3d S;
     // BEGIN EXERCISE 12.1 stvk_stress #st-venantkirchhoff
-    // HINT: the Green strain in H: E = ½(H + Hᵀ + HᵀH) (= ½(FᵀF − I) with F = I + H);
-    // HINT: then S = 2μE + λ tr(E) I.
+    // HINT: StVK's Green strain E (returned through the argument) and second Piola–Kirchhoff stress S, from
+    // HINT: docs/12_hyperelastic_newton.md#st-venantkirchhoff with lame.mu and lame.lambda. Write E in H = F − I,
+    // HINT: never as a difference of FᵀF and I: near rest that difference loses the strain to round-off
+    // HINT: (#round-off-near-rest; a test keeps six digits at strains of 10⁻¹²).
     E = 0.5 * (H + H.transpose() + H.transpose() * H);
     S = 2.0 * lame.mu * E + lame.lambda * E.trace() * Eigen::Matrix3d::Identity();
     // END EXERCISE
@@ -165,8 +167,10 @@ Eigen::Matrix3d NeoHookean::first_piola(const Eigen::Matrix3d& H) const
     const Eigen::Matrix3d G_change = inverse_transpose_change(H, J, log_J);  // F⁻ᵀ − I
     Eigen::Matrix3d P;
     // BEGIN EXERCISE 12.2 neo_hookean_stress #neo-hookean
-    // HINT: P = μ(F − F⁻ᵀ) + λ ln J F⁻ᵀ. Write F − F⁻ᵀ as H − (F⁻ᵀ − I) = H − G_change and
-    // HINT: F⁻ᵀ as I + G_change, so that no two terms of size μ cancel near rest.
+    // HINT: Neo-Hookean's first Piola–Kirchhoff stress, in P (docs/12_hyperelastic_newton.md#neo-hookean), with
+    // HINT: lame().mu and lame().lambda. F⁻ᵀ is not given as such: G_change above is F⁻ᵀ − I and log_J is ln J,
+    // HINT: both free of cancellation; write P so that no two terms of size μ cancel near rest
+    // HINT: (#round-off-near-rest: a test keeps six digits at strains of 10⁻¹²).
     P = lame().mu * (H - G_change) + lame().lambda * log_J * (Eigen::Matrix3d::Identity() + G_change);
     // END EXERCISE
     return P;
@@ -199,8 +203,10 @@ Eigen::Matrix3d neo_hookean_stress_change(const elastic::Lame& lame, const Eigen
     const double mu = lame.mu, lambda = lame.lambda, log_J = std::log(J);
     Eigen::Matrix3d dP;
     // BEGIN EXERCISE 12.10 neo_hookean_stress_change #neo-hookean
-    // HINT: δ(F⁻ᵀ) = −G δFᵀ G and δ(ln J) = G:δF (Jacobi's formula, G:δF = Σ_ab G_ab δF_ab);
-    // HINT: differentiate P = μ(F − G) + λ ln J G term by term.
+    // HINT: A derivation exercise: the change of neo-Hookean's P along a change dF of F, a 3×3 matrix in dP (not
+    // HINT: the 9×9 ∂P/∂F). Differentiate P term by term with the derivatives of F⁻ᵀ and ln J derived in
+    // HINT: docs/12_hyperelastic_newton.md#neo-hookean; G (= F⁻ᵀ), mu, lambda and log_J are ready. Mind where dF
+    // HINT: is transposed, and that G:dF is a number, the sum of entrywise products.
     dP = mu * dF + (mu - lambda * log_J) * G * dF.transpose() * G + lambda * (G.cwiseProduct(dF).sum()) * G;
     // END EXERCISE
     return dP;
@@ -236,8 +242,10 @@ Matrix9d stable_derivative(double mu, double lambda_hat, const Eigen::Matrix3d& 
     Matrix9d dP = mu * Matrix9d::Identity() + lambda_hat * C * C.transpose();
     const double weight = lambda_hat * change - mu;
     // BEGIN EXERCISE 12.3 stable_neo_hookean_derivative #stable-neo-hookean
-    // HINT: add (λ̂(J − 1) − μ) ∂²J/∂F² to dP, entry (3a + b, 3c + d), where
-    // HINT: ∂²J/∂F_ab∂F_cd = Σ_kl ε_ack ε_bdl F_kl (levi_civita(i, j, k) is ε_ijk).
+    // HINT: Complete stable neo-Hookean's ∂P/∂F (docs/12_hyperelastic_newton.md#stable-neo-hookean): dP holds its
+    // HINT: first two terms; add `weight` (= λ̂(J − 1) − μ) times the second derivative of J = det F, whose entries
+    // HINT: the docs write with Levi-Civita symbols (levi_civita(i, j, k) is ε_ijk; F is ready). Entry (3a + b,
+    // HINT: 3c + d) is ∂P_ab/∂F_cd, vec row-major (#energy-densities): mind which indices each ε takes.
     for (int a = 0; a < 3; ++a)
         for (int b = 0; b < 3; ++b)
             for (int c = 0; c < 3; ++c)
@@ -429,8 +437,10 @@ Eigen::Matrix<double, N, N> project_to_psd(const Eigen::Matrix<double, N, N>& A,
     Eigen::Matrix<double, N, 1> values = eigen.eigenvalues();
     Matrix projected;
     // BEGIN EXERCISE 12.6 psd_projection #definiteness
-    // HINT: A = Q Λ Qᵀ (eigen.eigenvectors(), values): replace each negative eigenvalue by 0 (clamp)
-    // HINT: or by its absolute value (absolute), then rebuild Q Λ' Qᵀ.
+    // HINT: The nearest positive semi-definite matrix to A, in `projected` (docs/12_hyperelastic_newton.md#definiteness).
+    // HINT: The eigen-decomposition of A's symmetric part is done: `eigen` has the eigenvectors and `values` is a
+    // HINT: copy of the eigenvalues, yours to change. Projection::clamp and Projection::absolute treat a negative
+    // HINT: eigenvalue differently (the docs say how); a PSD A comes back unchanged.
     for (int i = 0; i < N; ++i)
         if (values[i] < 0.0)
             values[i] = projection == Projection::clamp ? 0.0 : -values[i];

@@ -85,8 +85,9 @@ BarycentricFrames::BarycentricFrames(const TetMesh& mesh, const std::string& wha
 Eigen::Vector4d BarycentricFrames::weights(int t, const Eigen::Vector3d& p) const
 {
     // BEGIN EXERCISE 13.1 barycentric_weights #barycentric-weights
-    // HINT: (φ₁, φ₂, φ₃) = T⁻¹ (p − X₀) with the prepared inverse_[t] and origin_.row(t);
-    // HINT: φ₀ makes the four sum to 1.
+    // HINT: The four barycentric weights (φ₀, φ₁, φ₂, φ₃) of p in tet t (docs/13_skinning.md#barycentric-weights),
+    // HINT: from what the constructor prepared: inverse_[t] (T⁻¹, T's columns the edges from corner 0) and
+    // HINT: origin_.row(t) (corner 0, a row). Outside the tet a weight is negative: keep it (no clamping).
     const Eigen::Vector3d tail = inverse_[t] * (p - origin_.row(t).transpose());
     Eigen::Vector4d phi;
     phi << 1.0 - tail.sum(), tail;
@@ -163,9 +164,11 @@ UniformGrid::UniformGrid(const BarycentricFrames& frames, double tolerance, doub
     origin_ = low;
     cell_size_ = extent.cwiseQuotient(dims_.cast<double>());
     // BEGIN EXERCISE 13.2 uniform_grid #a-uniform-grid
-    // HINT: Two passes over the tets, like chapter 07's COO → CSR: count the tets of every cell that
-    // HINT: each padded box meets (cells cell_of(low) … cell_of(high)), turn the counts into offsets_,
-    // HINT: then drop each tet into its cells in ascending order of t.
+    // HINT: The grid's cell lists in CSR form (docs/13_skinning.md#a-uniform-grid): cell c's tets are
+    // HINT: tets_[offsets_[c] … offsets_[c+1]−1], every tet whose padded box boxes[t] meets the cell, in ascending
+    // HINT: t (locate() stops at the first hit). The construction is chapter 07's triplets-to-CSR
+    // HINT: (docs/07_sparse_storage.md#from-triplets-to-csr). cell_of(point) gives a point's cell (i, j, k),
+    // HINT: clamped to the grid; number the cells as locate() does.
     const std::size_t cells = std::size_t(dims_[0]) * dims_[1] * dims_[2];
     const auto cell_index = [&](int i, int j, int k) { return i + dims_[0] * (j + std::size_t(dims_[1]) * k); };
     const auto for_cells_of = [&](Eigen::Index t, const auto& visit) {
@@ -281,8 +284,11 @@ Location AabbTree::locate(const Eigen::Vector3d& p) const
 {
     Location best;
     // BEGIN EXERCISE 13.3 aabb_tree_locate #an-aabb-tree
-    // HINT: Depth first with a small stack of node numbers from the root (node 0): skip a node whose
-    // HINT: box does not hold p; in a leaf, test its tets with the padded box first, then keep_lowest.
+    // HINT: The lowest-numbered tet containing p, in `best` (docs/13_skinning.md#an-aabb-tree, #point-location):
+    // HINT: visit every node whose box [low, high] holds p, from the root nodes_[0]. A leaf (left < 0) lists
+    // HINT: tets_[first … first + count − 1]; keep_lowest(frames_, t, p, tolerance_, best) tests one tet's
+    // HINT: weights and keeps the lower number; boxes_[t], the tet's padded box, is a cheaper test first. The depth
+    // HINT: is about log₂(#T/4), so a small fixed stack serves.
     std::array<int, 128> stack;
     int top = 0;
     stack[top++] = 0;
@@ -338,9 +344,10 @@ Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& p, const Eigen:
                                           const Eigen::Vector3d& b, const Eigen::Vector3d& c)
 {
     // BEGIN EXERCISE 13.5 closest_point_on_triangle #points-outside
-    // HINT: Ericson's Voronoi-region walk: with ab = b − a, ac = c − a and the dot products of ab, ac
-    // HINT: with p − a, p − b, p − c, decide whether p projects onto a corner (a, b, c), an edge
-    // HINT: (ab, ac, bc) or the face, and return that projection.
+    // HINT: The point of triangle abc nearest to p (docs/13_skinning.md#points-outside): it lies in one of seven
+    // HINT: Voronoi regions (three corners, three edges, the face). Ericson's Real-Time Collision Detection, §5.1.5
+    // HINT: (the docs' references), tells the region from dot products with the edge vectors, without a square
+    // HINT: root. The tests place a point in every region.
     const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
     const double d1 = ab.dot(ap), d2 = ac.dot(ap);
     if (d1 <= 0.0 && d2 <= 0.0)
@@ -434,8 +441,10 @@ sparse::CsrMatrix skinning_matrix(const TetMesh& coarse, const std::vector<int>&
             throw Error(str("skinning_matrix: surface vertex ", s, " refers to tet ", tet[s], "; the coarse mesh has ",
                             coarse.T.rows(), " (numbered from 0)"));
     // BEGIN EXERCISE 13.4 skinning_matrix #the-skinning-matrix
-    // HINT: One triplet (s, corner v of tet[s], φ) per corner: a CooMatrix of #V_skin × #V_sim with
-    // HINT: four entries a row, then chapter 07's coo_to_csr (which sorts the columns of each row).
+    // HINT: W of docs/13_skinning.md#the-skinning-matrix, #V_skin × #V_sim (not three times either: the notes'
+    // HINT: slip): row s holds phi.row(s) in the columns of the corners of tet tet[s] (coarse.T). Build it from
+    // HINT: chapter 07's triplets (sparse::CooMatrix: rows, cols, add) and sparse::coo_to_csr, which sorts each
+    // HINT: row's columns. A zero weight stays a stored entry: four a row.
     sparse::CooMatrix W;
     W.rows = static_cast<int>(tet.size());
     W.cols = static_cast<int>(coarse.V.rows());
@@ -495,8 +504,9 @@ MatrixX3d skinned_positions(const sparse::CsrMatrix& W, const MatrixX3d& Q)
     (void)sparse::view(W);  // checks the array sizes
     MatrixX3d x(W.rows, 3);
     // BEGIN EXERCISE 13.7 skinned_positions #the-skinned-surface
-    // HINT: Row s of x is Σ A[k] Q.row(JA[k]) over k = IA[s] … IA[s+1]−1: one pass over W for all
-    // HINT: three coordinates (three separate SpMVs would read W three times).
+    // HINT: x = W Q (docs/13_skinning.md#the-skinned-surface): row s of x is the weighted sum of the rows of Q
+    // HINT: that row s of W names. W is CSR (W.IA row offsets, W.JA columns, W.A values); x is sized. Read W once
+    // HINT: for all three coordinates, not once per column (why: docs/13_skinning.md#making-it-fast).
     for (int s = 0; s < W.rows; ++s) {
         Eigen::RowVector3d sum = Eigen::RowVector3d::Zero();
         for (int k = W.IA[s]; k < W.IA[s + 1]; ++k)
@@ -515,8 +525,9 @@ MatrixX3d vertex_normals(const MatrixX3i& F, const MatrixX3d& x)
             if (F(f, i) < 0 || F(f, i) >= x.rows())
                 throw Error(str("vertex_normals: triangle ", f, " refers to vertex ", F(f, i), "; there are ", x.rows()));
     // BEGIN EXERCISE 13.6 vertex_normals #normals
-    // HINT: Add (b − a) × (c − a) of each triangle (a, b, c) to its three vertices, then normalise
-    // HINT: each row that is not zero.
+    // HINT: Area-weighted unit vertex normals of the deformed surface x, in `normals`, zeroed above
+    // HINT: (docs/13_skinning.md#normals): each triangle adds its normal, scaled by its area and oriented by its
+    // HINT: corner order, to its three corners. A vertex in no triangle keeps a zero row (divide by no zero).
     for (Eigen::Index f = 0; f < F.rows(); ++f) {
         const Eigen::Vector3d a = x.row(F(f, 0)), b = x.row(F(f, 1)), c = x.row(F(f, 2));
         const Eigen::RowVector3d n = (b - a).cross(c - a).transpose();
