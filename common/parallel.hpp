@@ -50,6 +50,20 @@ inline void set_thread_count(int threads)
 #endif
 }
 
+/// Sets the number of threads for one scope and restores the previous number when the scope ends,
+/// also by an exception: e.g. `const ScopedThreadCount one_core(1);` around a study timed on one
+/// core. fem::Error for threads < 1.
+class ScopedThreadCount {
+public:
+    explicit ScopedThreadCount(int threads) : previous_(thread_count()) { set_thread_count(threads); }
+    ~ScopedThreadCount() { set_thread_count(previous_); }
+    ScopedThreadCount(const ScopedThreadCount&) = delete;
+    ScopedThreadCount& operator=(const ScopedThreadCount&) = delete;
+
+private:
+    int previous_;
+};
+
 /// Makes OpenMP's threads wait for the next loop asleep instead of spinning, unless the user chose
 /// (OMP_WAIT_POLICY set): sets OMP_WAIT_POLICY=passive and starts the program again, the same
 /// process (execv of /proc/self/exe with the same argv), since libgomp reads the variable once,

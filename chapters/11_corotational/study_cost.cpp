@@ -196,8 +196,7 @@ void peers_study(const RunContext& run, const Settings& settings)
                 {{"free dofs", Format::integer}, {"route", Format::text}, {"time per step [s]", Format::scientific, 2},
                  {"row above / this row [measured]", Format::fixed, 2}, {"plain / this row [measured]", Format::fixed, 1},
                  {"max |u - u_plain| / max |u_plain| [±1e-7]", Format::scientific, 1}});
-    const int threads_before = thread_count();
-    set_thread_count(1);  // like for like: the plain route runs on one core
+    const ScopedThreadCount one_core(1);  // like for like: the plain route runs on one core
     for (int cells : settings.cost_cells) {
         if (cells > largest_peer_cells)
             continue;  // the plain route's fresh factorizations take seconds a step beyond it
@@ -220,7 +219,6 @@ void peers_study(const RunContext& run, const Settings& settings)
         }
         peers.add_row({free_dofs, double(scene.mesh.T.rows()), plain_time, ours, plain_time / ours, deviation});
     }
-    set_thread_count(threads_before);
     peers.print(std::cout);
     peers.write_csv(run.file("peers_table.csv"));
     rungs.print(std::cout);
@@ -295,8 +293,7 @@ void cost_study(const RunContext& run, const Settings& settings)
     // Long enough for the balanced refresh to refactor the frozen factor a few times: its cost is in
     // the mean, as it would be in a long run.
     const int goal_steps = run.quick ? 4 : 300;
-    const int threads_before = thread_count();
-    set_thread_count(1);  // the goal is on one core
+    const ScopedThreadCount one_core(1);  // the goal is on one core
     for (const std::string& name : solver_option_names()) {
         if (name.rfind("pcg-ic0", 0) == 0 && name != "pcg-ic0 dv from last dv")
             continue;
@@ -312,7 +309,6 @@ void cost_study(const RunContext& run, const Settings& settings)
     goal.add_row({double(sofa.mesh.V.rows()), double(fast.dofs().size()),
                   std::string("rotated-frozen-factor-pcg, shape-gradient forces"), 1e3 * cost.seconds, cost.iterations,
                   sofa_fast_ms, sofa_fast_ms / (1e3 * cost.seconds)});
-    set_thread_count(threads_before);
     goal.print(std::cout);
     goal.write_csv(run.file("sofa_table.csv"));
 

@@ -148,8 +148,7 @@ void peers_study(const RunContext& run)
                 {"goal: half of it (ms)", Format::fixed, 1}, {"our default step, converged [ms]", Format::fixed, 1},
                 {"its CPU time [ms]", Format::fixed, 1}, {"our fastest step, converged [ms]", Format::fixed, 1},
                 {"its CPU time, fastest [ms]", Format::fixed, 1}, {"default meets the goal (CPU time) [measured]", Format::text}});
-    const int threads_before = thread_count();
-    set_thread_count(1);  // like for like: one core, as the plain route and HOBAK's run
+    const ScopedThreadCount one_core(1);  // like for like: one core, as the plain route and HOBAK's run
     for (const Bunny& bunny : bunnies) {
         const dynamics::Scene scene = bunny_scene(bunny.mesh());
         const double vertices = double(scene.mesh.V.rows());
@@ -184,7 +183,6 @@ void peers_study(const RunContext& run)
         std::cout << bunny.name << ": the scenes' default solver " << (meets ? "meets" : "misses") << " the goal ("
                   << 1e3 * default_cpu << " ms of CPU a step against " << 0.5 * bunny.hobak_ms << " ms)\n";
     }
-    set_thread_count(threads_before);
     rungs.print(std::cout);
     rungs.write_csv(run.file("peers_table.csv"));
     goal.print(std::cout);
@@ -246,7 +244,7 @@ void cost_study(const RunContext& run, const Settings& settings)
         Eigen::VectorXd forces, first_forces;
         dynamics::SparseMatrix first_hessian;
         double first_time = 0.0;
-        const int original = thread_count();
+        const ScopedThreadCount restore(thread_count());  // the loop below sets 1, then 2
         for (const int count : {1, 2}) {
             set_thread_count(count);
             const double evaluate = best_time([&] { model.evaluate(state.u, forces); }, settings.seconds);
@@ -263,7 +261,6 @@ void cost_study(const RunContext& run, const Settings& settings)
             }
             threads.add_row({double(count), evaluate, hessian, first_time / hessian, std::string(identical ? "yes" : "no")});
         }
-        set_thread_count(original);
     }
     threads.print(std::cout);
     threads.write_csv(run.file("threads_table.csv"));
@@ -282,8 +279,7 @@ void cost_study(const RunContext& run, const Settings& settings)
     // chapter 11's frozen factor (single precision, refreshed when CG needs more than 10
     // iterations) as CG's preconditioner, solved only as tightly as the gradient needs (inexact
     // Newton), keeps one factorization for several steps.
-    const int threads_before = thread_count();
-    set_thread_count(1);  // the goal is on one core
+    const ScopedThreadCount one_core(1);  // the goal is on one core
     for (const std::string solver : {"refactor", "frozen-factor-pcg"}) {
         NewtonOptions options;
         if (solver == "frozen-factor-pcg")
@@ -308,7 +304,6 @@ void cost_study(const RunContext& run, const Settings& settings)
         goal.add_row({double(vega.mesh.V.rows()), double(body.dofs().size()), solver, double(iterations) / steps,
                       double(cg_iterations) / steps, double(factorizations) / steps, ours, 0.5, 0.5 / ours});
     }
-    set_thread_count(threads_before);
     goal.print(std::cout);
     goal.write_csv(run.file("vega_table.csv"));
 
