@@ -29,11 +29,12 @@ TrianglePoint closest_triangle_point(const Eigen::Vector3d& p, const Eigen::Vect
 {
     TrianglePoint closest;
     // BEGIN EXERCISE 14.5 closest_triangle_point #distance-to-a-triangle
-    // HINT: With n = (b − a) × (c − a), project p onto the plane: q = p − ((p − a)·n) n/|n|². q is inside
-    // HINT: when the three areas ((b − a) × (q − a))·n, ((c − b) × (q − b))·n, ((a − c) × (q − c))·n are ≥ 0:
-    // HINT: the face. Otherwise the nearest point is on the border: for each edge i → j = (i + 1) mod 3,
-    // HINT: t = clamp((p − xᵢ)·(xⱼ − xᵢ)/|xⱼ − xᵢ|², 0, 1); keep the nearest xᵢ + t (xⱼ − xᵢ): a corner
-    // HINT: (i at t = 0, j at t = 1) or the edge i.
+    // HINT: The point of triangle abc nearest to p, and which feature holds it (the face, an edge or a
+    // HINT: corner: `closest.feature`, and for an edge or corner its first corner in `closest.corner`),
+    // HINT: docs/14_contact.md#distance-to-a-triangle. The face answers when p's projection onto the
+    // HINT: plane lies inside; otherwise the nearest point lies on the border, on one of the three edges
+    // HINT: with its ends. The triangle may be sliver-thin but not degenerate (the reader refuses those).
+    // HINT: The tests compare with chapter 13's closest_point_on_triangle and place p in every region.
     const std::array<Eigen::Vector3d, 3> x{a, b, c};
     const Eigen::Vector3d n = (b - a).cross(c - a);
     const Eigen::Vector3d q = p - ((p - a).dot(n) / n.squaredNorm()) * n;
@@ -224,13 +225,13 @@ double MeshObstacle::local_time_of_impact(const Eigen::Vector3d& p, const Eigen:
         return 0.0;
     double first = infinity;
     // BEGIN EXERCISE 14.6 mesh_time_of_impact #continuous-collision-detection
-    // HINT: Möller–Trumbore for the triangles whose boxes meet the path's box (triangles_meeting): with
-    // HINT: e₁ = b − a, e₂ = c − a, h = dp × e₂, det = e₁·h, r = p − a, q = r × e₁, the path meets the
-    // HINT: triangle's plane at s = (e₂·q)/det with barycentric u = (r·h)/det, v = (dp·q)/det. Keep the
-    // HINT: smallest s in [0, 2] with u, v ≥ −1e-9 and u + v ≤ 1 + 1e-9 (each triangle grown a little: a path
-    // HINT: through a shared edge is caught whatever the round-off). A path parallel to a
-    // HINT: triangle's plane (|det| ≤ 1e-12 |e₁||e₂||dp|) misses it when p is off the plane by more
-    // HINT: than 1e-9 |dp|; in the plane, answer conservative_time_of_impact instead.
+    // HINT: The smallest s in [0, 2] at which p + s dp meets one of the triangles whose boxes meet the
+    // HINT: path's box (triangles_meeting), in `first` (docs/14_contact.md#continuous-collision-detection):
+    // HINT: solve for where the path crosses each triangle's plane and whether that point lies in the
+    // HINT: triangle (Möller–Trumbore, as the docs name it). Count a hit on an edge as inside, with a
+    // HINT: margin of 1e-9 of the barycentric range, so a path through a shared edge cannot slip between
+    // HINT: two triangles by round-off. A path parallel to a plane misses it unless it lies in it; then
+    // HINT: there is no root to solve for: answer conservative_time_of_impact.
     constexpr double far = 2.0;      // callers step at most s = 1: beyond this, no impact that matters
     constexpr double margin = 1e-9;  // each triangle tested grown by this fraction at its edges
     const Eigen::Vector3d end = p + far * dp;
