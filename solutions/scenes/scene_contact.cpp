@@ -1,6 +1,8 @@
 // The scenes capstone: a body's steps with obstacles. docs/scenes.md#obstacles
 #include "scenes/scene_contact.hpp"
 
+#include "12_hyperelastic_newton/force_models.hpp"
+
 namespace fem::scenes {
 
 std::vector<std::shared_ptr<const contact::Obstacle>> scene_obstacles(const SceneSpec& scene)
@@ -12,14 +14,6 @@ std::vector<std::shared_ptr<const contact::Obstacle>> scene_obstacles(const Scen
 }
 
 namespace {
-
-hyper::NewtonOptions newton_options(const SceneSpec& scene)
-{
-    hyper::NewtonOptions options;
-    options.relative_tolerance = scene.newton_tolerance;
-    options.solver = scene.solver;
-    return options;
-}
 
 contact::ContactOptions contact_options(const SceneSpec& scene)
 {
@@ -36,7 +30,7 @@ ContactIntegrator::ContactIntegrator(dynamics::Integrator& own, const dynamics::
                                      const SceneSpec& scene)
     : own_(own),
       potential_(std::make_unique<contact::ContactPotential>(body, std::move(obstacles), contact_options(scene))),
-      newton_(newton_options(scene))
+      newton_(hyper::newton_options_for({.solver = scene.solver, .newton_tolerance = scene.newton_tolerance}))
 {
     newton_.set_potential(potential_.get());
 }
