@@ -58,7 +58,8 @@ inline constexpr std::string_view frozen_factor_solver = "frozen-factor-pcg";
 NewtonOptions newton_options_for(const StepSettings& settings);
 
 /// The integrator for the force model called `model`: chapter 10's make_integrator(settings.integrator)
-/// with settings.solver for "linear" and "corotational"; NewtonBackwardEuler with
+/// with settings.solver for "linear" and "corotational" (frozen_factor_solver through
+/// ImplicitOptions::make_solver); NewtonBackwardEuler with
 /// newton_options_for(settings) for a hyperelastic one. fem::Error for an unknown model, integrator or
 /// solver, a hyperelastic model with an integrator other than "backward-euler" (Newton steps backward
 /// Euler only), or a tolerance outside (0, 1).

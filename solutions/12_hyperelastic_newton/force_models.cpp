@@ -23,6 +23,12 @@ Error unknown_model(std::string_view name)
     return Error(str("unknown force model '", name, "'; choose one of: ", names));
 }
 
+/// Chapter 11's frozen factor as the solver of every step matrix (frozen_factor_solver).
+std::unique_ptr<cg::LinearSolver> make_frozen_factor_solver()
+{
+    return std::make_unique<corot::FrozenFactorPcg>(cg::SolverOptions{1e-8, 0}, corot::RefreshRule{.iterations_above = 10});
+}
+
 }  // namespace
 
 std::vector<std::string> force_model_names()
@@ -59,10 +65,7 @@ NewtonOptions newton_options_for(const StepSettings& settings)
     NewtonOptions options;
     options.relative_tolerance = settings.newton_tolerance;
     if (settings.solver == "default" || settings.solver == frozen_factor_solver)
-        options.make_solver = [] {
-            return std::make_unique<corot::FrozenFactorPcg>(cg::SolverOptions{1e-8, 0},
-                                                            corot::RefreshRule{.iterations_above = 10});
-        };
+        options.make_solver = make_frozen_factor_solver;
     else
         options.solver = settings.solver;
     return options;
@@ -79,7 +82,10 @@ std::unique_ptr<dynamics::Integrator> make_integrator_for(std::string_view model
     if (model != "linear" && model != "corotational")
         throw unknown_model(model);
     dynamics::ImplicitOptions options;
-    options.solver = settings.solver;
+    if (settings.solver == frozen_factor_solver)
+        options.make_solver = make_frozen_factor_solver;
+    else
+        options.solver = settings.solver;
     return dynamics::make_integrator(settings.integrator, options);
 }
 

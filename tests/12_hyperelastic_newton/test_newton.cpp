@@ -1,6 +1,7 @@
 // Chapter 12: the hyperelastic force model and backward Euler by Newton's method, against finite
 // differences, chapter 10's linear step, the patch test and quadratic convergence.
 // docs/12_hyperelastic_newton.md
+#include "12_hyperelastic_newton/force_models.hpp"
 #include "12_hyperelastic_newton/hyperelastic.hpp"
 #include "12_hyperelastic_newton/newton.hpp"
 
@@ -647,6 +648,47 @@ TEST_CASE("inexact Newton: CG solved only as tightly as the gradient needs, the 
     CHECK_THAT(entries_of(exact_solves), EntriesNear(reference, 1e-5 * reference.norm()));
     CHECK_THAT(entries_of(inexact), EntriesNear(reference, 1e-5 * reference.norm()));
     CHECK(loose < tight);
+}
+
+TEST_CASE("the solver by name: Newton defaults to the frozen factor, which every model can use, with the direct "
+          "solver's answer", "[ex12.9]")
+{
+    // make_integrator_for's "default" is chapter 11's FrozenFactorPcg for a Newton step (CG iterations
+    // counted) and chapter 09's supernodal Cholesky for the linear and corotational steps (none);
+    // "frozen-factor-pcg" puts the frozen factor under those too. Either way the motion is the
+    // direct solver's to within the tolerances (Newton 1e-6, CG 1e-8).
+    dynamics::Scene scene;
+    scene.mesh = beam_mesh(0.2, 0.02, 0.02, 10);
+    scene.material = {2e5, 0.45, 1000.0};
+    scene.pinned = assembly::vertices_on_plane(scene.mesh, 0, 0.0);
+    scene.time_step = 1.0 / 30.0;
+    const auto run = [&](const std::string& model, const std::string& solver, int& cg_iterations) {
+        dynamics::Body body(scene, make_force_model(model, scene.mesh, scene.material));
+        const auto integrator = make_integrator_for(model, {.solver = solver});
+        dynamics::Simulation simulation(body, *integrator, dynamics::initial_state(body));
+        cg_iterations = 0;
+        simulation.run(8, [&](const dynamics::State&, const dynamics::StepRecord& record) {
+            cg_iterations += record.solver_iterations;
+        });
+        return simulation.state().u;
+    };
+    for (const std::string model : {"linear", "corotational", "stable-neo-hookean"}) {
+        CAPTURE(model);
+        int direct = 0, by_default = 0, frozen = 0;
+        const Eigen::VectorXd reference = run(model, "ours-cholesky", direct);
+        const Eigen::VectorXd default_u = run(model, "default", by_default);
+        const Eigen::VectorXd frozen_u = run(model, std::string(frozen_factor_solver), frozen);
+        CHECK(direct == 0);
+        CHECK(frozen > 0);
+        CHECK((by_default > 0) == is_hyperelastic(model));
+        CHECK_THAT(entries_of(default_u), EntriesNear(reference, 1e-5 * reference.norm()));
+        CHECK_THAT(entries_of(frozen_u), EntriesNear(reference, 1e-5 * reference.norm()));
+    }
+    const NewtonOptions named = newton_options_for({.solver = "eigen-llt", .newton_tolerance = 1e-4});
+    CHECK(named.solver == "eigen-llt");
+    CHECK_FALSE(named.make_solver);
+    CHECK(named.relative_tolerance == 1e-4);
+    CHECK(newton_options_for({}).make_solver);
 }
 
 TEST_CASE("the element loops on 1 and 2 threads: the same energy, forces and Hessian to the last bit", "[ex12.5]")
