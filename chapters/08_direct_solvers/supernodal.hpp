@@ -16,6 +16,14 @@
 //
 // The columns must be numbered in a postorder of the elimination tree (SparseCholesky does this),
 // so that every supernode is a contiguous range of columns.
+//
+// Threads (fem::thread_count()): the analysis splits the supernodal tree into independent subtrees
+// (each a contiguous range of supernodes, in postorder) and the "top" supernodes above them, by
+// estimated flops and never by the number of threads. The subtrees are factored and substituted
+// in parallel, the top supernodes one after another with their large products split by column
+// panels among the threads. Every front adds its children's updates in the same order on any
+// number of threads, so the factor and the solutions are identical to the last bit on 1 thread
+// or many. docs/08_direct_solvers.md#threads
 
 #include "08_direct_solvers/sparse_cholesky.hpp"
 
@@ -67,6 +75,10 @@ public:
     void solve_in_place_single(Eigen::Ref<Eigen::VectorXf> x) const;
 
     int supernodes() const { return static_cast<int>(first_.size()) - 1; }
+    /// The number of independent subtrees the factorization and the substitutions run in parallel.
+    int subtrees() const { return static_cast<int>(subtree_begin_.size()); }
+    /// Supernodes outside every subtree (the separators near the roots), factored one at a time.
+    int top_supernodes() const { return static_cast<int>(top_.size()); }
     /// Columns first(s) … first(s+1)−1 form supernode s.
     int first(int s) const { return first_[s]; }
     /// The number of rows m_s of supernode s (its columns and the rows below).
@@ -90,6 +102,33 @@ private:
     std::vector<float> single_values_;    // values_ rounded to float (round_to_single), or empty
     std::vector<int> column_to_supernode_;
     bool factored_ = false;
+    // The parallel schedule (docs/08_direct_solvers.md#threads): subtree t is the supernodes
+    // subtree_begin_[t] … subtree_root_[t] (its root last); top_ holds the others, increasing.
+    std::vector<int> subtree_begin_, subtree_root_;
+    std::vector<int> subtree_schedule_;  // the subtrees by decreasing estimated flops
+    std::vector<int> top_;
+    std::vector<int> children_start_, children_;  // children of s: children_[children_start_[s] …], decreasing
+
+    /// The front of supernode s: A's columns into its block of values_, the children's update
+    /// matrices extend-added (updates[i] belongs to children_[children_start_[s] + i], an r_c×r_c
+    /// lower triangle), the partial Cholesky, and U_s = F_22 − L_21 L_21ᵀ, formed in W and copied
+    /// to `update` (each r×r, lower triangle). `split`: the large products run on all threads.
+    /// Returns the local failed column (pivot in `pivot`) or −1.
+    int factor_front(int s, const sparse::CscMatrix& C_lower, const double* tiny, const double* const* updates,
+                     double* W, double* update, std::vector<int>& position, std::vector<int>& relative, bool split,
+                     double& pivot);
+    /// A failed pivot: the supernode, the column (permuted numbering) and the pivot.
+    struct Failure {
+        int supernode = -1, column = -1;
+        double pivot = 0.0;
+    };
+    /// The multifrontal loop over `sequence` (increasing supernodes, stopping before any > stop):
+    /// the updates of children in the sequence on its own stack, those of subtree roots taken
+    /// from root_updates[subtree_with_root[c]] (and freed). Returns the update matrix still on the
+    /// stack at the end (a subtree's root's, r×r), or the first failure through `failure`.
+    std::vector<double> factor_supernodes(const std::vector<int>& sequence, int stop, const sparse::CscMatrix& C_lower,
+                                          const double* tiny, std::vector<std::vector<double>>& root_updates,
+                                          const std::vector<int>& subtree_with_root, bool split, Failure& failure);
 
     /// The two substitutions with one right-hand side, for the double blocks or their float copy.
     template <class Scalar>
