@@ -313,6 +313,10 @@ void subtract_product(int m, int n, int k, const double* A, int lda, const doubl
                                                                      blocking, nullptr);
 }
 
+/// Factors with fewer stored entries are factored and substituted on one thread (the same
+/// operations either way): below this, starting the threads costs more than they save.
+constexpr long long parallel_entries = 100000;
+
 /// Products with fewer multiply-adds (m n k) run on one thread: a parallel region costs microseconds.
 constexpr double split_multiply_adds = 2e6;
 
@@ -797,7 +801,7 @@ void SupernodalCholesky::factorize(const sparse::CscMatrix& C_lower)
     std::vector<std::vector<double>> root_updates(T);
     std::vector<Failure> failures(T);
     std::vector<std::exception_ptr> errors(T);
-#pragma omp parallel for schedule(dynamic, 1)
+#pragma omp parallel for schedule(dynamic, 1) if (stored_entries() >= parallel_entries)
     for (int k = 0; k < T; ++k) {
         const int t = subtree_schedule_[k];
         try {
@@ -822,7 +826,8 @@ void SupernodalCholesky::factorize(const sparse::CscMatrix& C_lower)
 
     // 2. The top supernodes, in order, each on all threads.
     Failure top_failure;
-    factor_supernodes(top_, stop, C_lower, tiny.data(), root_updates, subtree_with_root, true, top_failure);
+    factor_supernodes(top_, stop, C_lower, tiny.data(), root_updates, subtree_with_root,
+                      stored_entries() >= parallel_entries, top_failure);
     if (top_failure.supernode >= 0)
         first = top_failure;
     if (first.supernode >= 0)
@@ -900,7 +905,7 @@ void SupernodalCholesky::solve_vector(const Scalar* values, Scalar* x) const
     };
 
     std::vector<std::vector<Scalar>> outside(T);
-#pragma omp parallel
+#pragma omp parallel if (stored_entries() >= parallel_entries)
     {
         std::vector<Scalar> work(static_cast<std::size_t>(largest));
 #pragma omp for schedule(dynamic, 1)
@@ -921,7 +926,7 @@ void SupernodalCholesky::solve_vector(const Scalar* values, Scalar* x) const
         forward(s, work.data(), n_, nullptr, nullptr);
     for (auto s = top_.rbegin(); s != top_.rend(); ++s)
         backward(*s, work.data());
-#pragma omp parallel
+#pragma omp parallel if (stored_entries() >= parallel_entries)
     {
         std::vector<Scalar> thread_work(static_cast<std::size_t>(largest));
 #pragma omp for schedule(dynamic, 1)
