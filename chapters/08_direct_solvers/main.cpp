@@ -13,7 +13,8 @@
 //   ch08_direct_solvers --max-unknowns 60000   skip the largest matrices
 //
 // Writes: tables dense_table.csv, hilbert_table.csv, ordering_table.csv, speed_table.csv,
-// goals_table.csv, supernodes_table.csv, kernels_table.csv, solve_many_table.csv, failures_table.csv;
+// goals_table.csv, supernodes_table.csv, kernels_table.csv, solve_many_table.csv, failures_table.csv,
+// threads_factor_table.csv, threads_solve_table.csv;
 // charts (PNG + CSV) dense_times, hilbert_errors, fill_growth, factor_times, solve_times;
 // the patterns of L for four orderings (factor_patterns.vti/.png) and the box under gravity solved
 // with our Cholesky (box_displacement.vtu/.png). docs/08_direct_solvers.md
@@ -31,7 +32,9 @@
 #include "common/error.hpp"
 #include "common/figures.hpp"
 #include "common/mesh.hpp"
+#include "common/parallel.hpp"
 #include "common/table.hpp"
+#include "common/threads_study.hpp"
 #include "common/timer.hpp"
 #include "common/vtk_io.hpp"
 #include "common/random.hpp"
@@ -863,6 +866,35 @@ void solve_many_study(const RunContext& run)
     table.write_csv(run.file("solve_many_table.csv"));
 }
 
+// --- 5b. Threads ------------------------------------------------------------------------------
+
+/// The supernodal factorization and a solve on 1 and 2 threads (threads_table: quiet and beside a
+/// busy core, the bits compared), on the stiffness matrix of a box of 25³ cubes (52,728 unknowns;
+/// quick: 5³). docs/08_direct_solvers.md#threads
+void threads_study(const RunContext& run)
+{
+    const int cells = run.quick ? 5 : 25;
+    const double seconds = run.quick ? 0.2 : 3.0;
+    const sparse::CscMatrix K = box_stiffness(cells, rubber);
+    const Eigen::VectorXd b = random_vector(K.rows, 12);
+    SparseCholesky chol(K);
+    const Table factor = threads_table(
+        str("Supernodal numeric factorization (+ one solve, whose x is compared) on 1 and 2 threads, 3D elasticity, ",
+            cells, "^3 cubes, ", K.rows, " unknowns"),
+        [&] {
+            chol.factorize(K);
+            return chol.solve(b);
+        },
+        seconds);
+    factor.print(std::cout);
+    factor.write_csv(run.file("threads_factor_table.csv"));
+    const Table solve = threads_table(
+        str("Supernodal solve (forward and back substitution, one right-hand side) on 1 and 2 threads, same matrix"),
+        [&] { return chol.solve(b); }, seconds);
+    solve.print(std::cout);
+    solve.write_csv(run.file("threads_solve_table.csv"));
+}
+
 // --- 6. When a direct solver must refuse -------------------------------------------------------
 
 void failures_study(const RunContext& run)
@@ -976,8 +1008,12 @@ int main(int argc, char** argv)
         hilbert_study(run);
         ordering_study(run, settings);
         pattern_figure(run);
-        goals_table(run, speed_study(run, settings));
-        solve_many_study(run);
+        {
+            const ScopedThreadCount one_core(1);  // the speed tables compare one core with one core
+            goals_table(run, speed_study(run, settings));
+            solve_many_study(run);
+        }
+        threads_study(run);
         failures_study(run);
         box_under_gravity(run);
     });
