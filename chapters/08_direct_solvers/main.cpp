@@ -869,7 +869,7 @@ void solve_many_study(const RunContext& run)
 // --- 5b. Threads ------------------------------------------------------------------------------
 
 /// The supernodal factorization and a solve on 1 and 2 threads (threads_table: quiet and beside a
-/// busy core, the bits compared), on the stiffness matrix of a box of 25³ cubes (52,728 unknowns;
+/// busy core, the bits compared), on the stiffness matrix of a box of 25³ cubes (50,700 unknowns;
 /// quick: 5³). docs/08_direct_solvers.md#threads
 void threads_study(const RunContext& run)
 {

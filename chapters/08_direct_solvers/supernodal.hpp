@@ -54,15 +54,17 @@ public:
                        const SupernodeRelaxation& relaxation = {});
 
     /// The numeric factorization of C from its LOWER triangle in CSC (the transpose of
-    /// symmetric_permutation's result): multifrontal over the supernodes in order. fem::Error when
-    /// C is not positive definite, naming the failed column in the original numbering
-    /// (symbolic.perm) and its pivot.
+    /// symmetric_permutation's result): multifrontal over the supernodes, the subtrees on
+    /// thread_count() threads, then the top in order. fem::Error when C is not positive definite,
+    /// naming the failed column in the original numbering (symbolic.perm) and its pivot: the first
+    /// failing column in the serial order, on any number of threads.
     void factorize(const sparse::CscMatrix& C_lower);
 
     /// X ← L⁻ᵀ L⁻¹ X in the permuted numbering (each column of X one right-hand side): forward
     /// substitution supernode by supernode (a dense triangular solve and a matrix product per
-    /// supernode), then back substitution in reverse order. fem::Error before factorize() or if
-    /// X has not n rows.
+    /// supernode), then back substitution in reverse order; one column over the subtrees in
+    /// parallel, several in blocks of 16 columns on the threads. fem::Error before factorize() or
+    /// if X has not n rows.
     void solve_in_place(Eigen::Ref<Eigen::MatrixXd> X) const;
 
     /// Keeps a copy of the blocks rounded to single precision (made now, dropped by the next

@@ -6,6 +6,7 @@
 #include "08_direct_solvers/supernodal.hpp"
 
 #include "common/error.hpp"
+#include "common/parallel.hpp"
 #include "common/simd.hpp"
 
 #include <Eigen/Core>
@@ -14,6 +15,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <exception>
 #include <numeric>
 #include <type_traits>
 #include <vector>
@@ -303,19 +305,58 @@ void subtract_product(int m, int n, int k, const double* A, int lda, const doubl
         return;
     }
 #endif
-    Block target(C, m, n, Eigen::OuterStride<>(ldc));
-    const ConstBlock left(A, m, k, Eigen::OuterStride<>(lda)), right(B, n, k, Eigen::OuterStride<>(ldb));
-    target.noalias() -= left * right.transpose();
+    // Eigen's product on one thread, asked for explicitly: `C −= A Bᵀ` through Eigen's expressions
+    // would run its own OpenMP GEMM when called outside a parallel region, blocked by the number of
+    // threads, and the last bits of C would depend on it.
+    using Eigen::ColMajor, Eigen::Dynamic, Eigen::RowMajor;
+    Eigen::internal::gemm_blocking_space<ColMajor, double, double, Dynamic, Dynamic, Dynamic> blocking(m, n, k, 1, true);
+    Eigen::internal::general_matrix_matrix_product<Eigen::Index, double, ColMajor, false, double, RowMajor, false,
+                                                   ColMajor, 1>::run(m, n, k, A, lda, B, ldb, C, 1, ldc, -1.0,
+                                                                     blocking, nullptr);
+}
+
+/// Factors with fewer stored entries are factored and substituted on one thread (the same
+/// operations either way): below this, starting the threads costs more than they save.
+constexpr long long parallel_entries = 100000;
+
+/// Products with fewer multiply-adds (m n k) run on one thread: a parallel region costs microseconds.
+constexpr double split_multiply_adds = 2e6;
+
+/// subtract_product with C's columns split among the threads when `split` and the product is
+/// large: pieces of 48 columns (whole 8×6 register blocks; the last piece takes the rest), each
+/// on the AVX2 kernel's path as the whole product would be, so every entry of C sees the same
+/// operations in the same order on any number of threads. Without the kernel, on one thread.
+void subtract_product_split(int m, int n, int k, const double* A, int lda, const double* B, int ldb, double* C,
+                            int ldc, bool split)
+{
+#ifdef FEM_AVX2_KERNEL
+    constexpr int piece_columns = 8 * kernel_cols;
+    const int pieces = n / piece_columns;
+    if (split && pieces >= 2 && avx2_enabled() && m >= kernel_rows &&
+        static_cast<double>(m) * n * k >= split_multiply_adds) {
+#pragma omp parallel for schedule(dynamic, 1)
+        for (int p = 0; p < pieces; ++p) {
+            const int j0 = p * piece_columns, width = p + 1 < pieces ? piece_columns : n - j0;
+            subtract_product(m, width, k, A, lda, B + j0, ldb, C + static_cast<long long>(j0) * ldc, ldc);
+        }
+        return;
+    }
+#endif
+    subtract_product(m, n, k, A, lda, B, ldb, C, ldc);
 }
 
 /// C −= A Aᵀ on the lower triangle of the square C (q×q, leading dimension ldc), A q×k (lda), by
 /// column panels: each panel also computes the upper half of its small diagonal block (wasted,
-/// but a plain product runs faster than a triangular one).
-void lower_rank_update(int q, int k, const double* A, int lda, double* C, int ldc)
+/// but a plain product runs faster than a triangular one). The panels are independent products:
+/// with `split` (and enough work) they run on all threads, each panel the same as on one.
+void lower_rank_update(int q, int k, const double* A, int lda, double* C, int ldc, bool split)
 {
     constexpr int width = 120;
-    for (int c0 = 0; c0 < q; c0 += width) {
-        const int cb = std::min(width, q - c0);
+    const int panels = (q + width - 1) / width;
+    const bool parallel = split && panels >= 2 && 0.5 * q * static_cast<double>(q) * k >= split_multiply_adds;
+#pragma omp parallel for schedule(dynamic, 1) if (parallel)
+    for (int p = 0; p < panels; ++p) {
+        const int c0 = p * width, cb = std::min(width, q - c0);
         subtract_product(q - c0, cb, k, A + c0, lda, A + c0, lda, C + c0 + static_cast<long long>(c0) * ldc, ldc);
     }
 }
@@ -350,9 +391,10 @@ int unblocked_cholesky(double* D, int kb, int ld, const double* tiny, double& fa
 /// columns of the frontal matrix; on return its top ns×ns lower triangle is L_11 and the rows
 /// below are L_21 = F_21 L_11⁻ᵀ. Blocked, right-looking: per panel of columns an unblocked
 /// Cholesky of the diagonal block, a triangular solve for the rows below, and a rank-kb update
-/// of the remaining columns. tiny: the pivot thresholds of the ns columns. Returns the local failed
-/// column (pivot in failed_pivot), or −1.
-int partial_cholesky(double* F, int m, int ns, const double* tiny, double& failed_pivot)
+/// of the remaining columns. tiny: the pivot thresholds of the ns columns. `split`: the updates run
+/// on all threads (subtract_product_split). Returns the local failed column (pivot in
+/// failed_pivot), or −1.
+int partial_cholesky(double* F, int m, int ns, const double* tiny, bool split, double& failed_pivot)
 {
     Block front(F, m, ns, Eigen::OuterStride<>(m));
     for (int k0 = 0; k0 < ns; k0 += panel_width) {
@@ -370,11 +412,77 @@ int partial_cholesky(double* F, int m, int ns, const double* tiny, double& faile
         if (q > 0) {
             const double* const panel = F + (k0 + kb) + static_cast<long long>(k0) * m;  // P, leading dimension m
             double* const trailing = F + (k0 + kb) + static_cast<long long>(k0 + kb) * m;
-            lower_rank_update(q, kb, panel, m, trailing, m);
-            subtract_product(m - ns, q, kb, panel + q, m, panel, m, trailing + q, m);
+            lower_rank_update(q, kb, panel, m, trailing, m, split);
+            subtract_product_split(m - ns, q, kb, panel + q, m, panel, m, trailing + q, m, split);
         }
     }
     return -1;
+}
+
+/// The sizes of the multifrontal loop's work areas over a sequence of supernodes: the peak of the
+/// update stack (Σ r² of the pending update matrices) and the largest update matrix r².
+struct StackSize {
+    long long peak = 0, largest = 0;
+};
+template <class Sequence>
+StackSize update_stack_size(const Sequence& supernodes, const std::vector<int>& parent,
+                            const SupernodalCholesky& chol)
+{
+    const auto update_rows = [&](int s) { return static_cast<long long>(chol.rows(s) - (chol.first(s + 1) - chol.first(s))); };
+    StackSize size;
+    long long stack = 0;
+    std::vector<int> pending;
+    for (const int s : supernodes) {
+        while (!pending.empty() && parent[pending.back()] == s) {
+            stack -= update_rows(pending.back()) * update_rows(pending.back());
+            pending.pop_back();
+        }
+        const long long r = update_rows(s);
+        size.largest = std::max(size.largest, r * r);
+        if (r > 0) {
+            stack += r * r;
+            size.peak = std::max(size.peak, stack);
+            pending.push_back(s);
+        }
+    }
+    return size;
+}
+
+/// The split of the supernodal tree (postordered; `subtree_flops[s]`: the estimated flops of s and
+/// its descendants) into independent subtrees and the top supernodes above them. Starting from
+/// the roots, the heaviest subtree is replaced by its children (its root moves to the top) until
+/// the subtrees, dealt largest first to the less loaded of two threads, load neither more than
+/// 5 % above half their sum; or the heaviest is one supernode, or 2000 steps passed. Depends on
+/// the tree alone, never on the number of threads. Returns the roots of the subtrees; `top`
+/// receives the others, increasing.
+std::vector<int> split_into_subtrees(const std::vector<int>& parent, const std::vector<double>& subtree_flops,
+                                     const std::vector<int>& children_start, const std::vector<int>& children,
+                                     std::vector<int>& top)
+{
+    std::vector<int> roots;
+    for (int s = 0; s < static_cast<int>(parent.size()); ++s)
+        if (parent[s] < 0)
+            roots.push_back(s);
+    const auto heavier = [&](int a, int b) {
+        return subtree_flops[a] > subtree_flops[b] || (subtree_flops[a] == subtree_flops[b] && a < b);
+    };
+    top.clear();
+    for (int step = 0; step < 2000 && !roots.empty(); ++step) {
+        std::sort(roots.begin(), roots.end(), heavier);
+        double load[2] = {0.0, 0.0};
+        for (const int r : roots)
+            load[load[1] < load[0] ? 1 : 0] += subtree_flops[r];
+        const int heaviest = roots.front();
+        if (std::max(load[0], load[1]) <= 0.525 * (load[0] + load[1]) ||
+            children_start[heaviest] == children_start[heaviest + 1])
+            break;
+        roots.erase(roots.begin());
+        top.push_back(heaviest);
+        roots.insert(roots.end(), children.begin() + children_start[heaviest],
+                     children.begin() + children_start[heaviest + 1]);
+    }
+    std::sort(top.begin(), top.end());
+    return roots;
 }
 
 }  // namespace
@@ -525,6 +633,153 @@ SupernodalCholesky::SupernodalCholesky(const SymbolicCholesky& symbolic, const s
     value_start_.assign(S + 1, 0);
     for (int s = 0; s < S; ++s)
         value_start_[s + 1] = value_start_[s] + static_cast<long long>(rows(s)) * (first_[s + 1] - first_[s]);
+
+    // 5. The parallel schedule: the children of each supernode (decreasing, the order the serial
+    //    stack pops them), independent subtrees by estimated flops (ns m² per supernode), the top.
+    children_start_.assign(S + 1, 0);
+    for (int s = 0; s < S; ++s)
+        if (parent_[s] >= 0)
+            ++children_start_[parent_[s] + 1];
+    std::partial_sum(children_start_.begin(), children_start_.end(), children_start_.begin());
+    children_.assign(children_start_[S], 0);
+    {
+        std::vector<int> next(children_start_.begin(), children_start_.end() - 1);
+        for (int s = S - 1; s >= 0; --s)
+            if (parent_[s] >= 0)
+                children_[next[parent_[s]]++] = s;
+    }
+    std::vector<double> subtree_flops(S, 0.0);
+    std::vector<int> first_descendant(S);
+    std::iota(first_descendant.begin(), first_descendant.end(), 0);
+    for (int s = 0; s < S; ++s) {
+        subtree_flops[s] += static_cast<double>(first_[s + 1] - first_[s]) * rows(s) * rows(s);
+        if (parent_[s] >= 0) {
+            subtree_flops[parent_[s]] += subtree_flops[s];
+            first_descendant[parent_[s]] = std::min(first_descendant[parent_[s]], first_descendant[s]);
+        }
+    }
+    subtree_root_ = split_into_subtrees(parent_, subtree_flops, children_start_, children_, top_);
+    subtree_schedule_.resize(subtree_root_.size());
+    std::iota(subtree_schedule_.begin(), subtree_schedule_.end(), 0);
+    std::sort(subtree_root_.begin(), subtree_root_.end());
+    subtree_begin_.clear();
+    for (const int root : subtree_root_)
+        subtree_begin_.push_back(first_descendant[root]);
+    std::stable_sort(subtree_schedule_.begin(), subtree_schedule_.end(),
+                     [&](int a, int b) { return subtree_flops[subtree_root_[a]] > subtree_flops[subtree_root_[b]]; });
+}
+
+int SupernodalCholesky::factor_front(int s, const sparse::CscMatrix& C_lower, const double* tiny,
+                                     const double* const* updates, double* W, double* update,
+                                     std::vector<int>& position, std::vector<int>& relative, bool split,
+                                     double& pivot)
+{
+    const int f = first_[s];
+    const int ns = first_[s + 1] - f;
+    const int m = rows(s);
+    const int r = m - ns;
+    const int* const row = rows_.data() + row_start_[s];
+    double* const L = values_.data() + value_start_[s];
+    for (int t = 0; t < m; ++t)
+        position[row[t]] = t;
+
+    // The front: A's columns of s into L (m×ns), zero update area W (r×r, lower triangle).
+    for (int c = 0; c < ns; ++c) {
+        double* const column = L + static_cast<long long>(c) * m;
+        for (int k = C_lower.IA[f + c]; k < C_lower.IA[f + c + 1]; ++k)
+            column[position[C_lower.JA[k]]] += C_lower.A[k];
+    }
+    for (int c = 0; c < r; ++c)
+        std::fill(W + static_cast<long long>(c) * r + c, W + static_cast<long long>(c + 1) * r, 0.0);
+
+    // Extend-add the update matrices of the children, the last one first.
+    for (int k = children_start_[s]; k < children_start_[s + 1]; ++k) {
+        const int c = children_[k];
+        const int nc = first_[c + 1] - first_[c];
+        const int rc = rows(c) - nc;
+        const double* const U = updates[k - children_start_[s]];
+        const int* const child_rows = rows_.data() + row_start_[c] + nc;
+        relative.resize(rc);
+        for (int t = 0; t < rc; ++t)
+            relative[t] = position[child_rows[t]];
+        for (int jj = 0; jj < rc; ++jj) {
+            const int pj = relative[jj];
+            const double* const source = U + static_cast<long long>(jj) * rc;
+            if (pj < ns) {
+                double* const target = L + static_cast<long long>(pj) * m;
+                for (int ii = jj; ii < rc; ++ii)
+                    target[relative[ii]] += source[ii];
+            } else {
+                double* const target = W + static_cast<long long>(pj - ns) * r - ns;
+                for (int ii = jj; ii < rc; ++ii)
+                    target[relative[ii]] += source[ii];
+            }
+        }
+    }
+
+    const int failed = partial_cholesky(L, m, ns, tiny + f, split, pivot);
+    if (failed >= 0)
+        return failed;
+    if (r > 0) {
+        lower_rank_update(r, ns, L + ns, m, W, r, split);  // W −= L21 L21ᵀ
+        for (int c = 0; c < r; ++c)
+            std::memcpy(update + static_cast<long long>(c) * r + c, W + static_cast<long long>(c) * r + c,
+                        sizeof(double) * (r - c));
+    }
+    return -1;
+}
+
+std::vector<double> SupernodalCholesky::factor_supernodes(const std::vector<int>& sequence, int stop,
+                                                          const sparse::CscMatrix& C_lower, const double* tiny,
+                                                          std::vector<std::vector<double>>& root_updates,
+                                                          const std::vector<int>& subtree_with_root, bool split,
+                                                          Failure& failure)
+{
+    const StackSize size = update_stack_size(sequence, parent_, *this);
+    std::vector<double> stack_values(static_cast<std::size_t>(size.peak));
+    std::vector<double> work(static_cast<std::size_t>(size.largest));
+    struct Pending {
+        int supernode;
+        long long offset;
+    };
+    std::vector<Pending> stack;
+    long long stack_top = 0;
+    thread_local std::vector<int> position, relative;  // one per thread: position is n long
+    position.resize(std::max<std::size_t>(position.size(), static_cast<std::size_t>(n_)));
+    std::vector<const double*> updates;
+    for (const int s : sequence) {
+        if (s > stop)
+            break;
+        updates.clear();
+        for (int k = children_start_[s]; k < children_start_[s + 1]; ++k) {
+            const int c = children_[k], t = subtree_with_root[c];
+            if (t >= 0) {
+                updates.push_back(root_updates[t].data());
+            } else {  // on top of the stack: the children are popped in decreasing order
+                updates.push_back(stack_values.data() + stack.back().offset);
+                stack_top = stack.back().offset;
+                stack.pop_back();
+            }
+        }
+        const int r = rows(s) - (first_[s + 1] - first_[s]);
+        double pivot = 0.0;
+        const int failed = factor_front(s, C_lower, tiny, updates.data(), work.data(), stack_values.data() + stack_top,
+                                        position, relative, split, pivot);
+        if (failed >= 0) {
+            failure = {s, first_[s] + failed, pivot};
+            return {};
+        }
+        for (int k = children_start_[s]; k < children_start_[s + 1]; ++k)
+            if (subtree_with_root[children_[k]] >= 0)
+                std::vector<double>().swap(root_updates[subtree_with_root[children_[k]]]);
+        if (r > 0) {
+            stack.push_back({s, stack_top});
+            stack_top += static_cast<long long>(r) * r;
+        }
+    }
+    stack_values.resize(static_cast<std::size_t>(stack_top));  // the last root's update, at offset 0
+    stack_values.shrink_to_fit();
+    return stack_values;
 }
 
 void SupernodalCholesky::factorize(const sparse::CscMatrix& C_lower)
@@ -536,100 +791,49 @@ void SupernodalCholesky::factorize(const sparse::CscMatrix& C_lower)
     factored_ = false;
     single_values_.clear();
     const int S = supernodes();
-    // Sizes of the work areas: the largest update matrix, and the peak of the update stack.
-    long long largest_update = 0, peak_stack = 0;
-    {
-        long long stack = 0;
-        std::vector<long long> pending;
-        for (int s = 0; s < S; ++s) {
-            while (!pending.empty() && pending.back() >= 0 && parent_[pending.back()] == s) {
-                const long long r = rows(pending.back()) - (first_[pending.back() + 1] - first_[pending.back()]);
-                stack -= r * r;
-                pending.pop_back();
-            }
-            const long long r = rows(s) - (first_[s + 1] - first_[s]);
-            largest_update = std::max(largest_update, r * r);
-            if (r > 0) {
-                stack += r * r;
-                peak_stack = std::max(peak_stack, stack);
-                pending.push_back(s);
-            }
-        }
-    }
     const std::vector<double> tiny = pivot_thresholds(C_lower);
     values_.assign(static_cast<std::size_t>(stored_entries()), 0.0);
-    std::vector<double> work(static_cast<std::size_t>(largest_update));
-    std::vector<double> stack_values(static_cast<std::size_t>(peak_stack));
-    struct Pending {
-        int supernode;
-        long long offset;
-    };
-    std::vector<Pending> stack;
-    long long stack_top = 0;
-    std::vector<int> position(n, -1), relative;
 
-    for (int s = 0; s < S; ++s) {
-        const int f = first_[s];
-        const int ns = first_[s + 1] - f;
-        const int m = rows(s);
-        const int r = m - ns;
-        const int* const row = rows_.data() + row_start_[s];
-        double* const L = values_.data() + value_start_[s];
-        for (int t = 0; t < m; ++t)
-            position[row[t]] = t;
-
-        // The front: A's columns of s into L (m×ns), zero update area W (r×r, lower triangle).
-        for (int c = 0; c < ns; ++c) {
-            double* const column = L + static_cast<long long>(c) * m;
-            for (int k = C_lower.IA[f + c]; k < C_lower.IA[f + c + 1]; ++k)
-                column[position[C_lower.JA[k]]] += C_lower.A[k];
-        }
-        double* const W = work.data();
-        for (int c = 0; c < r; ++c)
-            std::fill(W + static_cast<long long>(c) * r + c, W + static_cast<long long>(c + 1) * r, 0.0);
-
-        // Extend-add the update matrices of the children (on top of the stack).
-        while (!stack.empty() && parent_[stack.back().supernode] == s) {
-            const Pending child = stack.back();
-            stack.pop_back();
-            const int c = child.supernode;
-            const int nc = first_[c + 1] - first_[c];
-            const int rc = rows(c) - nc;
-            const double* const U = stack_values.data() + child.offset;
-            const int* const child_rows = rows_.data() + row_start_[c] + nc;
-            relative.resize(rc);
-            for (int t = 0; t < rc; ++t)
-                relative[t] = position[child_rows[t]];
-            for (int jj = 0; jj < rc; ++jj) {
-                const int pj = relative[jj];
-                const double* const source = U + static_cast<long long>(jj) * rc;
-                if (pj < ns) {
-                    double* const target = L + static_cast<long long>(pj) * m;
-                    for (int ii = jj; ii < rc; ++ii)
-                        target[relative[ii]] += source[ii];
-                } else {
-                    double* const target = W + static_cast<long long>(pj - ns) * r - ns;
-                    for (int ii = jj; ii < rc; ++ii)
-                        target[relative[ii]] += source[ii];
-                }
-            }
-            stack_top = child.offset;
-        }
-
-        double pivot = 0.0;
-        const int failed = partial_cholesky(L, m, ns, tiny.data() + f, pivot);
-        if (failed >= 0)
-            throw not_positive_definite(perm_[f + failed], pivot, tiny[f + failed]);
-        if (r > 0) {
-            lower_rank_update(r, ns, L + ns, m, W, r);  // W −= L21 L21ᵀ
-            double* const target = stack_values.data() + stack_top;
-            for (int c = 0; c < r; ++c)
-                std::memcpy(target + static_cast<long long>(c) * r + c, W + static_cast<long long>(c) * r + c,
-                            sizeof(double) * (r - c));
-            stack.push_back({s, stack_top});
-            stack_top += static_cast<long long>(r) * r;
+    // 1. The subtrees, in parallel: the heaviest first, each taken by the next free thread. Each
+    //    keeps its root's update matrix for the top.
+    const int T = subtrees();
+    std::vector<int> subtree_with_root(S, -1);
+    for (int t = 0; t < T; ++t)
+        subtree_with_root[subtree_root_[t]] = t;
+    std::vector<std::vector<double>> root_updates(T);
+    std::vector<Failure> failures(T);
+    std::vector<std::exception_ptr> errors(T);
+#pragma omp parallel for schedule(dynamic, 1) if (stored_entries() >= parallel_entries)
+    for (int k = 0; k < T; ++k) {
+        const int t = subtree_schedule_[k];
+        try {
+            std::vector<int> sequence(subtree_root_[t] - subtree_begin_[t] + 1);
+            std::iota(sequence.begin(), sequence.end(), subtree_begin_[t]);
+            root_updates[t] = factor_supernodes(sequence, S, C_lower, tiny.data(), root_updates, subtree_with_root,
+                                                false, failures[t]);
+        } catch (...) {
+            errors[t] = std::current_exception();
         }
     }
+    for (const std::exception_ptr& error : errors)
+        if (error)
+            std::rethrow_exception(error);
+    // The serial order fails at the smallest failed supernode: a failure in a subtree stops the
+    // top before the supernodes after it (a top supernode before it may fail first).
+    Failure first;
+    for (const Failure& failure : failures)
+        if (failure.supernode >= 0 && (first.supernode < 0 || failure.supernode < first.supernode))
+            first = failure;
+    const int stop = first.supernode < 0 ? S : first.supernode;
+
+    // 2. The top supernodes, in order, each on all threads.
+    Failure top_failure;
+    factor_supernodes(top_, stop, C_lower, tiny.data(), root_updates, subtree_with_root,
+                      stored_entries() >= parallel_entries, top_failure);
+    if (top_failure.supernode >= 0)
+        first = top_failure;
+    if (first.supernode >= 0)
+        throw not_positive_definite(perm_[first.column], first.pivot, tiny[first.column]);
     factored_ = true;
 }
 
@@ -641,17 +845,24 @@ void SupernodalCholesky::solve_vector(const Scalar* values, Scalar* x) const
     // panel's unknowns are gathered into w (m), and the substitution runs over the panel four
     // columns at a time: a 4×4 triangle by scalars, then one pass of the columns' entries below it
     // (diagonal block and rows below together: each stored entry of L is read once per solve).
+    //
+    // Threads: forward, the subtrees run in parallel; what a subtree adds to unknowns outside it
+    // (its root's rows below, all in the top) goes into a buffer of its own, and the buffers are
+    // added to x in subtree order, on any number of threads; then the top in order. Backward, the
+    // top in reverse order, then the subtrees in parallel (reading the top's unknowns).
     constexpr int step = 4;
-    const int S = supernodes();
+    const int S = supernodes(), T = subtrees();
     int largest = 0;
     for (int s = 0; s < S; ++s)
         largest = std::max(largest, rows(s));
-    std::vector<Scalar> work(static_cast<std::size_t>(largest));
-    Scalar* const w = work.data();
-    for (int s = 0; s < S; ++s) {  // forward: L y = b
+    const auto below_rows = [&](int s) { return rows_.data() + row_start_[s] + (first_[s + 1] - first_[s]); };
+
+    // L y = b at supernode s; rows ≥ limit are outside the subtree: added to outside[k] where
+    // outside_rows[k] is that row (both sorted).
+    const auto forward = [&](int s, Scalar* w, int limit, const int* outside_rows, Scalar* outside) {
         const int f = first_[s], ns = first_[s + 1] - f, m = rows(s);
         const Scalar* const P = values + value_start_[s];
-        const int* const below = rows_.data() + row_start_[s] + ns;
+        const int* const below = below_rows(s);
         std::copy(x + f, x + f + ns, w);
         std::fill(w + ns, w + m, Scalar(0));
         for (int j0 = 0; j0 < ns; j0 += step) {
@@ -665,13 +876,20 @@ void SupernodalCholesky::solve_vector(const Scalar* values, Scalar* x) const
                                           w + j0 + jb);
         }
         std::copy(w, w + ns, x + f);
-        for (int i = 0; i < m - ns; ++i)
+        int i = 0, k = 0;
+        for (; i < m - ns && below[i] < limit; ++i)
             x[below[i]] += w[ns + i];
-    }
-    for (int s = S - 1; s >= 0; --s) {  // backward: Lᵀ x = y
+        for (; i < m - ns; ++i) {
+            while (outside_rows[k] < below[i])
+                ++k;
+            outside[k] += w[ns + i];
+        }
+    };
+    // Lᵀ x = y at supernode s.
+    const auto backward = [&](int s, Scalar* w) {
         const int f = first_[s], ns = first_[s + 1] - f, m = rows(s);
         const Scalar* const P = values + value_start_[s];
-        const int* const below = rows_.data() + row_start_[s] + ns;
+        const int* const below = below_rows(s);
         std::copy(x + f, x + f + ns, w);
         for (int i = 0; i < m - ns; ++i)
             w[ns + i] = x[below[i]];
@@ -686,6 +904,39 @@ void SupernodalCholesky::solve_vector(const Scalar* values, Scalar* x) const
             }
         }
         std::copy(w, w + ns, x + f);
+    };
+
+    std::vector<std::vector<Scalar>> outside(T);
+#pragma omp parallel if (stored_entries() >= parallel_entries)
+    {
+        std::vector<Scalar> work(static_cast<std::size_t>(largest));
+#pragma omp for schedule(dynamic, 1)
+        for (int k = 0; k < T; ++k) {
+            const int t = subtree_schedule_[k], root = subtree_root_[t];
+            outside[t].assign(static_cast<std::size_t>(rows(root) - (first_[root + 1] - first_[root])), Scalar(0));
+            for (int s = subtree_begin_[t]; s <= root; ++s)
+                forward(s, work.data(), first_[root + 1], below_rows(root), outside[t].data());
+        }
+    }
+    for (int t = 0; t < T; ++t) {
+        const int* const rows_outside = below_rows(subtree_root_[t]);
+        for (std::size_t i = 0; i < outside[t].size(); ++i)
+            x[rows_outside[i]] += outside[t][i];
+    }
+    std::vector<Scalar> work(static_cast<std::size_t>(largest));
+    for (const int s : top_)
+        forward(s, work.data(), n_, nullptr, nullptr);
+    for (auto s = top_.rbegin(); s != top_.rend(); ++s)
+        backward(*s, work.data());
+#pragma omp parallel if (stored_entries() >= parallel_entries)
+    {
+        std::vector<Scalar> thread_work(static_cast<std::size_t>(largest));
+#pragma omp for schedule(dynamic, 1)
+        for (int k = 0; k < T; ++k) {
+            const int t = subtree_schedule_[k];
+            for (int s = subtree_root_[t]; s >= subtree_begin_[t]; --s)
+                backward(s, thread_work.data());
+        }
     }
 }
 
@@ -715,37 +966,45 @@ void SupernodalCholesky::solve_in_place(Eigen::Ref<Eigen::MatrixXd> X) const
         solve_vector(values_.data(), X.data());
         return;
     }
+    // Several right-hand sides: blocks of 16 columns on the threads, each block by blocked
+    // substitutions (a triangular solve and a product per supernode). Inside a parallel loop
+    // Eigen's products run on one thread, so each column's bits do not depend on the threads.
+    constexpr Eigen::Index block_columns = 16;
     const int S = supernodes();
     int largest = 0;
     for (int s = 0; s < S; ++s)
         largest = std::max(largest, rows(s) - (first_[s + 1] - first_[s]));
-    Eigen::MatrixXd work(largest, X.cols());
-    for (int s = 0; s < S; ++s) {  // forward: L Y = B
-        const int f = first_[s], ns = first_[s + 1] - f, m = rows(s), r = m - ns;
-        const ConstBlock L(values_.data() + value_start_[s], m, ns, Eigen::OuterStride<>(m));
-        auto Xs = X.middleRows(f, ns);
-        L.topRows(ns).triangularView<Eigen::Lower>().solveInPlace(Xs);
-        if (r > 0) {
-            auto T = work.topRows(r);
-            T.noalias() = L.bottomRows(r) * Xs;
-            const int* const below = rows_.data() + row_start_[s] + ns;
-            for (int t = 0; t < r; ++t)
-                X.row(below[t]) -= T.row(t);
+    const Eigen::Index blocks = (X.cols() + block_columns - 1) / block_columns;
+    parallel_for(blocks, [&](Eigen::Index b) {
+        auto Xb = X.middleCols(b * block_columns, std::min(block_columns, X.cols() - b * block_columns));
+        Eigen::MatrixXd work(largest, Xb.cols());
+        for (int s = 0; s < S; ++s) {  // forward: L Y = B
+            const int f = first_[s], ns = first_[s + 1] - f, m = rows(s), r = m - ns;
+            const ConstBlock L(values_.data() + value_start_[s], m, ns, Eigen::OuterStride<>(m));
+            auto Xs = Xb.middleRows(f, ns);
+            L.topRows(ns).triangularView<Eigen::Lower>().solveInPlace(Xs);
+            if (r > 0) {
+                auto T = work.topRows(r);
+                T.noalias() = L.bottomRows(r) * Xs;
+                const int* const below = rows_.data() + row_start_[s] + ns;
+                for (int t = 0; t < r; ++t)
+                    Xb.row(below[t]) -= T.row(t);
+            }
         }
-    }
-    for (int s = S - 1; s >= 0; --s) {  // backward: Lᵀ X = Y
-        const int f = first_[s], ns = first_[s + 1] - f, m = rows(s), r = m - ns;
-        const ConstBlock L(values_.data() + value_start_[s], m, ns, Eigen::OuterStride<>(m));
-        auto Xs = X.middleRows(f, ns);
-        if (r > 0) {
-            auto T = work.topRows(r);
-            const int* const below = rows_.data() + row_start_[s] + ns;
-            for (int t = 0; t < r; ++t)
-                T.row(t) = X.row(below[t]);
-            Xs.noalias() -= L.bottomRows(r).transpose() * T;
+        for (int s = S - 1; s >= 0; --s) {  // backward: Lᵀ X = Y
+            const int f = first_[s], ns = first_[s + 1] - f, m = rows(s), r = m - ns;
+            const ConstBlock L(values_.data() + value_start_[s], m, ns, Eigen::OuterStride<>(m));
+            auto Xs = Xb.middleRows(f, ns);
+            if (r > 0) {
+                auto T = work.topRows(r);
+                const int* const below = rows_.data() + row_start_[s] + ns;
+                for (int t = 0; t < r; ++t)
+                    T.row(t) = Xb.row(below[t]);
+                Xs.noalias() -= L.bottomRows(r).transpose() * T;
+            }
+            L.topRows(ns).triangularView<Eigen::Lower>().transpose().solveInPlace(Xs);
         }
-        L.topRows(ns).triangularView<Eigen::Lower>().transpose().solveInPlace(Xs);
-    }
+    });
 }
 
 sparse::CscMatrix SupernodalCholesky::factor() const
