@@ -7,6 +7,7 @@
 #include "12_hyperelastic_newton/newton.hpp"
 
 #include "11_corotational/corotational.hpp"
+#include "11_corotational/frozen_preconditioner.hpp"
 
 #include "common/error.hpp"
 
@@ -22,6 +23,12 @@ Error unknown_model(std::string_view name)
     for (const std::string& known : force_model_names())
         names += str(names.empty() ? "" : ", ", known);
     return Error(str("unknown force model '", name, "'; choose one of: ", names));
+}
+
+/// Chapter 11's frozen factor as the solver of every step matrix (frozen_factor_solver).
+std::unique_ptr<cg::LinearSolver> make_frozen_factor_solver()
+{
+    return std::make_unique<corot::FrozenFactorPcg>(cg::SolverOptions{1e-8, 0}, corot::RefreshRule{.iterations_above = 10});
 }
 
 }  // namespace
@@ -55,21 +62,32 @@ std::unique_ptr<dynamics::ForceModel> make_force_model(std::string_view name, co
     throw unknown_model(name);
 }
 
+NewtonOptions newton_options_for(const StepSettings& settings)
+{
+    NewtonOptions options;
+    options.relative_tolerance = settings.newton_tolerance;
+    if (settings.solver == "default" || settings.solver == frozen_factor_solver)
+        options.make_solver = make_frozen_factor_solver;
+    else
+        options.solver = settings.solver;
+    return options;
+}
+
 std::unique_ptr<dynamics::Integrator> make_integrator_for(std::string_view model, const StepSettings& settings)
 {
     if (is_hyperelastic(model)) {
         if (settings.integrator != "backward-euler")
             throw Error(str("integrator '", settings.integrator, "' for the hyperelastic model '", model,
                             "': chapter 12's Newton steps backward Euler only; use backward-euler"));
-        NewtonOptions options;
-        options.relative_tolerance = settings.newton_tolerance;
-        options.solver = settings.solver;
-        return std::make_unique<NewtonBackwardEuler>(options);
+        return std::make_unique<NewtonBackwardEuler>(newton_options_for(settings));
     }
     if (model != "linear" && model != "corotational")
         throw unknown_model(model);
     dynamics::ImplicitOptions options;
-    options.solver = settings.solver;
+    if (settings.solver == frozen_factor_solver)
+        options.make_solver = make_frozen_factor_solver;
+    else
+        options.solver = settings.solver;
     return dynamics::make_integrator(settings.integrator, options);
 }
 
