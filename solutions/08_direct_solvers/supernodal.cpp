@@ -304,8 +304,8 @@ void subtract_product(int m, int n, int k, const double* A, int lda, const doubl
     }
 #endif
     // Eigen's product on one thread, asked for explicitly: `C −= A Bᵀ` through Eigen's expressions
-    // would run its own OpenMP GEMM when called outside a parallel region, blocked by the number of
-    // threads, and the last bits of C would depend on it.
+    // runs Eigen's own OpenMP GEMM when called outside a parallel region (the top's products), and
+    // that GEMM chooses its blocking, so possibly the order of the sums, by the number of threads.
     using Eigen::ColMajor, Eigen::Dynamic, Eigen::RowMajor;
     Eigen::internal::gemm_blocking_space<ColMajor, double, double, Dynamic, Dynamic, Dynamic> blocking(m, n, k, 1, true);
     Eigen::internal::general_matrix_matrix_product<Eigen::Index, double, ColMajor, false, double, RowMajor, false,
