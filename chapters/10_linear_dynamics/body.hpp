@@ -297,6 +297,12 @@ struct Energies {
 /// docs/10_linear_dynamics.md#energy
 double kinetic_energy(const SparseMatrix& M, const Eigen::VectorXd& v);
 
+/// y = A x for a symmetric sparse A stored whole (both triangles, column-major, n×n; x: n), on every
+/// core, row by row: y_i = Σ_j A_ji x_j over column i of A (row i, A being symmetric), j ascending.
+/// Each y_i is one thread's sum in a fixed order, so the bits do not depend on the number of
+/// threads (they equal Eigen's serial A * x when A is exactly symmetric). fem::Error on sizes.
+Eigen::VectorXd symmetric_times(const SparseMatrix& A, const Eigen::VectorXd& x);
+
 /// The potential of a constant load, W = −f_extᵀ u (both 3n): the work the load did is −W.
 /// docs/10_linear_dynamics.md#energy
 double load_potential(const Eigen::VectorXd& f_ext, const Eigen::VectorXd& u);

@@ -18,6 +18,7 @@
 #include "common/tetgen.hpp"
 #include "common/parallel.hpp"
 #include "common/table.hpp"
+#include "common/threads_study.hpp"
 #include "common/timer.hpp"
 
 #include <algorithm>
@@ -226,43 +227,39 @@ void cost_study(const RunContext& run, const Settings& settings)
     parts.print(std::cout);
     parts.write_csv(run.file("parts_table.csv"));
 
-    // Why: the per-element loops (energy, forces, Hessians) run on every core (common/parallel.hpp)
-    // with the sums in tet order afterwards, so more threads must change the time and nothing else.
-    Table threads("The element loops on 1 and 2 threads (OpenMP), the largest beam at its sagging state",
-                  {{"threads", Format::integer}, {"energy and forces [s]", Format::scientific, 2},
-                   {"projected Hessian [s]", Format::scientific, 2}, {"speed-up of the Hessian [measured]", Format::fixed, 2},
-                   {"results identical to 1 thread", Format::text}});
+    // Why: the whole Newton step on 1 and 2 threads (issue 26): element loops, assembly, the
+    // factorization or the frozen factor's CG, the line search; the same bits on any number of
+    // threads. Each call makes its integrator afresh, so that no call inherits a factor from the
+    // one before (a kept factor would make later calls cheaper than the first).
     {
         const dynamics::Scene scene =
             dynamics::cantilever_scene(dynamics::Material{1e6, 0.45, 1100.0}, settings.cost_cells.back(), 1.0);
         dynamics::Body body(scene, make_force_model("neo-hookean", scene.mesh, scene.material));
-        NewtonBackwardEuler newton;
-        dynamics::State state = dynamics::initial_state(body);
-        newton.step(body, scene.time_step, state);
-        auto& model = dynamic_cast<HyperelasticElasticity&>(body.model());
-        Eigen::VectorXd forces, first_forces;
-        dynamics::SparseMatrix first_hessian;
-        double first_time = 0.0;
-        const ScopedThreadCount restore(thread_count());  // the loop below sets 1, then 2
-        for (const int count : {1, 2}) {
-            set_thread_count(count);
-            const double evaluate = best_time([&] { model.evaluate(state.u, forces); }, settings.seconds);
-            const double hessian = best_time([&] { (void)model.definite_stiffness(state.u); }, settings.seconds);
-            const dynamics::SparseMatrix& K = model.definite_stiffness(state.u);
-            bool identical = true;
-            if (count == 1) {
-                first_forces = forces;
-                first_hessian = K;
-                first_time = hessian;
-            } else {
-                identical = forces == first_forces && K.nonZeros() == first_hessian.nonZeros() &&
-                            std::equal(K.valuePtr(), K.valuePtr() + K.nonZeros(), first_hessian.valuePtr());
-            }
-            threads.add_row({double(count), evaluate, hessian, first_time / hessian, std::string(identical ? "yes" : "no")});
+        dynamics::State start = dynamics::initial_state(body);
+        NewtonBackwardEuler sagging;
+        for (int k = 0; k < 3; ++k)
+            sagging.step(body, scene.time_step, start);
+        struct ThreadsRoute {
+            std::string name, file;
+            NewtonOptions options;
+        };
+        for (const ThreadsRoute& route :
+             {ThreadsRoute{"the scenes' default (frozen factor, inexact Newton)", "threads_table.csv", newton_options_for({})},
+              ThreadsRoute{"a fresh factorization per iteration", "threads_refactor_table.csv", NewtonOptions{}}}) {
+            const Table threads = threads_table(
+                str("The stable neo-Hookean Newton step, ", route.name, ", on 1 and 2 threads, ", body.dofs().size(),
+                    " free dofs, one step from the same sagging state per call"),
+                [&] {
+                    NewtonBackwardEuler newton(route.options);
+                    dynamics::State state = start;
+                    newton.step(body, scene.time_step, state);
+                    return state.u;
+                },
+                settings.seconds);
+            threads.print(std::cout);
+            threads.write_csv(run.file(route.file));
         }
     }
-    threads.print(std::cout);
-    threads.write_csv(run.file("threads_table.csv"));
 
     // Why: a published reference point. Vega runs StVK on a 9 875-vertex mesh at 2 steps per second.
     dynamics::Scene vega = dynamics::cantilever_scene(dynamics::Material{1e6, 0.45, 1100.0}, 2, 1.0);

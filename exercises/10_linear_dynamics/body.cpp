@@ -5,6 +5,7 @@
 #include "04_tet_jacobians/tet_jacobians.hpp"
 
 #include "common/error.hpp"
+#include "common/parallel.hpp"
 #include "common/vtk_io.hpp"
 
 #include <algorithm>
@@ -74,7 +75,7 @@ double LinearElasticity::evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& for
 {
     if (u.size() != K_.rows())
         throw Error(str("displacement has ", u.size(), " entries, expected 3n = ", K_.rows()));
-    forces.noalias() = -(K_ * u);
+    forces = -symmetric_times(K_, u);
     return -0.5 * u.dot(forces);
 }
 
@@ -260,6 +261,25 @@ double kinetic_energy(const SparseMatrix& M, const Eigen::VectorXd& v)
     if (M.rows() != v.size() || M.cols() != v.size())
         throw Error(str("kinetic energy: M is ", M.rows(), "x", M.cols(), " but v has ", v.size(), " entries"));
     return 0.5 * v.dot(M * v);
+}
+
+Eigen::VectorXd symmetric_times(const SparseMatrix& A, const Eigen::VectorXd& x)
+{
+    if (A.rows() != A.cols() || A.cols() != x.size())
+        throw Error(str("symmetric product: A is ", A.rows(), "x", A.cols(), " but x has ", x.size(), " entries"));
+    Eigen::VectorXd y(x.size());
+    const int* outer = A.outerIndexPtr();
+    const int* nonzeros = A.innerNonZeroPtr();  // null when A is compressed
+    const int* inner = A.innerIndexPtr();
+    const double* values = A.valuePtr();
+    parallel_for(A.cols(), [&](Eigen::Index i) {
+        const int first = outer[i], last = nonzeros == nullptr ? outer[i + 1] : first + nonzeros[i];
+        double sum = 0.0;
+        for (int k = first; k < last; ++k)
+            sum += values[k] * x[inner[k]];
+        y[i] = sum;
+    });
+    return y;
 }
 
 double load_potential(const Eigen::VectorXd& f_ext, const Eigen::VectorXd& u)

@@ -267,7 +267,8 @@ Eigen::VectorXd velocity_change_right_hand_side(const SparseMatrix& M, const Eig
         external_forces.size() != v.size())
         throw Error(str("velocity-change right-hand side: M is ", M.rows(), "x", M.cols(), ", v, K v, f and f_ext have ",
                         v.size(), ", ", Kv.size(), ", ", forces.size(), " and ", external_forces.size(), " entries"));
-    const Eigen::VectorXd Dv = damping.alpha * (M * v) + damping.beta * Kv;
+    const Eigen::VectorXd Dv = damping.alpha == 0.0 ? Eigen::VectorXd(damping.beta * Kv)
+                                                    : Eigen::VectorXd(damping.alpha * symmetric_times(M, v) + damping.beta * Kv);
     return time_step * (forces + external_forces - Dv - (theta * time_step) * Kv);
 }
 
@@ -334,7 +335,7 @@ StepInfo ThetaMethod::step(Body& body, double time_step, State& state)
     const bool change = options_.form == StepForm::velocity_change;
     Eigen::VectorXd Kv;
     if (change || theta_ < 1.0)
-        Kv = K * state.v;
+        Kv = symmetric_times(K, state.v);
     Eigen::VectorXd b;
     if (change) {
         b = velocity_change_right_hand_side(M, state.v, Kv, state.forces, body.external_forces(),

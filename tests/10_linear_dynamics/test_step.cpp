@@ -3,6 +3,7 @@
 #include "dynamics_fixtures.hpp"
 
 #include "common/error.hpp"
+#include "common/parallel.hpp"
 #include "common/random.hpp"
 
 #include "../common/test_support.hpp"
@@ -208,4 +209,29 @@ TEST_CASE("reduced step matrix: P^T (a M + k K) P refilled in one fixed pattern,
     CHECK(reduced.fits(M, K));
     CHECK_FALSE(reduced.fits(consistent.mass_matrix(), K));
     CHECK_THROWS_WITH(reduced.assemble(consistent.mass_matrix(), K, 1.0, 1.0), Contains("pattern"));
+}
+
+TEST_CASE("symmetric_times: A x of a symmetric sparse matrix, the same bits on 1 and 2 threads", "[ch10]")
+{
+    Body body(cantilever_scene(6, 2));
+    const SparseMatrix& K = body.model().stiffness(Eigen::VectorXd::Zero(body.dofs().full_size()));
+    const Eigen::MatrixXd Kd(K);
+    const Eigen::VectorXd x = Eigen::VectorXd::LinSpaced(K.cols(), -1.0, 2.0).array().sin();
+    Eigen::VectorXd one_thread;
+    {
+        const fem::ScopedThreadCount one(1);
+        one_thread = symmetric_times(K, x);
+    }
+    // Against the dense product (an independent sum): equal to round-off.
+    CHECK((one_thread - Kd * x).lpNorm<Eigen::Infinity>() <= 1e-12 * (Kd.cwiseAbs() * x.cwiseAbs()).maxCoeff());
+    {
+        const fem::ScopedThreadCount two(2);
+        CHECK(symmetric_times(K, x) == one_thread);
+    }
+    // An uncompressed matrix (free room in its columns) gives the same.
+    SparseMatrix loose = K;
+    loose.uncompress();
+    loose.reserve(Eigen::VectorXi::Constant(K.cols(), 3));
+    CHECK(symmetric_times(loose, x) == one_thread);
+    CHECK_THROWS_WITH(symmetric_times(K, Eigen::VectorXd::Zero(3)), Contains("symmetric product") && Contains("3 entries"));
 }
