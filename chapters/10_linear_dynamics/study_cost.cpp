@@ -6,7 +6,6 @@
 
 #include "common/error.hpp"
 #include "common/table.hpp"
-#include "common/threads_study.hpp"
 #include "common/timer.hpp"
 
 #include <cmath>
@@ -150,14 +149,8 @@ void cost_study(const RunContext& run, const Settings& settings)
         State start = initial_state(body);
         for (int k = 0; k < 3; ++k)  // a moving, sagging beam; the step matrix is factored by now
             integrator.step(body, dt, start);
-        const Table threads = threads_table(
-            str("The prefactored backward Euler step (right-hand side, two triangular solves) on 1 and 2 threads, ",
-                body.dofs().size(), " free dofs, one step from the same state per call"),
-            [&] {
-                State state = start;
-                integrator.step(body, dt, state);
-                return state.u;
-            },
+        const Table threads = step_threads_table(
+            "The prefactored backward Euler step (right-hand side, two triangular solves)", body, integrator, start, dt,
             settings.seconds);
         threads.print(std::cout);
         threads.write_csv(run.file("threads_table.csv"));

@@ -37,6 +37,8 @@
 
 #include "10_linear_dynamics/body.hpp"
 
+#include "common/error.hpp"
+#include "common/threads_study.hpp"
 #include "common/vtk_io.hpp"
 
 #include "09_conjugate_gradient/linear_solver.hpp"
@@ -332,5 +334,23 @@ private:
 /// puts in −δfᵀu (the load potential's jump); a switch of the model, U_new(u) − U_old(u).
 /// docs/10_linear_dynamics.md#the-step-hook
 double apply_step_hook(const Simulation::BeforeStep& hook, Body& body, State& state, double step_end);
+
+/// The threads table of one time step (common/threads_study.hpp): each call steps a copy of `start`
+/// by Δt with `integrator` and returns its displacement (3n), on 1 and 2 threads, quiet and beside a
+/// busy core; `what` names the step in the title. The integrator must do the same work at every
+/// call (a factor made before the table, or one made afresh each step), so that the times compare
+/// and the bits can be compared. docs/10_linear_dynamics.md#threads
+inline Table step_threads_table(const std::string& what, Body& body, Integrator& integrator, const State& start,
+                                double time_step, double seconds)
+{
+    return threads_table(str(what, " on 1 and 2 threads, ", body.dofs().size(),
+                             " free dofs, one step from the same state per call"),
+                         [&] {
+                             State state = start;
+                             integrator.step(body, time_step, state);
+                             return state.u;
+                         },
+                         seconds);
+}
 
 }  // namespace fem::dynamics

@@ -14,7 +14,6 @@
 #include "common/error.hpp"
 #include "common/parallel.hpp"
 #include "common/table.hpp"
-#include "common/threads_study.hpp"
 #include "common/timer.hpp"
 
 #include <functional>
@@ -289,15 +288,9 @@ void cost_study(const RunContext& run, const Settings& settings)
         dynamics::ThetaMethod integrator(1.0, solver_option("refactor", solve_tolerance, body));
         dynamics::State first = start;
         integrator.step(body, scene.time_step, first);  // makes the solver and its symbolic analysis
-        const Table threads = threads_table(
-            str("The corotational backward Euler step (rotations, forces, K_R, step matrix, Cholesky factorization, "
-                "solve) on 1 and 2 threads, ", body.dofs().size(), " free dofs, one step from the same bent state per call"),
-            [&] {
-                dynamics::State state = start;
-                integrator.step(body, scene.time_step, state);
-                return state.u;
-            },
-            settings.seconds);
+        const Table threads = dynamics::step_threads_table(
+            "The corotational backward Euler step from a bent state (rotations, forces, K_R, step matrix, Cholesky "
+            "factorization, solve)", body, integrator, start, scene.time_step, settings.seconds);
         threads.print(std::cout);
         threads.write_csv(run.file("threads_table.csv"));
     }

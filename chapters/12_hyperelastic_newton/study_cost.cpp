@@ -18,7 +18,6 @@
 #include "common/tetgen.hpp"
 #include "common/parallel.hpp"
 #include "common/table.hpp"
-#include "common/threads_study.hpp"
 #include "common/timer.hpp"
 
 #include <algorithm>
@@ -241,15 +240,9 @@ void cost_study(const RunContext& run, const Settings& settings)
         NewtonBackwardEuler newton;  // a fresh supernodal factorization per Newton iteration
         for (int k = 0; k < 3; ++k)
             newton.step(body, scene.time_step, start);
-        const Table threads = threads_table(
-            str("The stable neo-Hookean Newton step (a fresh factorization per iteration) on 1 and 2 threads, ",
-                body.dofs().size(), " free dofs, one step from the same sagging state per call"),
-            [&] {
-                dynamics::State state = start;
-                newton.step(body, scene.time_step, state);
-                return state.u;
-            },
-            settings.seconds);
+        const Table threads = dynamics::step_threads_table(
+            "The stable neo-Hookean Newton step from a sagging state (a fresh factorization per iteration)", body,
+            newton, start, scene.time_step, settings.seconds);
         threads.print(std::cout);
         threads.write_csv(run.file("threads_table.csv"));
     }
