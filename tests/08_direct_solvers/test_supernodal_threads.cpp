@@ -181,7 +181,7 @@ TEST_CASE("supernodal threads: one supernode, a chain and a forest give the same
 
 TEST_CASE("supernodal threads: a matrix that is not SPD fails at the same column on any number of threads, the "
           "first one in the elimination order",
-          "[ex08.6]")
+          "[ex08.7]")
 {
     const sparse::CscMatrix forest = block_diagonal({laplacian_3d(14), laplacian_2d(20), laplacian_3d(12)});
     const int n = forest.rows;  // 2744 + 400 + 1728
