@@ -16,7 +16,6 @@
 
 #include <Eigen/SparseCholesky>
 
-#include <regex>
 #include <string>
 #include <vector>
 
@@ -139,8 +138,17 @@ sparse::CscMatrix with_negative_diagonal(const sparse::CscMatrix& A, const std::
 /// The column a "not symmetric positive definite" message names, or −1.
 int failed_column(const std::string& message)
 {
-    std::smatch match;
-    return std::regex_search(message, match, std::regex("pivot of column ([0-9]+) ")) ? std::stoi(match[1]) : -1;
+    // (no std::regex: g++ 12 warns about its internals at -O1 with the sanitizers)
+    const std::string key = "pivot of column ";
+    const std::size_t at = message.find(key);
+    if (at == std::string::npos)
+        return -1;
+    const std::size_t first = at + key.size();
+    std::size_t last = first;
+    while (last < message.size() && message[last] >= '0' && message[last] <= '9')
+        ++last;
+    return last > first && last < message.size() && message[last] == ' ' ? std::stoi(message.substr(first, last - first))
+                                                                           : -1;
 }
 
 }  // namespace
