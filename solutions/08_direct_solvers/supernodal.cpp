@@ -351,7 +351,7 @@ void lower_rank_update(int q, int k, const double* A, int lda, double* C, int ld
 {
     constexpr int width = 120;
     const int panels = (q + width - 1) / width;
-    const bool parallel = split && panels >= 2 && 0.5 * q * static_cast<double>(q) * k >= split_multiply_adds;
+    [[maybe_unused]] const bool parallel = split && panels >= 2 && 0.5 * q * static_cast<double>(q) * k >= split_multiply_adds;
 #pragma omp parallel for schedule(dynamic, 1) if (parallel)
     for (int p = 0; p < panels; ++p) {
         const int c0 = p * width, cb = std::min(width, q - c0);
