@@ -56,8 +56,7 @@ double median_time(const std::function<Eigen::VectorXd()>& work, double seconds,
         else if (result.size() != reference.size() || result != reference)
             identical = false;
     }
-    std::nth_element(times.begin(), times.begin() + times.size() / 2, times.end());
-    return times[times.size() / 2];
+    return median(std::move(times));
 }
 
 }  // namespace

@@ -1,7 +1,11 @@
 #pragma once
 // Wall-clock timing for the speed-against-error tables. Timings are printed, never asserted.
 
+#include "common/error.hpp"
+
+#include <algorithm>
 #include <chrono>
+#include <vector>
 
 namespace fem {
 
@@ -36,6 +40,17 @@ double best_time(Work&& work, double min_total_seconds = 0.2, int max_repeats = 
             break;
     }
     return best;
+}
+
+/// The median of a list of times (of an even count, the upper of the two middle ones): for
+/// timings whose spread is part of what they show, where a minimum would hide it. fem::Error for
+/// an empty list.
+inline double median(std::vector<double> times)
+{
+    if (times.empty())
+        throw Error("median: no times");
+    std::nth_element(times.begin(), times.begin() + times.size() / 2, times.end());
+    return times[times.size() / 2];
 }
 
 }  // namespace fem

@@ -14,7 +14,7 @@
 //
 // Writes: tables dense_table.csv, hilbert_table.csv, ordering_table.csv, speed_table.csv,
 // goals_table.csv, supernodes_table.csv, kernels_table.csv, solve_many_table.csv, failures_table.csv,
-// threads_factor_table.csv, threads_solve_table.csv;
+// threads_factor_table.csv, threads_phases_table.csv, threads_solve_table.csv;
 // charts (PNG + CSV) dense_times, hilbert_errors, fill_growth, factor_times, solve_times;
 // the patterns of L for four orderings (factor_patterns.vti/.png) and the box under gravity solved
 // with our Cholesky (box_displacement.vtu/.png). docs/08_direct_solvers.md
@@ -888,6 +888,39 @@ void threads_study(const RunContext& run)
         seconds);
     factor.print(std::cout);
     factor.write_csv(run.file("threads_factor_table.csv"));
+
+    // Where the two threads gain: the factorization's phases (CholeskyTimes), medians of the calls
+    // made in `seconds` on each count.
+    Table phases(str("The factorization's two phases on 1 and 2 threads (medians), same matrix: the subtrees side by "
+                     "side, then the top supernodes one after another"),
+                 {{"threads", Format::integer},
+                  {"factorization [s]", Format::scientific, 3},
+                  {"subtrees [s]", Format::scientific, 3},
+                  {"top supernodes [s]", Format::scientific, 3},
+                  {"subtrees: speed-up [measured]", Format::fixed, 2},
+                  {"top: speed-up [measured]", Format::fixed, 2},
+                  {"top: share of the time [measured]", Format::fixed, 2}});
+    double one_thread_subtrees = 0.0, one_thread_top = 0.0;
+    for (const int threads : {1, 2}) {
+        const ScopedThreadCount scope(threads);
+        std::vector<double> numeric, subtrees, top;
+        const Timer measuring;
+        while (numeric.size() < 3 || measuring.seconds() < seconds) {
+            chol.factorize(K);
+            numeric.push_back(chol.times().numeric);
+            subtrees.push_back(chol.times().numeric_subtrees);
+            top.push_back(chol.times().numeric_top);
+        }
+        const double subtree_time = median(subtrees), top_time = median(top), numeric_time = median(numeric);
+        if (threads == 1) {
+            one_thread_subtrees = subtree_time;
+            one_thread_top = top_time;
+        }
+        phases.add_row({double(threads), numeric_time, subtree_time, top_time, one_thread_subtrees / subtree_time,
+                        one_thread_top / top_time, top_time / numeric_time});
+    }
+    phases.print(std::cout);
+    phases.write_csv(run.file("threads_phases_table.csv"));
     const Table solve = threads_table(
         str("Supernodal solve (forward and back substitution, one right-hand side) on 1 and 2 threads, same matrix"),
         [&] { return chol.solve(b); }, seconds);

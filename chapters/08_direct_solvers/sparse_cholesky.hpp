@@ -118,6 +118,9 @@ struct CholeskyTimes {
     double ordering = 0.0;   ///< the fill-reducing ordering
     double symbolic = 0.0;   ///< permutation, elimination tree, counts, supernodes
     double numeric = 0.0;    ///< the numeric factorization
+    /// Supernodal: the numeric factorization's independent subtrees and its top supernodes
+    /// (docs/08_direct_solvers.md#threads); 0 for up-looking.
+    double numeric_subtrees = 0.0, numeric_top = 0.0;
 };
 
 /// Factor once, solve many: the sparse Cholesky factorization P A Pᵀ = L Lᵀ of a symmetric

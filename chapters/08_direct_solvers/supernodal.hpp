@@ -76,6 +76,12 @@ public:
     /// the last factorize(), or if x has not n entries.
     void solve_in_place_single(Eigen::Ref<Eigen::VectorXf> x) const;
 
+    /// Wall times [s] of the last factorize(): its independent subtrees (side by side on the
+    /// threads) and its top supernodes (one after another, each front's large products and column
+    /// loops on all threads). docs/08_direct_solvers.md#threads
+    double subtree_seconds() const { return subtree_seconds_; }
+    double top_seconds() const { return top_seconds_; }
+
     int supernodes() const { return static_cast<int>(first_.size()) - 1; }
     /// The number of independent subtrees the factorization and the substitutions run in parallel.
     int subtrees() const { return static_cast<int>(subtree_begin_.size()); }
@@ -104,6 +110,7 @@ private:
     std::vector<float> single_values_;    // values_ rounded to float (round_to_single), or empty
     std::vector<int> column_to_supernode_;
     bool factored_ = false;
+    double subtree_seconds_ = 0.0, top_seconds_ = 0.0;
     // The parallel schedule (docs/08_direct_solvers.md#threads): subtree t is the supernodes
     // subtree_begin_[t] … subtree_root_[t] (its root last); top_ holds the others, increasing.
     std::vector<int> subtree_begin_, subtree_root_;

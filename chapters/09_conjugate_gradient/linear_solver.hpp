@@ -55,7 +55,6 @@ struct SolverOptions {
 /// What the last prepare() and solve() did.
 struct SolveStats {
     int iterations = 0;              ///< CG iterations of the last solve (0 for a direct solver)
-    double relative_residual = 0.0;  ///< ‖b − A x‖₂ / ‖b‖₂ of the last solution, recomputed
     double prepare_seconds = 0.0;    ///< wall time of the last prepare()
     double solve_seconds = 0.0;      ///< wall time of the last solve (without the residual check)
 };
@@ -91,6 +90,11 @@ public:
     void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x);
 
     const SolveStats& stats() const { return stats_; }
+    /// ‖b − A x‖₂ / ‖b‖₂ of the last solve (‖x‖₂ for b = 0): the value the solver reported (CG's
+    /// last product with A), or else computed here at the first call after the solve, a product
+    /// with A that callers who never ask, like the time steps of chapters 10–12, do not pay for.
+    /// fem::Error before the first solve after prepare().
+    double relative_residual() const;
     /// n of the prepared matrix (0 before prepare()).
     Eigen::Index size() const { return A_.rows(); }
 
@@ -112,7 +116,7 @@ protected:
     virtual int do_solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) = 0;
     /// For do_solve: the true relative residual ‖b − A x‖₂ / ‖b‖₂ of the x it returns, when it
     /// computed it anyway (chapter 09's CG does, with a product by this A), so that solve() does not
-    /// multiply by A once more for stats().relative_residual. Unreported, solve() computes it.
+    /// multiply by A once more for relative_residual(). Unreported, relative_residual() computes it.
     void report_true_residual(double relative_residual) { reported_residual_ = relative_residual; }
 
 private:
@@ -121,6 +125,11 @@ private:
     Eigen::SparseMatrix<double> A_;  // for the residual check and the pattern comparison
     std::vector<std::pair<int, int>> mirror_;  // the entry pairs (k, m) the symmetry check compares
     SolveStats stats_;
+    // The last solve's residual (< 0: none yet), or its b and x while relative_residual() has not
+    // computed it (pending).
+    mutable double relative_residual_ = -1.0;
+    Eigen::VectorXd residual_b_, residual_x_;
+    mutable bool residual_pending_ = false;
     double reported_residual_ = -1.0;  // report_true_residual's value during a solve (< 0: none)
 };
 

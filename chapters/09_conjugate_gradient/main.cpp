@@ -559,7 +559,7 @@ Measurement measure_direct(const Problem& p, const std::string& name, const Eige
     }
     row.setup = best_setup;
     row.seconds = best_setup + best_solve;
-    row.residual = solver->stats().relative_residual;
+    row.residual = solver->relative_residual();
     row.error = reference ? relative_error(x, *reference) : 0.0;
     return row;
 }
@@ -791,7 +791,7 @@ void hard_cases_study(const RunContext& run, const Settings& settings)
             try {
                 solver->prepare(*A);
                 const Eigen::VectorXd x = solver->solve(*b);
-                outcome = str("no error: relative residual ", scientific(solver->stats().relative_residual),
+                outcome = str("no error: relative residual ", scientific(solver->relative_residual()),
                               ", |x| = ", scientific(x.norm()));
             } catch (const Error& e) {
                 std::cout << solver_name << " on " << name << ": " << e.what() << '\n';

@@ -262,6 +262,8 @@ struct SparseCholesky::Impl {
             C_lower.rows = C_lower.cols = C_upper.cols;
             sparse::transpose_compressed(sparse::view(C_upper), C_lower.A, C_lower.IA, C_lower.JA);
             supernodal->factorize(C_lower);
+            times.numeric_subtrees = supernodal->subtree_seconds();
+            times.numeric_top = supernodal->top_seconds();
             if (options.single_precision_copy)
                 supernodal->round_to_single();
         }

@@ -8,6 +8,7 @@
 #include "common/error.hpp"
 #include "common/parallel.hpp"
 #include "common/simd.hpp"
+#include "common/timer.hpp"
 
 #include <Eigen/Core>
 
@@ -318,6 +319,26 @@ void subtract_product(int m, int n, int k, const double* A, int lda, const doubl
 /// Factors with fewer stored entries are factored and substituted on one thread (the same
 /// operations either way): below this, starting the threads costs more than they save.
 constexpr long long parallel_entries = 100000;
+
+/// On top fronts of at least this many m² entries the loops over columns (assembly, extend-add,
+/// copies) run on all threads.
+constexpr long long split_front_entries = 65536;
+
+/// body(c) for c in [0, count): on all threads (chunks of 32 columns to whichever thread is free)
+/// when `on_threads`, else a plain loop, which costs nothing per call where a parallel region
+/// with a false `if` still costs a microsecond (thousands of small fronts).
+template <class Body>
+void for_each_column(int count, bool on_threads, Body&& body)
+{
+    if (!on_threads) {
+        for (int c = 0; c < count; ++c)
+            body(c);
+        return;
+    }
+#pragma omp parallel for schedule(dynamic, 32)
+    for (int c = 0; c < count; ++c)
+        body(c);
+}
 
 /// Products with fewer multiply-adds (m n k) run on one thread: a parallel region costs microseconds.
 constexpr double split_multiply_adds = 2e6;
@@ -683,14 +704,20 @@ int SupernodalCholesky::factor_front(int s, const sparse::CscMatrix& C_lower, co
     for (int t = 0; t < m; ++t)
         position[row[t]] = t;
 
-    // The front: A's columns of s into L (m×ns), zero update area W (r×r, lower triangle).
-    for (int c = 0; c < ns; ++c) {
+    // The loops over columns below write each column from one thread, in the serial order within it:
+    // on a large top front (split) they run on all threads with the same bits.
+    const bool columns_on_threads = split && static_cast<long long>(m) * m >= split_front_entries;
+
+    // The front: A's columns of s into the zeroed L (m×ns), zero update area W (r×r, lower triangle).
+    for_each_column(ns, columns_on_threads, [&](int c) {
         double* const column = L + static_cast<long long>(c) * m;
+        std::fill(column, column + m, 0.0);
         for (int k = C_lower.IA[f + c]; k < C_lower.IA[f + c + 1]; ++k)
             column[position[C_lower.JA[k]]] += C_lower.A[k];
-    }
-    for (int c = 0; c < r; ++c)
+    });
+    for_each_column(r, columns_on_threads, [&](int c) {
         std::fill(W + static_cast<long long>(c) * r + c, W + static_cast<long long>(c + 1) * r, 0.0);
+    });
 
     // Extend-add the update matrices of the children, the last one first.
     for (int k = children_start_[s]; k < children_start_[s + 1]; ++k) {
@@ -702,7 +729,7 @@ int SupernodalCholesky::factor_front(int s, const sparse::CscMatrix& C_lower, co
         relative.resize(rc);
         for (int t = 0; t < rc; ++t)
             relative[t] = position[child_rows[t]];
-        for (int jj = 0; jj < rc; ++jj) {
+        for_each_column(rc, columns_on_threads, [&](int jj) {
             const int pj = relative[jj];
             const double* const source = U + static_cast<long long>(jj) * rc;
             if (pj < ns) {
@@ -714,7 +741,7 @@ int SupernodalCholesky::factor_front(int s, const sparse::CscMatrix& C_lower, co
                 for (int ii = jj; ii < rc; ++ii)
                     target[relative[ii]] += source[ii];
             }
-        }
+        });
     }
 
     const int failed = partial_cholesky(L, m, ns, tiny + f, split, pivot);
@@ -722,9 +749,10 @@ int SupernodalCholesky::factor_front(int s, const sparse::CscMatrix& C_lower, co
         return failed;
     if (r > 0) {
         lower_rank_update(r, ns, L + ns, m, W, r, split);  // W −= L21 L21ᵀ
-        for (int c = 0; c < r; ++c)
+        for_each_column(r, columns_on_threads, [&](int c) {
             std::memcpy(update + static_cast<long long>(c) * r + c, W + static_cast<long long>(c) * r + c,
                         sizeof(double) * (r - c));
+        });
     }
     return -1;
 }
@@ -792,10 +820,11 @@ void SupernodalCholesky::factorize(const sparse::CscMatrix& C_lower)
     single_values_.clear();
     const int S = supernodes();
     const std::vector<double> tiny = pivot_thresholds(C_lower);
-    values_.assign(static_cast<std::size_t>(stored_entries()), 0.0);
+    values_.resize(static_cast<std::size_t>(stored_entries()));  // each front zeroes its own block
 
     // 1. The subtrees, in parallel: the heaviest first, each taken by the next free thread. Each
     //    keeps its root's update matrix for the top.
+    Timer phase;
     const int T = subtrees();
     std::vector<int> subtree_with_root(S, -1);
     for (int t = 0; t < T; ++t)
@@ -826,10 +855,14 @@ void SupernodalCholesky::factorize(const sparse::CscMatrix& C_lower)
             first = failure;
     const int stop = first.supernode < 0 ? S : first.supernode;
 
+    subtree_seconds_ = phase.seconds();
+
     // 2. The top supernodes, in order, each on all threads.
+    phase.restart();
     Failure top_failure;
     factor_supernodes(top_, stop, C_lower, tiny.data(), root_updates, subtree_with_root,
                       stored_entries() >= parallel_entries, top_failure);
+    top_seconds_ = phase.seconds();
     if (top_failure.supernode >= 0)
         first = top_failure;
     if (first.supernode >= 0)

@@ -279,6 +279,8 @@ void LinearSolver::prepare(const Eigen::SparseMatrix<double>& A)
         A_.makeCompressed();
     }
     stats_ = SolveStats{};
+    relative_residual_ = -1.0;
+    residual_pending_ = false;
     Timer timer;
     try {
         if (!same)
@@ -319,6 +321,8 @@ void LinearSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x)
         std::frexp(largest, &exponent);
     Timer timer;
     reported_residual_ = -1.0;
+    relative_residual_ = -1.0;
+    residual_pending_ = false;
     if (exponent == 0) {
         stats_.iterations = do_solve(b, x);
     } else {
@@ -333,9 +337,24 @@ void LinearSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x)
     stats_.solve_seconds = timer.seconds();
     // (The relative residual of a solve scaled by 2ᵏ is the unscaled one: the scaling is exact.)
     const double b_norm = b.norm();
-    stats_.relative_residual = b_norm == 0.0            ? x.norm()
-                               : reported_residual_ >= 0.0 ? reported_residual_
-                                                           : (b - A_ * x).norm() / b_norm;
+    if (b_norm == 0.0 || reported_residual_ >= 0.0) {
+        relative_residual_ = b_norm == 0.0 ? x.norm() : reported_residual_;
+    } else {
+        residual_b_ = b;  // relative_residual() computes ‖b − A x‖ / ‖b‖ when asked
+        residual_x_ = x;
+        residual_pending_ = true;
+    }
+}
+
+double LinearSolver::relative_residual() const
+{
+    if (residual_pending_) {
+        relative_residual_ = (residual_b_ - A_ * residual_x_).norm() / residual_b_.norm();
+        residual_pending_ = false;
+    }
+    if (relative_residual_ < 0.0)
+        throw Error(str(name_, ": relative_residual() before a solve"));
+    return relative_residual_;
 }
 
 std::unique_ptr<LinearSolver> make_solver(std::string_view name, const SolverOptions& options)
