@@ -129,30 +129,19 @@ sparse::CscMatrix shifted_laplacian_1d(int n)
 /// eliminates last, so the factor's root is one supernode of `shared` rows over the chains.
 sparse::CscMatrix chains_under_dense_block(int chains, int length, int shared)
 {
+    std::vector<sparse::CscMatrix> blocks(chains, shifted_laplacian_1d(length));
+    blocks.push_back(csc(random_spd(shared, 5).sparseView()));
     const int n = chains * length + shared, base = chains * length;
-    std::vector<Eigen::Triplet<double>> entries;
-    for (int c = 0; c < chains; ++c)
-        for (int i = 0; i < length; ++i) {
-            const int row = c * length + i;
-            entries.emplace_back(row, row, 3.0);
-            if (i + 1 < length) {
-                entries.emplace_back(row + 1, row, -1.0);
-                entries.emplace_back(row, row + 1, -1.0);
-            }
-        }
+    std::vector<Eigen::Triplet<double>> coupling;
     for (int c = 0; c < chains; ++c)
         for (int k = 0; k < 4; ++k) {
             const int chain_end = c * length + length - 1, block = base + (c * 4 + k) % shared;
-            entries.emplace_back(block, chain_end, -0.1);
-            entries.emplace_back(chain_end, block, -0.1);
+            coupling.emplace_back(block, chain_end, -0.1);
+            coupling.emplace_back(chain_end, block, -0.1);
         }
-    const Eigen::MatrixXd D = random_spd(shared, 5);
-    for (int j = 0; j < shared; ++j)
-        for (int i = 0; i < shared; ++i)
-            entries.emplace_back(base + i, base + j, D(i, j));
-    Eigen::SparseMatrix<double> A(n, n);
-    A.setFromTriplets(entries.begin(), entries.end());
-    return csc(A);
+    Eigen::SparseMatrix<double> C(n, n);
+    C.setFromTriplets(coupling.begin(), coupling.end());
+    return csc(sparse::to_eigen(block_diagonal(blocks)) + C);
 }
 
 /// A copy of A with the diagonal entries of the given columns made negative.
