@@ -17,7 +17,7 @@
 #   chNN_docs           ctest: docs/NN_name.md names only functions and exercises that exist and
 #                       quotes the numbers the executable prints (label chNN, docs).
 #   chNN_test_target    ctest: building test_chNN alone builds no later chapter (label chNN, layout),
-#                       the student's one-chapter loop (README, "Student workflow").
+#                       the student's one-chapter loop (README, "A student's loop").
 #   chNN_bad_options    ctest, when tests/NN_name/bad_options.txt exists: the executable refuses each
 #                       bad command line of that table before it computes or writes anything
 #                       (tools/check_bad_options.py says the table's form; label chNN, run).

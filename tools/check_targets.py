@@ -2,7 +2,7 @@
 """Checks a chapter's own build target (a ctest test per chapter): `cmake --build --preset student
 --target test_chNN` must build that chapter's tests from the chapter and the earlier chapters it
 uses only, never a later one, so that a student working on chapter NN waits for nothing else
-(README, "Student workflow"). Reads the dependency graph of the Ninja build without building.
+(README, "A student's loop"). Reads the dependency graph of the Ninja build without building.
 """
 
 import argparse

@@ -2,7 +2,7 @@
 # The memory each executable needs: runs every chapter executable of a build (full runs, not
 # --quick), then fem_scene on every scene and its --compare, ONE AT A TIME (two at once would add
 # up), and prints a Markdown table of the peak resident memory each run reports on its last line
-# ("peak memory: N MB", common/memory.hpp) with its wall time. README.md, "Memory", holds the result.
+# ("peak memory: N MB", common/memory.hpp) with its wall time. docs/engineering.md, "Memory", holds the result.
 #
 #   tools/memory_table.sh [BUILD_DIR] [NN ...]     default build/release, every chapter and the scenes
 #   tools/memory_table.sh build/release 10 12      chapters 10 and 12 only

@@ -278,7 +278,7 @@ void cost_study(const RunContext& run, const Settings& settings)
     solvers.print(std::cout);
     solvers.write_csv(run.file("solvers_table.csv"));
 
-    // Why: the whole step on 1 and 2 threads (issue 26): rotations, forces, K_R and the step matrix,
+    // Why: the whole step on 1 and 2 threads (the threads goal, 1.7× on 2 cores): rotations, forces, K_R and the step matrix,
     // the factorization and the solve, the same bits on any number of threads. The integrator is
     // kept across calls: "refactor" factors afresh every step, reusing only the symbolic analysis.
     {

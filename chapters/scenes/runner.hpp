@@ -1,5 +1,5 @@
 #pragma once
-// The scenes capstone: one runner over chapters 10–13. docs/scenes.md#the-runner
+// The scenes capstone: one runner over chapters 10–14. docs/scenes.md#the-runner
 //
 // For each body of a scene the runner builds chapter 10's Scene, Body and Simulation — one loop,
 // chapter 10's — with

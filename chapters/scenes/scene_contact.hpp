@@ -8,8 +8,12 @@
 // the barrier and friction are zero and the step is the contact step's answer. Otherwise the step is
 // taken again from its start by chapter 12's Newton backward Euler with chapter 14's contact
 // potential (barrier, lagged friction, the line search cut by the continuous collision check), on
-// the force model of the body's current level.
+// the force model of the body's current level, raised to corotational first if it is linear: the
+// linear energy ½ uᵀK u of a body that has moved far from where it started is round-off (its terms
+// cancel), so the line search could not tell a decrease from noise (the rule that refuses model
+// linear with obstacles, applied to auto's choice of the moment).
 
+#include "scenes/model_auto.hpp"
 #include "scenes/scene_file.hpp"
 
 #include "14_contact/contact.hpp"
@@ -32,10 +36,11 @@ std::vector<std::shared_ptr<const contact::Obstacle>> scene_obstacles(const Scen
 /// contact, Newton backward Euler with the contact potential in the steps that need it.
 class ContactIntegrator final : public dynamics::Integrator {
 public:
-    /// own: the body's integrator without contact (backward Euler; not owned, it must outlive this).
-    /// The contact potential is built for body against obstacles with the scene's d̂ and ε_v (κ
+    /// own: the body's integrator without contact (backward Euler; not owned, it must outlive this);
+    /// levels: the body's force model (not owned), raised to Level::corotational for a contact step
+    /// taken at Level::linear (header comment). The contact potential is built for body against obstacles with the scene's d̂ and ε_v (κ
     /// adaptive), Newton with the scene's solver and tolerance. fem::Error as ContactPotential.
-    ContactIntegrator(dynamics::Integrator& own, const dynamics::Body& body,
+    ContactIntegrator(dynamics::Integrator& own, SceneForces& levels, const dynamics::Body& body,
                       std::vector<std::shared_ptr<const contact::Obstacle>> obstacles, const SceneSpec& scene);
 
     std::string name() const override { return last_contact_ ? newton_.name() + " with contact" : own_.name(); }
@@ -56,6 +61,7 @@ public:
 
 private:
     dynamics::Integrator& own_;
+    SceneForces& levels_;
     std::unique_ptr<contact::ContactPotential> potential_;
     hyper::NewtonBackwardEuler newton_;
     int contact_steps_ = 0;

@@ -207,7 +207,9 @@ NewtonResult newton_minimize(const NewtonProblem& problem, Eigen::VectorXd x0, c
             // HINT: Armijo backtracking (docs/12_hyperelastic_newton.md#newton-with-line-search): `alpha` arrives as the
             // HINT: first trial (1, or the largest safe step: do not reset it); shrink it by options.shrink until E at
             // HINT: x + α d lies below `start` by at least options.armijo's share of the decrease `slope` (∇Eᵀd < 0)
-            // HINT: predicts for that α, `noise` (E's round-off) allowed. The notes' target leaves α out: their fourth
+            // HINT: predicts for that α, `noise` (E's round-off) allowed; where both E's change and the decrease
+            // HINT: predicted are below objective_resolution × `magnitude`, decide by the trapezoid rule on the
+            // HINT: slopes ∇Eᵀd at x and at x + α d instead (E's difference is round-off there). The notes' target leaves α out: their fourth
             // HINT: slip. problem.objective(y, &magnitude) is +∞ where the material is undefined. Throw fem::Error once α
             // HINT: falls below options.smallest_step. The accepted trial's E and magnitude must end in `objective` and
             // HINT: `magnitude` (the next iteration starts there), its α in `alpha`.

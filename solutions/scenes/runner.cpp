@@ -97,7 +97,7 @@ BodyRun start_body(const BodySpec& spec, const SceneSpec& scene, const std::stri
                         "hyperelastic model"));
     b.integrator = std::make_unique<LevelIntegrator>(*b.forces, scene);
     if (!obstacles.empty())
-        b.contact = std::make_unique<ContactIntegrator>(*b.integrator, *b.body, obstacles, scene);
+        b.contact = std::make_unique<ContactIntegrator>(*b.integrator, *b.forces, *b.body, obstacles, scene);
     SceneConditions conditions(spec, scene, b.forces, automatic, b.contact.get());
     b.body->set_applied_loads(conditions.initial_loads());
     Eigen::VectorXd v0 = Eigen::VectorXd::Zero(3 * spec.mesh.V.rows());

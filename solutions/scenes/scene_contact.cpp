@@ -25,10 +25,11 @@ contact::ContactOptions contact_options(const SceneSpec& scene)
 
 }  // namespace
 
-ContactIntegrator::ContactIntegrator(dynamics::Integrator& own, const dynamics::Body& body,
+ContactIntegrator::ContactIntegrator(dynamics::Integrator& own, SceneForces& levels, const dynamics::Body& body,
                                      std::vector<std::shared_ptr<const contact::Obstacle>> obstacles,
                                      const SceneSpec& scene)
     : own_(own),
+      levels_(levels),
       potential_(std::make_unique<contact::ContactPotential>(body, std::move(obstacles), contact_options(scene))),
       newton_(hyper::newton_options_for({.solver = scene.solver, .newton_tolerance = scene.newton_tolerance}))
 {
@@ -50,6 +51,8 @@ dynamics::StepInfo ContactIntegrator::step(dynamics::Body& body, double time_ste
     }
     last_contact_ = true;
     ++contact_steps_;
+    if (levels_.level() == Level::linear)
+        levels_.set_level(Level::corotational);
     const Eigen::VectorXd start = state.u;
     const double start_time = state.time;
     dynamics::StepInfo info = newton_.step(body, time_step, state);

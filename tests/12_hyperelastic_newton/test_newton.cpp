@@ -24,6 +24,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -385,6 +387,66 @@ TEST_CASE("the line search: every accepted step decreases E by at least c alpha 
     CHECK(shortest < 1.0);  // full steps were rejected: the case the test is about
     INFO(failure);
     CHECK(failure.empty());
+}
+
+TEST_CASE("the line search where E's differences are round-off: the slopes decide, and Newton converges", "[ex12.9]")
+{
+    // E(x) = Σ wᵢ √(1 + (xᵢ − cᵢ)²) plus a noise of ±η that jumps with every bit of x: the round-off
+    // of a body's energy whose terms cancel (a resting or translated body), here η = 1e-9, 100 times
+    // what objective_round_off × E's terms allows and 1/100 of objective_resolution × them. The
+    // gradient is exact. Near the minimum Newton's decrease (~|∇E|²) falls far below η: E's Armijo
+    // test then passes or fails by the noise's draw, and only the trapezoid rule on the slopes can
+    // accept the full steps that converge.
+    const Eigen::Vector2d weights(100.0, 1.0), centre(0.3, -0.7);
+    const double noise_amplitude = 1e-9;
+    const auto noise = [&](const Eigen::VectorXd& x) {  // splitmix64 of x's bits, mapped to [−1, 1]
+        std::uint64_t h = 0x9e3779b97f4a7c15ULL;
+        for (Eigen::Index i = 0; i < x.size(); ++i) {
+            std::uint64_t bits = 0;
+            std::memcpy(&bits, &x[i], sizeof bits);
+            h ^= bits + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2);
+            h = (h ^ (h >> 30)) * 0xbf58476d1ce4e5b9ULL;
+            h = (h ^ (h >> 27)) * 0x94d049bb133111ebULL;
+            h ^= h >> 31;
+        }
+        return 2.0 * (static_cast<double>(h >> 11) / 9007199254740992.0) - 1.0;
+    };
+    const auto smooth = [&](const Eigen::VectorXd& x) {
+        return weights.dot(Eigen::VectorXd((1.0 + (x - centre).array().square()).sqrt()));
+    };
+    const auto gradient = [&](const Eigen::VectorXd& x) {
+        const Eigen::ArrayXd y = (x - centre).array();
+        return Eigen::VectorXd(weights.array() * y / (1.0 + y.square()).sqrt());
+    };
+    dynamics::SparseMatrix hessian(2, 2);
+    NewtonProblem problem;
+    problem.objective = [&](const Eigen::VectorXd& x, double* magnitude) {
+        if (magnitude != nullptr)
+            *magnitude = smooth(x);  // the terms' size, which does not show the noise
+        return smooth(x) + noise_amplitude * noise(x);
+    };
+    problem.gradient = gradient;
+    problem.hessian = [&](const Eigen::VectorXd& x, bool) -> const dynamics::SparseMatrix& {
+        const Eigen::ArrayXd y = (x - centre).array();
+        hessian = Eigen::MatrixXd(Eigen::VectorXd(weights.array() / (1.0 + y.square()).pow(1.5)).asDiagonal()).sparseView();
+        return hessian;
+    };
+    problem.scale = weights.norm();
+    problem.what = "the noisy test problem";
+    REQUIRE(noise_amplitude > 10.0 * objective_round_off * weights.sum());
+    REQUIRE(noise_amplitude < 0.1 * objective_resolution * weights.sum());
+    NewtonOptions options;
+    options.relative_tolerance = 1e-12;
+    const auto solver = cg::make_solver("default");
+    const Eigen::Vector2d start(0.9, 0.4);
+    NewtonResult result;
+    REQUIRE_NOTHROW(result = newton_minimize(problem, start, options, *solver));
+    INFO("iterations " << result.iterations << ", last |gradient| / scale " << result.gradient_history.back());
+    CHECK(result.gradient_history.back() <= options.relative_tolerance);
+    CHECK((result.x - centre).norm() <= 1e-10);
+    CHECK(result.iterations <= 10);  // Newton's few steps, none lost to the noise
+    // Only a rise within the resolution is ever accepted: E never went up by more than that.
+    CHECK(problem.objective(result.x, nullptr) <= problem.objective(start, nullptr));
 }
 
 TEST_CASE("Newton backward Euler: the gradient and Hessian of E by finite differences, quadratic convergence",

@@ -135,11 +135,12 @@ TEST_CASE("contact only where needed: the run is the free run, bit for bit, unti
         CHECK(lowest(x) > 0.0);
     CHECK(lowest(with.frames[0].back()) < reach);
     CHECK(lowest(without.frames[0].back()) < -0.1);  // the free block fell through where the floor would be
-    // auto: linear until the first contact step, at least corotational after it.
+    // auto: linear until the first contact step, at least corotational from it on (the contact step
+    // itself too: the linear energy of the block 2 cm below its rest place is round-off).
     for (const Segment& s : with.segments[0]) {
-        CAPTURE(s.first_step, s.last_step, s.model);
-        if (s.first_step > first)
-            CHECK(s.level != Level::linear);
+        CAPTURE(s.first_step, s.last_step, s.model, first);
+        if (s.level == Level::linear)
+            CHECK(s.last_step < first);
     }
     CHECK(with.segments[0].front().level == Level::linear);
 }
