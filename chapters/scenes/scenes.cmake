@@ -1,7 +1,7 @@
 # The scenes capstone (docs/scenes.md): the scene file and runner library fem_scenes (headers in
 # chapters/scenes, sources in solutions/scenes; no exercises), the executable bin/fem_scene, its
-# tests test_scenes (ctest label scenes), and a --quick run of every gallery scene in scenes/
-# against its stored numbers (tests/scenes/expected/<scene>).
+# tests test_scenes (ctest label scenes), a --quick run of every gallery scene in scenes/ against
+# its stored numbers (tests/scenes/expected/<scene>), and every gallery scene at full size (label full).
 find_package(tomlplusplus 3 REQUIRED)  # Debian's libtomlplusplus-dev (tools/setup.sh)
 
 file(GLOB scene_sources CONFIGURE_DEPENDS ${FEM_ROOT}/solutions/scenes/*.cpp)
@@ -35,6 +35,12 @@ if(FEM_BUILD_TESTS)
                      --exe $<TARGET_FILE:fem_scene> --expected ${FEM_ROOT}/tests/scenes/expected/${scene}
                      --out ${CMAKE_BINARY_DIR}/check_runs/scenes/${scene} -- ${scene_file} --no-progress)
     set_tests_properties(scenes_quick_run_${scene} PROPERTIES LABELS "scenes;run" COST 10)  # as chNN_quick_run
+    # … and at full size, as tools/run_course.sh runs it (figures off): the run command cannot break
+    # unnoticed. Label full: the release stage runs it, the sanitizer stage leaves it out (too slow there).
+    add_test(NAME scenes_full_${scene}
+             COMMAND $<TARGET_FILE:fem_scene> ${scene_file} --no-figures --no-progress
+                     --out ${CMAKE_BINARY_DIR}/check_runs/scenes_full/${scene})
+    set_tests_properties(scenes_full_${scene} PROPERTIES LABELS "scenes;full" COST 20)
   endforeach()
 endif()
 
