@@ -53,6 +53,12 @@ int main(int argc, char** argv)
     cli.app.add_option("--duration", settings.duration, "Length of each run [s]")
         ->check(check::real(0.0, 5.0, check::Ends::open_closed))->capture_default_str();
     cli.check_options([&] {
+        // --quick runs one fixed configuration: a swept option beside it would be silently ignored.
+        if (cli.app.count("--quick") > 0)
+            for (const char* swept : {"--dhat", "--kappa", "--dt", "--tolerance"})
+                if (cli.app.count(swept) > 0)
+                    throw Error(str(swept, ": --quick runs one fixed configuration (d̂ = 1e-3 m, adaptive kappa, ",
+                                    "dt = 1/100 s, tolerance 1e-6) and would ignore it; leave out --quick or ", swept));
         for (double dt : settings.time_steps)
             try {
                 dynamics::step_count(settings.duration, dt);
