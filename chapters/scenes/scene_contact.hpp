@@ -38,8 +38,9 @@ class ContactIntegrator final : public dynamics::Integrator {
 public:
     /// own: the body's integrator without contact (backward Euler; not owned, it must outlive this);
     /// levels: the body's force model (not owned), raised to Level::corotational for a contact step
-    /// taken at Level::linear (header comment). The contact potential is built for body against obstacles with the scene's d̂ and ε_v (κ
-    /// adaptive), Newton with the scene's solver and tolerance. fem::Error as ContactPotential.
+    /// taken at Level::linear (header comment). The contact potential is built for body against
+    /// obstacles with the scene's d̂ and ε_v (κ adaptive), Newton with the scene's solver and
+    /// tolerance. fem::Error as ContactPotential.
     ContactIntegrator(dynamics::Integrator& own, SceneForces& levels, const dynamics::Body& body,
                       std::vector<std::shared_ptr<const contact::Obstacle>> obstacles, const SceneSpec& scene);
 
@@ -50,7 +51,9 @@ public:
     /// work on the body, −(B(u⁺, t + Δt) − B(uᵗ, t)) with B the step's barrier energy
     /// (ContactPotential::barrier_energy), in StepInfo::boundary_work: chapter 10's loop counts it as
     /// work put in, so the energy the barrier stores and gives back is not mistaken for dissipation
-    /// or divergence (friction's work stays the integrator's dissipation). fem::Error when a step fails.
+    /// or divergence (friction's work stays the integrator's dissipation); a level raised for the
+    /// step adds the jump of H it makes at the step's start (dynamics::apply_step_hook's booking).
+    /// fem::Error when a step fails.
     dynamics::StepInfo step(dynamics::Body& body, double time_step, dynamics::State& state) override;
 
     /// The steps so far that needed contact.

@@ -51,13 +51,23 @@ dynamics::StepInfo ContactIntegrator::step(dynamics::Body& body, double time_ste
     }
     last_contact_ = true;
     ++contact_steps_;
+    // A linear body is raised to corotational first (scene_contact.hpp), booked as chapter 10's step
+    // hook books a change of model: the jump of H at the same (u, v) is work put in, and the state's
+    // forces and elastic energy are the new model's before the step reads them.
+    double model_change = 0.0;
     if (levels_.level() == Level::linear)
-        levels_.set_level(Level::corotational);
+        model_change = dynamics::apply_step_hook(
+            [this](dynamics::Body&, const dynamics::State&, double) {
+                levels_.set_level(Level::corotational);
+                return true;
+            },
+            body, state, end);
     const Eigen::VectorXd start = state.u;
     const double start_time = state.time;
     dynamics::StepInfo info = newton_.step(body, time_step, state);
     // κ is the step's now (begin_step set it): B at the start with it, against B at the end.
-    info.boundary_work += potential_->barrier_energy(start, start_time) - potential_->barrier_energy(state.u, state.time);
+    info.boundary_work += model_change + potential_->barrier_energy(start, start_time) -
+                          potential_->barrier_energy(state.u, state.time);
     return info;
 }
 

@@ -1,6 +1,9 @@
 // Obstacles in a scene (chapter 14): the reader's fields, chapter 14's obstacles made from them, and
 // the rule that steps a body with contact only when it needs it. docs/scenes.md#obstacles
 #include "scenes/runner.hpp"
+#include "scenes/scene_contact.hpp"
+
+#include "12_hyperelastic_newton/force_models.hpp"
 
 #include "common/error.hpp"
 
@@ -13,6 +16,8 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <memory>
+#include <numbers>
 
 using namespace fem;
 using namespace fem::scenes;
@@ -221,4 +226,43 @@ TEST_CASE("a frictionless drop: the barrier's energy is booked as the floor's wo
         CAPTURE(k, before, after);
         CHECK(after - before <= 1e-12 * scale);
     }
+}
+
+TEST_CASE("auto raised to corotational for a contact step books the jump of H, as the step hook books a model change",
+          "[scenes][contact]")
+{
+    // The block turned 30° about the floor's normal, 0.5 mm above it (within d̂: contact at once), at
+    // rest, at Level::linear: the linear energy of the rotation is its ghost strain, the corotational
+    // one is zero. The contact step raises the level; the jump U_corot − U_lin is work put in at the
+    // step's start, beside the barrier's B(start) − B(end).
+    const SceneSpec scene = read_scene(drop_scene("raise_booked", "type = \"half-space\"\n"));
+    const BodySpec& spec = scene.bodies.at(0);
+    auto owned = std::make_unique<SceneForces>(spec.mesh, spec.material, "stable-neo-hookean", Level::linear);
+    SceneForces& levels = *owned;
+    dynamics::Body body(dynamics_scene(scene, spec), std::move(owned));
+    const std::unique_ptr<dynamics::Integrator> own = dynamics::make_integrator("backward-euler");
+    ContactIntegrator integrator(*own, levels, body, scene_obstacles(scene), scene);
+
+    const Eigen::Vector3d centre = spec.mesh.V.colwise().mean().transpose();
+    const Eigen::Matrix3d R = Eigen::AngleAxisd(std::numbers::pi / 6.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    Eigen::VectorXd u(3 * spec.mesh.V.rows());
+    for (Eigen::Index v = 0; v < spec.mesh.V.rows(); ++v) {
+        const Eigen::Vector3d X = spec.mesh.V.row(v).transpose();
+        u.segment<3>(3 * v) = centre + R * (X - centre) - X;
+    }
+    u(Eigen::seqN(2, spec.mesh.V.rows(), 3)).array() += 5e-4 - spec.mesh.V.col(2).minCoeff();
+    dynamics::State state = dynamics::initial_state(body, u);
+    const double linear = state.elastic_energy;
+    const double corotational = hyper::make_force_model("corotational", spec.mesh, spec.material)->energy(u);
+    REQUIRE(linear > 1e3 * std::abs(corotational));  // a jump worth booking
+    const Eigen::VectorXd start = state.u;
+    const double start_time = state.time;
+
+    const dynamics::StepInfo info = integrator.step(body, scene.time_step, state);
+    CHECK(integrator.last_contact());
+    CHECK(levels.level() == Level::corotational);
+    const double barrier = integrator.potential().barrier_energy(start, start_time) -
+                           integrator.potential().barrier_energy(state.u, state.time);
+    CAPTURE(linear, corotational, barrier, info.boundary_work);
+    CHECK(std::abs(info.boundary_work - (corotational - linear + barrier)) <= 1e-9 * linear);
 }
