@@ -66,13 +66,14 @@ struct NewtonOptions {
 /// difference of E says nothing. Near convergence that is what keeps a step from failing.
 inline constexpr double objective_round_off = 1e-13;
 
-/// How far below the size of E's terms a change of E can still be lost in E's round-off: the terms
-/// of a body's elastic energy cancel to first order in the strain (the neo-Hookean μ tr H against
-/// −μ ln J), so U's round-off can be far above objective_round_off × |U| (seen: 20× in a contact step
-/// of the bunny, ~70× in a resting block at small Δt). Where both E's change and the decrease Armijo
-/// asks for are below this × its terms, the line search decides with slopes instead: E(x + αd) − E(x) ≈ α (∇Eᵀd at 0 + ∇Eᵀd at α)/2, the
-/// trapezoid rule, exact for a quadratic E, from gradients, which hold no such cancelling constant
-/// (Hager and Zhang's approximate Wolfe condition, 2005). docs/12_hyperelastic_newton.md#newton-with-line-search
+/// How far below the size of E's terms a change of E can be lost in E's round-off: the terms of a
+/// body's elastic energy cancel to first order in the strain (the neo-Hookean μ tr H against −μ ln J),
+/// so U's round-off can be far above objective_round_off × |U| (seen: 20× in a contact step of the
+/// bunny, ~70× in a resting block at small Δt). Where both E's change and the decrease Armijo asks
+/// for are below this × its terms, E's test passes or fails by its round-off, so the line search
+/// decides with slopes instead: E(x + αd) − E(x) ≈ α (∇E(x)ᵀd + ∇E(x + αd)ᵀd)/2, the trapezoid
+/// rule, exact for a quadratic E, from gradients, which hold no cancelling constant (Hager and
+/// Zhang's approximate Wolfe condition, 2005). docs/12_hyperelastic_newton.md#newton-with-line-search
 inline constexpr double objective_resolution = 1e-10;
 
 /// The smallest gradient norm newton_minimize can measure: √(smallest normal double) ≈ 1.5·10⁻¹⁵⁴.
@@ -186,7 +187,8 @@ struct NewtonResult {
 /// Newton's method with a backtracking (Armijo) line search from x₀ (where the objective must be
 /// finite): solve H d = −∇ with `solver`, the Hessian chosen as options.hessian says, take the
 /// largest α = shrinkᵏ with objective(x + αd) ≤ objective(x) + c α ∇ᵀd (+ its round-off; where the
-/// change is below objective_resolution × E's terms, the same test by the trapezoid rule on slopes), until
+/// change is below objective_resolution × E's terms, the same test by the trapezoid rule on
+/// slopes), until
 /// ‖∇‖ ≤ tolerance × scale (or ≤ smallest_measurable_norm). fem::Error naming problem.what when
 /// the cap is reached, the line search fails, or no Hessian gives a descent direction. When the
 /// problem has a largest_step, the trials start at α = largest_step(x, d) instead of 1.

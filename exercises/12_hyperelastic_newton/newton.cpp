@@ -204,15 +204,15 @@ NewtonResult newton_minimize(const NewtonProblem& problem, Eigen::VectorXd x0, c
             // E is a sum of terms that cancel; differences below its round-off carry no information.
             const double noise = objective_round_off * magnitude;
             // EXERCISE 12.9 (line_search): see docs/12_hyperelastic_newton.md#newton-with-line-search
-            // HINT: Armijo backtracking (docs/12_hyperelastic_newton.md#newton-with-line-search): `alpha` arrives as the
-            // HINT: first trial (1, or the largest safe step: do not reset it); shrink it by options.shrink until E at
-            // HINT: x + α d lies below `start` by at least options.armijo's share of the decrease `slope` (∇Eᵀd < 0)
-            // HINT: predicts for that α, `noise` (E's round-off) allowed; where both E's change and the decrease
-            // HINT: predicted are below objective_resolution × `magnitude`, decide by the trapezoid rule on the
-            // HINT: slopes ∇Eᵀd at x and at x + α d instead (E's difference is round-off there). The notes' target leaves α out: their fourth
-            // HINT: slip. problem.objective(y, &magnitude) is +∞ where the material is undefined. Throw fem::Error once α
-            // HINT: falls below options.smallest_step. The accepted trial's E and magnitude must end in `objective` and
-            // HINT: `magnitude` (the next iteration starts there), its α in `alpha`.
+            // HINT: Armijo backtracking (docs/12_hyperelastic_newton.md#newton-with-line-search): `alpha` arrives as
+            // HINT: the first trial (1, or the largest safe step: do not reset it); shrink it by options.shrink until E
+            // HINT: at x + α d lies below `start` by at least options.armijo's share of the decrease `slope` (∇Eᵀd < 0)
+            // HINT: predicts for that α, `noise` (E's round-off) allowed. Where both E's change and that decrease are
+            // HINT: below objective_resolution × `magnitude`, E's test is round-off either way: decide by the trapezoid
+            // HINT: rule on the slopes ∇Eᵀd at x and at x + α d instead. The notes' target leaves α out: their fourth
+            // HINT: slip. problem.objective(y, &magnitude) is +∞ where the material is undefined. Throw fem::Error once
+            // HINT: α falls below options.smallest_step. The accepted trial's E and magnitude must end in `objective`
+            // HINT: and `magnitude` (the next iteration starts there), its α in `alpha`.
             throw fem::NotImplemented("12.9", "line_search", "docs/12_hyperelastic_newton.md#newton-with-line-search");
         }
         result.step_lengths.push_back(alpha);

@@ -334,7 +334,9 @@ TEST_CASE("the line search: every accepted step decreases E by at least c alpha 
     const auto curvature = [&](const Eigen::VectorXd& x) {  // the Hessian's diagonal (it is diagonal)
         return Eigen::VectorXd(weights.array() / (1.0 + x.array().square()).pow(1.5));
     };
-    std::vector<Eigen::VectorXd> iterates;  // newton_minimize asks for the gradient once per iterate
+    // The iterates in order: newton_minimize asks for the Hessian once per iterate it leaves (the
+    // exact one is positive definite here), and the last is the result.
+    std::vector<Eigen::VectorXd> iterates;
     dynamics::SparseMatrix hessian(2, 2);
     NewtonProblem problem;
     problem.objective = [&](const Eigen::VectorXd& x, double* magnitude) {
@@ -342,11 +344,9 @@ TEST_CASE("the line search: every accepted step decreases E by at least c alpha 
             *magnitude = energy(x);
         return energy(x);
     };
-    problem.gradient = [&](const Eigen::VectorXd& x) {
-        iterates.push_back(x);
-        return gradient(x);
-    };
+    problem.gradient = gradient;
     problem.hessian = [&](const Eigen::VectorXd& x, bool) -> const dynamics::SparseMatrix& {
+        iterates.push_back(x);
         hessian = Eigen::MatrixXd(curvature(x).asDiagonal()).sparseView();
         return hessian;
     };
@@ -359,6 +359,7 @@ TEST_CASE("the line search: every accepted step decreases E by at least c alpha 
     std::string failure;  // a wrong line search may end in the iteration cap: the steps below say why
     try {
         const NewtonResult result = newton_minimize(problem, Eigen::Vector2d(0.9, 2.0), options, *solver);
+        iterates.push_back(result.x);
         CHECK(result.gradient_history.back() <= options.relative_tolerance);
         CHECK(result.step_lengths.size() + 1 == iterates.size());
     } catch (const Error& e) {
@@ -395,8 +396,7 @@ TEST_CASE("the line search where E's differences are round-off: the slopes decid
     // of a body's energy whose terms cancel (a resting or translated body), here η = 1e-9, 100 times
     // what objective_round_off × E's terms allows and 1/100 of objective_resolution × them. The
     // gradient is exact. Near the minimum Newton's decrease (~|∇E|²) falls far below η: E's Armijo
-    // test then passes or fails by the noise's draw, and only the trapezoid rule on the slopes can
-    // accept the full steps that converge.
+    // test then passes or fails by the noise's draw, and only the slopes can tell a good step.
     const Eigen::Vector2d weights(100.0, 1.0), centre(0.3, -0.7);
     const double noise_amplitude = 1e-9;
     const auto noise = [&](const Eigen::VectorXd& x) {  // splitmix64 of x's bits, mapped to [−1, 1]
@@ -418,35 +418,75 @@ TEST_CASE("the line search where E's differences are round-off: the slopes decid
         const Eigen::ArrayXd y = (x - centre).array();
         return Eigen::VectorXd(weights.array() * y / (1.0 + y.square()).sqrt());
     };
-    dynamics::SparseMatrix hessian(2, 2);
-    NewtonProblem problem;
-    problem.objective = [&](const Eigen::VectorXd& x, double* magnitude) {
-        if (magnitude != nullptr)
-            *magnitude = smooth(x);  // the terms' size, which does not show the noise
-        return smooth(x) + noise_amplitude * noise(x);
-    };
-    problem.gradient = gradient;
-    problem.hessian = [&](const Eigen::VectorXd& x, bool) -> const dynamics::SparseMatrix& {
-        const Eigen::ArrayXd y = (x - centre).array();
-        hessian = Eigen::MatrixXd(Eigen::VectorXd(weights.array() / (1.0 + y.square()).pow(1.5)).asDiagonal()).sparseView();
-        return hessian;
-    };
-    problem.scale = weights.norm();
-    problem.what = "the noisy test problem";
     REQUIRE(noise_amplitude > 10.0 * objective_round_off * weights.sum());
     REQUIRE(noise_amplitude < 0.1 * objective_resolution * weights.sum());
-    NewtonOptions options;
-    options.relative_tolerance = 1e-12;
-    const auto solver = cg::make_solver("default");
-    const Eigen::Vector2d start(0.9, 0.4);
-    NewtonResult result;
-    REQUIRE_NOTHROW(result = newton_minimize(problem, start, options, *solver));
-    INFO("iterations " << result.iterations << ", last |gradient| / scale " << result.gradient_history.back());
-    CHECK(result.gradient_history.back() <= options.relative_tolerance);
-    CHECK((result.x - centre).norm() <= 1e-10);
-    CHECK(result.iterations <= 10);  // Newton's few steps, none lost to the noise
-    // Only a rise within the resolution is ever accepted: E never went up by more than that.
-    CHECK(problem.objective(result.x, nullptr) <= problem.objective(start, nullptr));
+    // Newton with the Hessian times hessian_scale (1: exact; 1/3: a model whose full steps overshoot
+    // threefold, as a stale factor's can); the iterates in order, recorded where the Hessian is asked.
+    const auto minimise = [&](double hessian_scale, const Eigen::Vector2d& start, std::vector<Eigen::VectorXd>& iterates) {
+        dynamics::SparseMatrix hessian(2, 2);
+        NewtonProblem problem;
+        problem.objective = [&](const Eigen::VectorXd& x, double* magnitude) {
+            if (magnitude != nullptr)
+                *magnitude = smooth(x);  // the terms' size, which does not show the noise
+            return smooth(x) + noise_amplitude * noise(x);
+        };
+        problem.gradient = gradient;
+        problem.hessian = [&](const Eigen::VectorXd& x, bool) -> const dynamics::SparseMatrix& {
+            iterates.push_back(x);
+            const Eigen::ArrayXd y = (x - centre).array();
+            const Eigen::VectorXd diagonal = hessian_scale * weights.array() / (1.0 + y.square()).pow(1.5);
+            hessian = Eigen::MatrixXd(diagonal.asDiagonal()).sparseView();
+            return hessian;
+        };
+        problem.scale = weights.norm();
+        problem.what = "the noisy test problem";
+        NewtonOptions options;
+        options.relative_tolerance = 1e-12;
+        const auto solver = cg::make_solver("default");
+        NewtonResult result = newton_minimize(problem, start, options, *solver);
+        iterates.push_back(result.x);
+        return result;
+    };
+
+    SECTION("the exact Hessian: Newton's quadratic convergence, none of it lost to the noise")
+    {
+        std::vector<Eigen::VectorXd> iterates;
+        NewtonResult result;
+        REQUIRE_NOTHROW(result = minimise(1.0, Eigen::Vector2d(0.9, 0.4), iterates));
+        INFO("iterations " << result.iterations << ", last |gradient| / scale " << result.gradient_history.back());
+        CHECK(result.gradient_history.back() <= 1e-12);
+        CHECK((result.x - centre).norm() <= 1e-10);
+        CHECK(result.iterations <= 10);
+    }
+    SECTION("a Hessian a third of the true one, from where every change is below the resolution: each "
+            "accepted step passes Armijo by the trapezoid rule, and the overshooting full steps are refused")
+    {
+        const Eigen::Vector2d start = centre + Eigen::Vector2d(1e-7, -2e-7);
+        std::vector<Eigen::VectorXd> iterates;
+        std::string failure;  // a wrong line search may end in the iteration cap: the steps below say why
+        try {
+            const NewtonResult result = minimise(1.0 / 3.0, start, iterates);
+            CHECK(result.gradient_history.back() <= 1e-12);
+        } catch (const Error& e) {
+            failure = e.what();
+        }
+        REQUIRE(iterates.size() > 2);
+        for (std::size_t k = 0; k + 1 < iterates.size(); ++k) {
+            const Eigen::VectorXd step = iterates[k + 1] - iterates[k];
+            const double slope_start = gradient(iterates[k]).dot(step), slope_end = gradient(iterates[k + 1]).dot(step);
+            // α d over the direction the 1/3 Hessian gives: 1 for a full step (3 Newton steps).
+            const Eigen::VectorXd full = -3.0 * gradient(iterates[k]).cwiseQuotient(Eigen::VectorXd(
+                                             weights.array() / (1.0 + (iterates[k] - centre).array().square()).pow(1.5)));
+            const double alpha = step.dot(full) / full.squaredNorm();
+            INFO("iteration " << k << ": alpha " << alpha << ", grad^T (alpha d) at x " << slope_start << " and at x + alpha d "
+                              << slope_end << "; Armijo by the trapezoid rule asks (start + end)/2 <= c * start = "
+                              << NewtonOptions{}.armijo * slope_start << " (the end slope at x + alpha d, not at x)");
+            CHECK(0.5 * (slope_start + slope_end) <= NewtonOptions{}.armijo * slope_start);
+            CHECK(alpha < 1.0);  // every full step overshoots threefold: refused
+        }
+        INFO(failure);
+        CHECK(failure.empty());
+    }
 }
 
 TEST_CASE("Newton backward Euler: the gradient and Hessian of E by finite differences, quadratic convergence",
