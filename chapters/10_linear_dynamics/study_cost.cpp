@@ -140,8 +140,9 @@ void cost_study(const RunContext& run, const Settings& settings)
     peers.print(std::cout);
     peers.write_csv(run.file("peers_table.csv"));
 
-    // Why: the whole step on 1 and 2 threads (the threads goal, 1.7× on 2 cores): the products of the right-hand side and the
-    // two triangular solves with the factor made once; the same bits on any number of threads.
+    // Why: the whole step on 1 and 2 threads (the threads goal, 1.7× on 2 cores): the products of the
+    // right-hand side and the two triangular solves with the factor made once; the same bits on any
+    // number of threads.
     {
         const Scene scene = cantilever_scene(settings.beam, settings.cost_cells.back());
         Body body(scene);

@@ -278,9 +278,10 @@ void cost_study(const RunContext& run, const Settings& settings)
     solvers.print(std::cout);
     solvers.write_csv(run.file("solvers_table.csv"));
 
-    // Why: the whole step on 1 and 2 threads (the threads goal, 1.7× on 2 cores): rotations, forces, K_R and the step matrix,
-    // the factorization and the solve, the same bits on any number of threads. The integrator is
-    // kept across calls: "refactor" factors afresh every step, reusing only the symbolic analysis.
+    // Why: the whole step on 1 and 2 threads (the threads goal, 1.7× on 2 cores): rotations, forces, K_R and
+    // the step matrix, the factorization and the solve, the same bits on any number of threads. The
+    // integrator is kept across calls: "refactor" factors afresh every step, reusing only the symbolic
+    // analysis.
     {
         const dynamics::Scene scene = dynamics::cantilever_scene(settings.sofa, settings.cost_cells.back(), 1.0);
         dynamics::Body body(scene, force_model("corotational", scene));

@@ -226,12 +226,12 @@ void cost_study(const RunContext& run, const Settings& settings)
     parts.print(std::cout);
     parts.write_csv(run.file("parts_table.csv"));
 
-    // Why: the whole Newton step on 1 and 2 threads (the threads goal, 1.7× on 2 cores): element loops, assembly, the
-    // factorizations, the solves, the line search; the same bits on any number of threads. The
-    // route that factors afresh at every iteration does the same work at every call (the ordering
-    // and symbolic analysis, made by the first call, are kept as in a running simulation). The
-    // scenes' default keeps its frozen factor from step to step, so its calls would not repeat
-    // the same work; it runs the same parallel kernels (element loops, factorization, solves).
+    // Why: the whole Newton step on 1 and 2 threads (the threads goal, 1.7× on 2 cores): element loops,
+    // assembly, the factorizations, the solves, the line search; the same bits on any number of threads. The
+    // route that factors afresh at every iteration does the same work at every call (the ordering and
+    // symbolic analysis, made by the first call, are kept as in a running simulation). The scenes' default
+    // keeps its frozen factor from step to step, so its calls would not repeat the same work; it runs the
+    // same parallel kernels (element loops, factorization, solves).
     {
         const dynamics::Scene scene =
             dynamics::cantilever_scene(dynamics::Material{1e6, 0.45, 1100.0}, settings.cost_cells.back(), 1.0);

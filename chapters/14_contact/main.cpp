@@ -57,8 +57,8 @@ int main(int argc, char** argv)
         if (cli.app.count("--quick") > 0)
             for (const char* swept : {"--dhat", "--kappa", "--dt", "--tolerance"})
                 if (cli.app.count(swept) > 0)
-                    throw Error(str(swept, ": --quick runs one fixed configuration (d̂ = 1e-3 m, adaptive kappa, ",
-                                    "dt = 1/100 s, tolerance 1e-6) and would ignore it; leave out --quick or ", swept));
+                    throw Error(str(swept, ": --quick runs its one fixed configuration and would ignore it; ",
+                                    "leave out --quick or ", swept));
         for (double dt : settings.time_steps)
             try {
                 dynamics::step_count(settings.duration, dt);

@@ -1,6 +1,7 @@
 // fem_scene: runs a scene file (scenes/*.toml) with chapters 10–14 — a body, its material and
 // model, what is pinned and how it moves, what pushes, for how long — and writes a .pvd time series,
-// PNG frames, a video, the energies and the cost of each step. Read chapters 10–12 first (13 and 14 for skins and obstacles).
+// PNG frames, a video, the energies and the cost of each step. Read chapters 10–12 first (13 and 14
+// for skins and obstacles).
 //
 // Sample runs:
 //   fem_scene scenes/cantilever.toml                       the scene as written
