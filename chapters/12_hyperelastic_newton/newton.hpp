@@ -138,6 +138,16 @@ public:
         (void)u, (void)du;
         return 1.0;
     }
+    /// The velocity v (3n) the step's search starts from before it tries the last velocity: the
+    /// step's motion from qᵗ to qᵗ + Δt v must be one the potential allows (P finite at the end,
+    /// nothing it guards crossed on the way; its pinned entries are replaced by the pins' own).
+    /// Called after begin_step. Default: v = 0, the positions of the step's start.
+    virtual Eigen::VectorXd start_velocity(const dynamics::Body& body, const dynamics::State& state,
+                                           double time_step) const
+    {
+        (void)body, (void)time_step;
+        return Eigen::VectorXd::Zero(state.v.size());
+    }
 };
 
 /// E(v) of the header comment for the full velocity v (3n), with model's energy at qᵗ + Δt v
@@ -214,7 +224,9 @@ public:
     int order() const override { return 1; }
     /// One step: Newton iterations from v = q̇ᵗ (or v = 0 when E(q̇ᵗ) = +∞) on the free dofs until
     /// ‖∇E‖ ≤ tol · momentum_scale, the pinned dofs held at v = ṽ_p (Body::pin_velocity), so
-    /// q⁺_p = qᵗ_p + Δt ṽ_p. StepInfo::damping_work = Δt v⁺ᵀ D v⁺ (≥ 0) [J]; when the pins move,
+    /// q⁺_p = qᵗ_p + Δt ṽ_p. With a potential: from the potential's start_velocity v₀, moved toward
+    /// q̇ᵗ as far as its largest_safe_step allows, and the scale raised by Δt ‖∇P‖ at that start.
+    /// StepInfo::damping_work = Δt v⁺ᵀ D v⁺ (≥ 0) [J]; when the pins move,
     /// StepInfo::boundary_work = Δt ṽ_pᵀ r_p = ṽ_pᵀ ∇E(v⁺) (the reactions r_p = ∇E_p(v⁺)/Δt) [J]. fem::Error (state
     /// unchanged) when the cap is reached, the line search fails, or d is no descent direction (an
     /// indefinite Hessian: use a projection).

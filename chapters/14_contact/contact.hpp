@@ -24,6 +24,7 @@
 #include <Eigen/Core>
 
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace fem::contact {
@@ -87,6 +88,16 @@ public:
     dynamics::SparseMatrix hessian(const Eigen::VectorXd& u) const override;
     /// min(1, safety × the earliest time of impact of any surface vertex's path x_v + s·Δx_v).
     double largest_safe_step(const Eigen::VectorXd& u, const Eigen::VectorXd& du) const override;
+    /// The step's start velocity (3n) for Newton: a stage's start (stage_next_step), else the first of v = 0 (the body stays put) and
+    /// v = w_o (the body carried along with moving obstacle o, in the obstacles' order; the pins
+    /// keep their own velocity) whose motion reaches no obstacle: every surface vertex's path
+    /// relative to every obstacle o', from x_v at t to x_v + Δt v_v at t + Δt, stays outside o'
+    /// (time_of_impact(x_v, Δt (v_v − w_o'), t) > 1). So an obstacle may move any distance in a
+    /// step. fem::Error "the obstacles leave the body no room", naming for each candidate a vertex
+    /// and the obstacle that reaches it, when none does (a body squeezed between obstacles).
+    /// docs/14_contact.md#moving-obstacles
+    Eigen::VectorXd start_velocity(const dynamics::Body& body, const dynamics::State& state,
+                                   double time_step) const override;
 
     /// The barrier's part of P: Σ_v Σ_o Σ_p κ b(d_{o,p}(x_v, time)) with the current step's κ [J] (+∞ when
     /// some surface vertex has d ≤ 0). Its change over a step, with the obstacles at the step's start
@@ -94,16 +105,35 @@ public:
     double barrier_energy(const Eigen::VectorXd& u, double time) const;
     /// The barrier's force on every vertex, −κ b'(d) ∇d summed over obstacles (3n) [N].
     Eigen::VectorXd barrier_forces(const Eigen::VectorXd& u) const;
+    /// The work the moving obstacles do on the body over the step by carrying their forces along:
+    /// Δt Σ_o w_o · F_o(u) [J], F_o the force of obstacle o's barrier and friction pairs on the body
+    /// at u (3n; the step's end: backward Euler's quadrature). With the change of the barrier's
+    /// energy, −(B(u⁺, t + Δt) − B(uᵗ, t)), it is the work of the barrier's forces on the body
+    /// (∂B/∂t = −∇B·w); 0 when no obstacle moves. docs/14_contact.md#moving-obstacles
+    double obstacle_work(const Eigen::VectorXd& u, double time_step) const;
     /// The smallest d_o(x_v) over surface vertices and obstacles at the step's end time [m].
     double smallest_distance(const Eigen::VectorXd& u) const;
 
     /// Whether the step from u at time t to u_end at t_end (3n each) is out of contact: every surface
     /// vertex is at d ≥ d̂ from every obstacle at its start (the obstacle at t and at t_end) and at its
-    /// end (at t_end), and no straight path x_v + s (x_v⁺ − x_v), s ∈ [0, 1], meets an obstacle held
-    /// at t_end. Then P and ∇P are zero at u_end and no friction pair forms at u: the step solved
+    /// end (at t_end), and no straight path meets an obstacle: x_v + s (x_v⁺ − x_v − (t_end − t) w_o),
+    /// s ∈ [0, 1], the vertex's path relative to the obstacle, against the obstacle held at t. Then P and ∇P are zero at u_end and no friction pair forms at u: the step solved
     /// without the potential solves it with the potential too (the scenes runner's rule, docs/scenes.md#obstacles).
     /// fem::Error on the sizes.
     bool out_of_contact(const Eigen::VectorXd& u, double time, const Eigen::VectorXd& u_end, double end_time) const;
+
+    /// Whether some start of the step from state (start_velocity's candidates, the obstacles at
+    /// t + Δt) reaches no obstacle: else contact_step takes the step in stages.
+    bool has_free_start(const dynamics::Body& body, const dynamics::State& state, double time_step) const;
+    /// The largest fraction f ≤ 1 of the step's obstacle motion (Δt w_o) that, beyond the fraction
+    /// `from` already made, reaches no surface vertex held at u (3n): f = from + safety s* (1 − from),
+    /// s* the earliest time of impact of the paths x_v − s (1 − from) Δt w_o, s ∈ [0, 1], against each
+    /// obstacle o held at time + from·Δt; 1 when none reaches (time: the step's start t).
+    double obstacle_advance(const Eigen::VectorXd& u, double time, double time_step, double from) const;
+    /// Holds the obstacles of the next step (the next begin_step) at t + fraction·Δt instead of t + Δt,
+    /// and starts its search from the velocity start (3n) instead of start_velocity's candidates:
+    /// the stages of contact_step. fem::Error for a fraction outside (0, 1] or a start of wrong size.
+    void stage_next_step(double fraction, const Eigen::VectorXd& start);
 
     /// Lags the next step's friction at u (3n) instead of the step's start: λ and T of each pair
     /// from the vertex at u (the obstacles at the step's end), the sticking point still x_vᵗ + Δt w_o.
@@ -119,6 +149,14 @@ public:
 
 private:
     Eigen::Vector3d position(const Eigen::VectorXd& u, int vertex) const;
+    /// The first of start_velocity's candidates that reaches no obstacle held at obstacle_time, or an
+    /// empty vector (blocked, when given, receives each candidate's first vertex and obstacle met).
+    Eigen::VectorXd free_start(const dynamics::Body& body, const dynamics::State& state, double time_step,
+                               double obstacle_time, std::string* blocked) const;
+    /// −κ Σ_p b'(d_p) ∇d_p: the barrier force of one obstacle on the surface vertex at x, time time_.
+    Eigen::Vector3d barrier_force(const Obstacle& obstacle, const Eigen::Vector3d& x) const;
+    /// −μλ f₁(y)/y T s: the friction force of one pair on its vertex at u.
+    Eigen::Vector3d friction_force(const FrictionPair& pair, const Eigen::VectorXd& u) const;
 
     std::vector<std::shared_ptr<const Obstacle>> obstacles_;
     ContactOptions options_;
@@ -130,6 +168,8 @@ private:
     bool stiffness_set_ = false;
     std::vector<FrictionPair> pairs_;
     Eigen::VectorXd lag_u_;  // empty: lag at the step's start
+    double next_fraction_ = 1.0, fraction_ = 1.0;  // of the step's obstacle motion: the next step's, this one's
+    Eigen::VectorXd next_start_, start_;           // the start velocity set for the next step, this one's (empty: none)
 };
 
 /// The friction lag iterated to convergence (step_with_friction_updates with updates = 0) stops when
@@ -149,6 +189,28 @@ inline constexpr int most_friction_updates = 20;
 dynamics::StepInfo step_with_friction_updates(hyper::NewtonBackwardEuler& newton, ContactPotential& contact,
                                               dynamics::Body& body, double time_step, dynamics::State& state,
                                               int updates, int* solves = nullptr);
+
+/// contact_step gives up (fem::Error "no room") after this many stages of one step.
+inline constexpr int most_obstacle_stages = 200;
+
+/// One backward Euler step with contact as a body's integrator takes it: step_with_friction_updates,
+/// in stages when no start of the step is free (start_velocity: a body that must be compressed or
+/// pushed by obstacles moving more than its gaps in one step) — the obstacles moved part of the way
+/// (obstacle_advance), the step solved with them there, its solution the start of the next stage,
+/// until they stand at t + Δt, where the last stage solves the step itself (fem::Error "no room"
+/// when a stage advances them by less than 10⁻⁹ of the step, after most_obstacle_stages, or when a
+/// stage cannot be solved);
+/// its StepInfo::boundary_work raised by the obstacles' work on the body, −(B(u⁺, t + Δt) − B(uᵗ, t))
+/// + obstacle_work(u⁺, Δt) (B: barrier_energy with the step's κ), so that chapter 10's energy books,
+/// which do not hold B, count the barrier's store and the moving obstacles' push as work put in
+/// (friction's sliding stays dissipation). Only surface vertices carry the barrier, so the step is
+/// refused (fem::Error naming the tet and its volume, the state left at the step's start) when it
+/// would turn a tet of positive volume at its start inside out: an impact or a squeeze the mesh
+/// cannot resolve. docs/14_contact.md#what-is-guaranteed
+/// stages (when set) receives their number (1: the step was solved at once).
+dynamics::StepInfo contact_step(hyper::NewtonBackwardEuler& newton, ContactPotential& contact, dynamics::Body& body,
+                                double time_step, dynamics::State& state, int updates = 1, int* solves = nullptr,
+                                int* stages = nullptr);
 
 /// The tangent-plane basis of a unit normal n: T (3×2) with orthonormal columns ⟂ n.
 Eigen::Matrix<double, 3, 2> tangent_basis(const Eigen::Vector3d& normal);

@@ -16,6 +16,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace fem::contact {
 
@@ -47,9 +48,12 @@ struct BlockScene {
     std::unique_ptr<hyper::NewtonBackwardEuler> integrator;
     dynamics::State state;
 
-    /// One backward Euler step with contact (Δt and friction updates of the settings); solves (when
+    /// One backward Euler step with contact (contact_step, with the settings' Δt and friction updates); solves (when
     /// set) receives the number of solves it took.
     dynamics::StepInfo step(int* solves = nullptr);
+    /// Puts obstacles in place of the floor: a new contact potential with options, set on the
+    /// integrator (fem::Error as ContactPotential).
+    void set_obstacles(std::vector<std::shared_ptr<const Obstacle>> obstacles, const ContactOptions& options);
     double time_step = 0.0;
     int friction_updates = 1;
 };

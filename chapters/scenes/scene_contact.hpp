@@ -47,12 +47,11 @@ public:
     std::string name() const override { return last_contact_ ? newton_.name() + " with contact" : own_.name(); }
     int order() const override { return 1; }
     bool is_explicit() const override { return !last_contact_ && own_.is_explicit(); }
-    /// One step from state (time t) to t + Δt (header comment). A contact step books the obstacles'
-    /// work on the body, −(B(u⁺, t + Δt) − B(uᵗ, t)) with B the step's barrier energy
-    /// (ContactPotential::barrier_energy), in StepInfo::boundary_work: chapter 10's loop counts it as
-    /// work put in, so the energy the barrier stores and gives back is not mistaken for dissipation
-    /// or divergence (friction's work stays the integrator's dissipation); a level raised for the
-    /// step adds the jump of H it makes at the step's start (dynamics::apply_step_hook's booking).
+    /// One step from state (time t) to t + Δt (header comment). A contact step is chapter 14's
+    /// contact::contact_step, which books the obstacles' work on the body in StepInfo::boundary_work
+    /// (the barrier's store and the moving obstacles' push: chapter 10's loop counts it as work put
+    /// in, so it is not mistaken for dissipation or divergence); a level raised for the step adds the
+    /// jump of H it makes at the step's start (dynamics::apply_step_hook's booking).
     /// fem::Error when a step fails.
     dynamics::StepInfo step(dynamics::Body& body, double time_step, dynamics::State& state) override;
 

@@ -62,12 +62,8 @@ dynamics::StepInfo ContactIntegrator::step(dynamics::Body& body, double time_ste
                 return true;
             },
             body, state, end);
-    const Eigen::VectorXd start = state.u;
-    const double start_time = state.time;
-    dynamics::StepInfo info = newton_.step(body, time_step, state);
-    // κ is the step's now (begin_step set it): B at the start with it, against B at the end.
-    info.boundary_work += model_change + potential_->barrier_energy(start, start_time) -
-                          potential_->barrier_energy(state.u, state.time);
+    dynamics::StepInfo info = contact::contact_step(newton_, *potential_, body, time_step, state);
+    info.boundary_work += model_change;
     return info;
 }
 
