@@ -118,7 +118,7 @@ PrimitiveFunction distance_to_span(const Points& x, const Eigen::Vector4d& base,
         for (int m = 0; m < k; ++m)
             B.block<3, 1>(3 * i, m) = c[i] * v.col(m) + coefficients(m, i) * w;
     }
-    d.hessian -= 2.0 * B * inverse_gram * B.transpose();
+    d.hessian.noalias() -= (2.0 * B * inverse_gram).lazyProduct(B.transpose());  // (lazy: no GEMM for 12×2×12)
     return d;
 }
 
@@ -281,25 +281,24 @@ PrimitiveFunction edge_edge_mollifier(const Eigen::Vector3d& ea0, const Eigen::V
     const double ratio = c / threshold;
     m.value = ratio * (2.0 - ratio);
     const double first = 2.0 / threshold * (1.0 - ratio), second = -2.0 / (threshold * threshold);
-    // c = |e_a|²|e_b|² − (e_a·e_b)² (Lagrange) as a function of (e_a, e_b), then e_a = ea1 − ea0 and
-    // e_b = eb1 − eb0 by the selector S (6×12): ∇c = Sᵀ ∇_e c, ∇²c = Sᵀ ∇²_e c S.
+    // c = |e_a|²|e_b|² − (e_a·e_b)² (Lagrange) as a function of e = (e_a, e_b), then e_a = ea1 − ea0 and
+    // e_b = eb1 − eb0: point i's block of ∇c is sign_i ∇_e c of its edge, block (i, j) of ∇²c is
+    // sign_i sign_j ∇²_e c of their edges, sign = −1 at a first end, +1 at a second.
     const double A = ea.squaredNorm(), B = ea.dot(eb), C = eb.squaredNorm();
     const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
-    Eigen::Matrix<double, 6, 1> grad_e;
-    grad_e << 2.0 * C * ea - 2.0 * B * eb, 2.0 * A * eb - 2.0 * B * ea;
-    Eigen::Matrix<double, 6, 6> hess_e;
-    hess_e.topLeftCorner<3, 3>() = 2.0 * C * I - 2.0 * eb * eb.transpose();
-    hess_e.bottomRightCorner<3, 3>() = 2.0 * A * I - 2.0 * ea * ea.transpose();
-    hess_e.topRightCorner<3, 3>() = 4.0 * ea * eb.transpose() - 2.0 * eb * ea.transpose() - 2.0 * B * I;
-    hess_e.bottomLeftCorner<3, 3>() = hess_e.topRightCorner<3, 3>().transpose();
-    Eigen::Matrix<double, 6, 12> S = Eigen::Matrix<double, 6, 12>::Zero();
-    S.block<3, 3>(0, 0) = -I;
-    S.block<3, 3>(0, 3) = I;
-    S.block<3, 3>(3, 6) = -I;
-    S.block<3, 3>(3, 9) = I;
-    const Vector12d grad_c = S.transpose() * grad_e;
+    const std::array<Eigen::Vector3d, 2> grad_e{2.0 * C * ea - 2.0 * B * eb, 2.0 * A * eb - 2.0 * B * ea};
+    const Eigen::Matrix3d across = 4.0 * ea * eb.transpose() - 2.0 * eb * ea.transpose() - 2.0 * B * I;
+    const std::array<std::array<Eigen::Matrix3d, 2>, 2> hess_e{
+        {{2.0 * C * I - 2.0 * eb * eb.transpose(), across}, {across.transpose(), 2.0 * A * I - 2.0 * ea * ea.transpose()}}};
+    const std::array<double, 4> sign{-1.0, 1.0, -1.0, 1.0};
+    Vector12d grad_c;
+    for (int i = 0; i < 4; ++i) {
+        grad_c.segment<3>(3 * i) = sign[i] * grad_e[i / 2];
+        for (int j = 0; j < 4; ++j)
+            m.hessian.block<3, 3>(3 * i, 3 * j) = first * sign[i] * sign[j] * hess_e[i / 2][j / 2];
+    }
     m.gradient = first * grad_c;
-    m.hessian = second * grad_c * grad_c.transpose() + first * S.transpose() * hess_e * S;
+    m.hessian.noalias() += second * grad_c * grad_c.transpose();
     return m;
 }
 
