@@ -7,9 +7,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <initializer_list>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace fem::contact {
 
@@ -72,20 +72,33 @@ void check_edges(const Points& x, const char* what)
     require_edge(x[2], x[3], "b", "eb0", "eb1", what);
 }
 
+/// A type's form: the point w₀ = x_i − x_j and the directions x_l − x_m (0, 1 or 2), as the
+/// stacked points' indices {i, j}, {l, m}.
+struct SpanForm {
+    std::array<int, 2> point;
+    std::vector<std::array<int, 2>> directions;
+};
+
+/// x_i − x_j as coefficients of the stacked points.
+Eigen::Vector4d difference(const std::array<int, 2>& ij)
+{
+    return Eigen::Vector4d::Unit(ij[0]) - Eigen::Vector4d::Unit(ij[1]);
+}
+
 /// One type's squared distance d², from the point w₀ = Σ_i base_i x_i to the span of the directions
-/// v_k = Σ_i directions_k,i x_i (0, 1 or 2 of them): min over y of F = |w(y)|², w(y) = Σ_i c_i(y) x_i,
+/// v_k = Σ_i directions_k,i x_i (0, 1 or 2 of them; base and directions as the form's differences): min over y of F = |w(y)|², w(y) = Σ_i c_i(y) x_i,
 /// c(y) = base + Σ_k y_k directions_k. Its value by the closed form of the header (|w₀|²,
 /// |w₀ × v₁|²/|v₁|², (w₀·(v₁ × v₂))²/|v₁ × v₂|²); its derivatives by the implicit function theorem
 /// at the minimiser y (G y = −Vᵀw₀, G = VᵀV), where w = w(y) ⟂ every v_k:
 ///   ∇d² = F_x, block i = 2 c_i w;
 ///   ∇²d² = F_xx − F_xy F_yy⁻¹ F_yx = 2 (c cᵀ) ⊗ I − 2 B G⁻¹ Bᵀ,  B_k's block i = c_i v_k + directions_k,i w.
-PrimitiveFunction distance_to_span(const Points& x, const Eigen::Vector4d& base,
-                                   std::initializer_list<Eigen::Vector4d> directions = {})
+PrimitiveFunction distance_to_span(const Points& x, const SpanForm& form)
 {
+    const Eigen::Vector4d base = difference(form.point);
     Eigen::Matrix<double, 2, 4> coefficients = Eigen::Matrix<double, 2, 4>::Zero();
-    int k = 0;
-    for (const Eigen::Vector4d& direction : directions)
-        coefficients.row(k++) = direction.transpose();
+    const int k = static_cast<int>(form.directions.size());
+    for (int m = 0; m < k; ++m)
+        coefficients.row(m) = difference(form.directions[m]).transpose();
     Eigen::Vector3d w0 = Eigen::Vector3d::Zero();
     Eigen::Matrix<double, 3, 2> v = Eigen::Matrix<double, 3, 2>::Zero();
     for (int i = 0; i < 4; ++i) {
@@ -121,9 +134,6 @@ PrimitiveFunction distance_to_span(const Points& x, const Eigen::Vector4d& base,
     d.hessian.noalias() -= (2.0 * B * inverse_gram).lazyProduct(B.transpose());  // (lazy: no GEMM for 12×2×12)
     return d;
 }
-
-/// x_i − x_j as coefficients of the stacked points.
-Eigen::Vector4d difference(int i, int j) { return Eigen::Vector4d::Unit(i) - Eigen::Vector4d::Unit(j); }
 
 /// An endpoint's closest point on a segment from x0 to x1, and its feature there (0: x0, 1: x1, 2:
 /// the inside, by the clamped parameter t = (p − x0)·e/|e|²).
@@ -177,16 +187,15 @@ PrimitiveFunction point_triangle_squared_distance(const Eigen::Vector3d& p, cons
 {
     const Points x{p, a, b, c};
     check_point_triangle(x, "point_triangle_squared_distance");
-    switch (type) {  // the stacked points: 0 p, 1 a, 2 b, 3 c
-    case PointTriangleType::corner_a: return distance_to_span(x, difference(0, 1));
-    case PointTriangleType::corner_b: return distance_to_span(x, difference(0, 2));
-    case PointTriangleType::corner_c: return distance_to_span(x, difference(0, 3));
-    case PointTriangleType::edge_ab: return distance_to_span(x, difference(0, 1), {difference(2, 1)});
-    case PointTriangleType::edge_bc: return distance_to_span(x, difference(0, 2), {difference(3, 2)});
-    case PointTriangleType::edge_ca: return distance_to_span(x, difference(0, 3), {difference(1, 3)});
-    case PointTriangleType::face: break;
-    }
-    return distance_to_span(x, difference(0, 1), {difference(2, 1), difference(3, 1)});
+    // By the order of PointTriangleType; the stacked points: 0 p, 1 a, 2 b, 3 c.
+    static const std::array<SpanForm, 7> forms{{{{0, 1}, {}},
+                                                {{0, 2}, {}},
+                                                {{0, 3}, {}},
+                                                {{0, 1}, {{2, 1}}},
+                                                {{0, 2}, {{3, 2}}},
+                                                {{0, 3}, {{1, 3}}},
+                                                {{0, 1}, {{2, 1}, {3, 1}}}}};
+    return distance_to_span(x, forms[static_cast<int>(type)]);
 }
 
 // --- Two edges ------------------------------------------------------------------------------------
@@ -237,25 +246,24 @@ PrimitiveFunction edge_edge_squared_distance(const Eigen::Vector3d& ea0, const E
 {
     const Points x{ea0, ea1, eb0, eb1};
     check_edges(x, "edge_edge_squared_distance");
-    switch (type) {  // the stacked points: 0 ea0, 1 ea1, 2 eb0, 3 eb1
-    case EdgeEdgeType::a0_b0: return distance_to_span(x, difference(0, 2));
-    case EdgeEdgeType::a0_b1: return distance_to_span(x, difference(0, 3));
-    case EdgeEdgeType::a1_b0: return distance_to_span(x, difference(1, 2));
-    case EdgeEdgeType::a1_b1: return distance_to_span(x, difference(1, 3));
-    case EdgeEdgeType::a0_edge_b: return distance_to_span(x, difference(0, 2), {difference(3, 2)});
-    case EdgeEdgeType::a1_edge_b: return distance_to_span(x, difference(1, 2), {difference(3, 2)});
-    case EdgeEdgeType::b0_edge_a: return distance_to_span(x, difference(2, 0), {difference(1, 0)});
-    case EdgeEdgeType::b1_edge_a: return distance_to_span(x, difference(3, 0), {difference(1, 0)});
-    case EdgeEdgeType::edge_edge: break;
-    }
     const Eigen::Vector3d ea = ea1 - ea0, eb = eb1 - eb0;
     const double cross2 = ea.cross(eb).squaredNorm();
-    if (!(cross2 > parallel_edges_sin2 * ea.squaredNorm() * eb.squaredNorm()))
+    if (type == EdgeEdgeType::edge_edge && !(cross2 > parallel_edges_sin2 * ea.squaredNorm() * eb.squaredNorm()))
         throw Error(str("edge_edge_squared_distance: the edge_edge type of parallel edges (|e_a × e_b|² = ", cross2,
                         ", sin² of their angle at most ", parallel_edges_sin2,
                         "); parallel edges take an endpoint type (edge_edge_type)"));
-    // ea0 against the plane through eb0 spanned by e_a and e_b: ((ea0 − eb0)·(e_a × e_b))²/|e_a × e_b|².
-    return distance_to_span(x, difference(0, 2), {difference(1, 0), difference(3, 2)});
+    // By the order of EdgeEdgeType; the stacked points: 0 ea0, 1 ea1, 2 eb0, 3 eb1. The last (edge_edge):
+    // ea0 against the plane through eb0 spanned by e_a and e_b, ((ea0 − eb0)·(e_a × e_b))²/|e_a × e_b|².
+    static const std::array<SpanForm, 9> forms{{{{0, 2}, {}},
+                                                {{0, 3}, {}},
+                                                {{1, 2}, {}},
+                                                {{1, 3}, {}},
+                                                {{0, 2}, {{3, 2}}},
+                                                {{1, 2}, {{3, 2}}},
+                                                {{2, 0}, {{1, 0}}},
+                                                {{3, 0}, {{1, 0}}},
+                                                {{0, 2}, {{1, 0}, {3, 2}}}}};
+    return distance_to_span(x, forms[static_cast<int>(type)]);
 }
 
 // --- The mollifier --------------------------------------------------------------------------------
