@@ -45,8 +45,8 @@ void require_edge(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1, const ch
     const double length = (x1 - x0).norm(), size = std::max(x0.cwiseAbs().maxCoeff(), x1.cwiseAbs().maxCoeff());
     if (!(length > 1e-14 * size))
         throw Error(str(what, ": edge ", name, " (", end0, " = ", coordinates(x0), ", ", end1, " = ", coordinates(x1),
-                        ") has zero length (", length, ", at most 1e-14 times its largest coordinate); edges must "
-                        "not be degenerate"));
+                        ") has zero length: |", end1, " − ", end0, "| = ", length,
+                        " is at most 1e-14 times its largest coordinate; edges must not be degenerate"));
 }
 
 /// fem::Error for a triangle whose twice area |(b − a) × (c − a)| is at most 2·10⁻¹⁴ × its longest
@@ -57,16 +57,18 @@ void require_triangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const 
     const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
     if (!(twice_area > 2e-14 * longest * longest))
         throw Error(str(what, ": the triangle a = ", coordinates(a), ", b = ", coordinates(b), ", c = ", coordinates(c),
-                        " has zero area (|(b − a) × (c − a)| = ", twice_area,
-                        ", at most 2e-14 times its longest edge squared); triangles must not be degenerate"));
+                        " has zero area: |(b − a) × (c − a)| = ", twice_area,
+                        " is at most 2e-14 times its longest edge squared; triangles must not be degenerate"));
 }
 
+/// The checks of a point–triangle pair (p, a, b, c): finite, a triangle of non-zero area.
 void check_point_triangle(const Points& x, const char* what)
 {
     require_finite_points(x, {"p", "a", "b", "c"}, what);
     require_triangle(x[1], x[2], x[3], what);
 }
 
+/// The checks of an edge pair (ea0, ea1, eb0, eb1): finite, edges of non-zero length.
 void check_edges(const Points& x, const char* what)
 {
     require_finite_points(x, {"ea0", "ea1", "eb0", "eb1"}, what);
