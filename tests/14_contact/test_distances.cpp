@@ -211,7 +211,7 @@ bool same_type_around(const Pair& pair, const Points& x, double h)
 
 }  // namespace
 
-TEST_CASE("primitive distances: d² equals the constrained least-squares minimum and no sample of the "
+TEST_CASE("primitive distances: d^2 equals the constrained least-squares minimum and no sample of the "
           "domain is nearer, in every region")
 {
     for (const Pair& pair : {point_triangle, edge_edge}) {
@@ -241,7 +241,7 @@ TEST_CASE("primitive distances: d² equals the constrained least-squares minimum
     }
 }
 
-TEST_CASE("primitive distances: gradient and Hessian of d² against central differences in every region")
+TEST_CASE("primitive distances: gradient and Hessian of d^2 against central differences in every region")
 {
     for (const Pair& pair : {point_triangle, edge_edge}) {
         std::map<int, int> checked;
@@ -267,7 +267,7 @@ TEST_CASE("primitive distances: gradient and Hessian of d² against central diff
     }
 }
 
-TEST_CASE("primitive distances: where two types meet, both give the same d² and gradient, and central "
+TEST_CASE("primitive distances: where two types meet, both give the same d^2 and gradient, and central "
           "differences hold just beside the border")
 {
     for (const Pair& pair : {point_triangle, edge_edge}) {
@@ -320,7 +320,7 @@ TEST_CASE("primitive distances: where two types meet, both give the same d² and
     }
 }
 
-TEST_CASE("primitive distances: relabelling the triangle's corners or the edges gives the same d² and the "
+TEST_CASE("primitive distances: relabelling the triangle's corners or the edges gives the same d^2 and the "
           "relabelled gradient")
 {
     // Each relabelling: where the stacked point i goes.
