@@ -324,18 +324,23 @@ dynamics::StepInfo NewtonBackwardEuler::step(dynamics::Body& body, double time_s
     problem.what = str("step ", state.step + 1, " (t = ", state.time + time_step, " s)");
     // The start: the last velocity, unless it already leaves the material's domain (a neo-Hookean
     // tet inverted by qᵗ + Δt q̇ᵗ); then v = 0, which keeps qᵗ, where E is finite.
-    // With a potential the start is the part of that velocity the potential allows from v = 0
-    // (its continuous collision check: no vertex passes through an obstacle on the way there).
+    // With a potential the start is the potential's start velocity (v = 0 unless a moving obstacle
+    // needs another), moved toward that last velocity as far as the potential allows (its continuous
+    // collision check: no vertex passes through an obstacle on the way there).
     Eigen::VectorXd start = dofs.gather(state.v);
+    Eigen::VectorXd fallback = Eigen::VectorXd::Zero(start.size());
     if (potential_ != nullptr) {
-        const Eigen::VectorXd rest = Eigen::VectorXd::Zero(start.size());
-        if (!std::isfinite(problem.objective(rest, nullptr)))
-            throw Error(str("Newton: ", problem.what, ": the potential is infinite at v = 0 (the positions of the "
-                            "step's start); a moving obstacle must not reach a vertex within one step"));
-        start *= std::min(1.0, problem.largest_step(rest, start));
+        fallback = dofs.gather(potential_->start_velocity(body, state, time_step));
+        if (!std::isfinite(problem.objective(fallback, nullptr)))
+            throw Error(str("Newton: ", problem.what, ": the energy is infinite at the start velocity the potential ",
+                            "gives (the body's elastic energy there, or the potential's)"));
+        start = fallback + std::min(1.0, problem.largest_step(fallback, start - fallback)) * (start - fallback);
     }
     if (!std::isfinite(problem.objective(start, nullptr)))
-        start.setZero();
+        start = fallback;
+    // A potential's force is one more load of the step (an obstacle pushing a body at rest).
+    if (potential_ != nullptr)
+        problem.scale += time_step * dofs.gather(potential_->gradient(state.u + time_step * full(start))).stableNorm();
     last_ = newton_minimize(problem, std::move(start), options_, *solver_);
     dynamics::StepInfo info;
     info.newton_iterations = last_.iterations;

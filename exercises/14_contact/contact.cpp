@@ -8,6 +8,8 @@
 
 #include "12_hyperelastic_newton/materials.hpp"
 
+#include "04_tet_jacobians/tet_jacobians.hpp"
+
 #include "common/error.hpp"
 
 #include <Eigen/Geometry>
@@ -16,6 +18,8 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <string>
+#include <utility>
 
 namespace fem::contact {
 namespace {
@@ -112,7 +116,8 @@ bool ContactPotential::out_of_contact(const Eigen::VectorXd& u, double time, con
         const Eigen::Vector3d x = position(u, v), x_end = position(u_end, v);
         for (const auto& obstacle : obstacles_)
             if (obstacle->distance(x, time) < reach || obstacle->distance(x, end_time) < reach ||
-                obstacle->distance(x_end, end_time) < reach || obstacle->time_of_impact(x, x_end - x, end_time) <= 1.0)
+                obstacle->distance(x_end, end_time) < reach ||
+                obstacle->time_of_impact(x, x_end - x - (end_time - time) * obstacle->velocity(), time) <= 1.0)
                 return false;
     }
     return true;
@@ -121,7 +126,9 @@ bool ContactPotential::out_of_contact(const Eigen::VectorXd& u, double time, con
 void ContactPotential::begin_step(dynamics::Body& body, const dynamics::State& state, double time_step)
 {
     require_positive(time_step, "time step dt [s]");
-    time_ = state.time + time_step;
+    fraction_ = std::exchange(next_fraction_, 1.0);
+    start_ = std::exchange(next_start_, Eigen::VectorXd());
+    time_ = state.time + fraction_ * time_step;
     friction_step_ = options_.friction_velocity * time_step;
     // κ (after IPC): balanced at the first contact, doubled while the distance keeps falling below ε_d.
     if (options_.stiffness == 0.0) {
@@ -244,32 +251,56 @@ double ContactPotential::energy(const Eigen::VectorXd& u) const
     return total;
 }
 
+Eigen::Vector3d ContactPotential::barrier_force(const Obstacle& obstacle, const Eigen::Vector3d& x) const
+{
+    std::vector<DistancePiece> pieces;
+    obstacle.pieces(x, time_, options_.activation_distance, pieces);
+    Eigen::Vector3d force = Eigen::Vector3d::Zero();
+    for (const DistancePiece& piece : pieces)
+        force -= stiffness_ * barrier(piece.distance, options_.activation_distance).first * piece.gradient;
+    return force;
+}
+
+Eigen::Vector3d ContactPotential::friction_force(const FrictionPair& pair, const Eigen::VectorXd& u) const
+{
+    const Eigen::Vector2d s = pair.tangent.transpose() * (position(u, pair.vertex) - pair.start);
+    const double y = s.norm();
+    const MollifierValue f = friction_mollifier(y, friction_step_);
+    // f₁(y)/y, finite at y = 0 where it tends to 2/ε.
+    const double f1_over_y = y > 0.0 ? f.f1 / y : 2.0 / friction_step_;
+    return -pair.coefficient * pair.normal_force * f1_over_y * (pair.tangent * s);
+}
+
 Eigen::VectorXd ContactPotential::barrier_forces(const Eigen::VectorXd& u) const
 {
     Eigen::VectorXd forces = Eigen::VectorXd::Zero(u.size());
     for (int v : surface_)
-        for (const auto& obstacle : obstacles_) {
-            std::vector<DistancePiece> pieces;
-            obstacle->pieces(position(u, v), time_, options_.activation_distance, pieces);
-            for (const DistancePiece& piece : pieces)
-                forces.segment<3>(3 * v) -=
-                    stiffness_ * barrier(piece.distance, options_.activation_distance).first * piece.gradient;
-        }
+        for (const auto& obstacle : obstacles_)
+            forces.segment<3>(3 * v) += barrier_force(*obstacle, position(u, v));
     return forces;
 }
 
 Eigen::VectorXd ContactPotential::gradient(const Eigen::VectorXd& u) const
 {
     Eigen::VectorXd gradient = -barrier_forces(u);
-    for (const FrictionPair& pair : pairs_) {
-        const Eigen::Vector2d s = pair.tangent.transpose() * (position(u, pair.vertex) - pair.start);
-        const double y = s.norm();
-        const MollifierValue f = friction_mollifier(y, friction_step_);
-        // f₁(y)/y, finite at y = 0 where it tends to 2/ε.
-        const double f1_over_y = y > 0.0 ? f.f1 / y : 2.0 / friction_step_;
-        gradient.segment<3>(3 * pair.vertex) += pair.coefficient * pair.normal_force * f1_over_y * (pair.tangent * s);
-    }
+    for (const FrictionPair& pair : pairs_)
+        gradient.segment<3>(3 * pair.vertex) -= friction_force(pair, u);
     return gradient;
+}
+
+double ContactPotential::obstacle_work(const Eigen::VectorXd& u, double time_step) const
+{
+    require_positive(time_step, "time step dt [s]");
+    double work = 0.0;
+    for (const auto& obstacle : obstacles_) {
+        if (obstacle->velocity().isZero(0.0))
+            continue;
+        for (int v : surface_)
+            work += obstacle->velocity().dot(barrier_force(*obstacle, position(u, v)));
+    }
+    for (const FrictionPair& pair : pairs_)
+        work += obstacles_[static_cast<std::size_t>(pair.obstacle)]->velocity().dot(friction_force(pair, u));
+    return time_step * work;
 }
 
 dynamics::SparseMatrix ContactPotential::hessian(const Eigen::VectorXd& u) const
@@ -327,6 +358,163 @@ double ContactPotential::largest_safe_step(const Eigen::VectorXd& u, const Eigen
             step = std::min(step, options_.safety * obstacle->time_of_impact(position(u, v), change, time_));
     }
     return step;
+}
+
+double ContactPotential::obstacle_advance(const Eigen::VectorXd& u, double time, double time_step, double from) const
+{
+    require_positive(time_step, "time step dt [s]");
+    double earliest = infinity;
+    for (const auto& obstacle : obstacles_) {
+        if (obstacle->velocity().isZero(0.0))
+            continue;
+        const Eigen::Vector3d travel = -(1.0 - from) * time_step * obstacle->velocity();
+        for (int v : surface_)
+            earliest = std::min(earliest, obstacle->time_of_impact(position(u, v), travel, time + from * time_step));
+    }
+    return earliest > 1.0 ? 1.0 : from + options_.safety * earliest * (1.0 - from);
+}
+
+void ContactPotential::stage_next_step(double fraction, const Eigen::VectorXd& start)
+{
+    if (!(fraction > 0.0 && fraction <= 1.0))
+        throw Error(str("contact: a stage's fraction of the obstacles' motion must lie in (0, 1], got ", fraction));
+    if (start.size() != 3 * rest_.rows())
+        throw Error(str("contact: a stage's start velocity needs 3n = ", 3 * rest_.rows(), " entries, got ",
+                        start.size()));
+    next_fraction_ = fraction;
+    next_start_ = start;
+}
+
+Eigen::VectorXd ContactPotential::free_start(const dynamics::Body& body, const dynamics::State& state,
+                                             double time_step, double obstacle_time, std::string* blocked) const
+{
+    require_positive(time_step, "time step dt [s]");
+    // The candidates: stay put, or ride along with each moving obstacle (the pins keep theirs).
+    std::vector<Eigen::VectorXd> candidates{Eigen::VectorXd::Zero(state.v.size())};
+    std::vector<std::string> names{"staying put"};
+    for (std::size_t o = 0; o < obstacles_.size(); ++o)
+        if (!obstacles_[o]->velocity().isZero(0.0)) {
+            Eigen::VectorXd carried(state.v.size());
+            for (Eigen::Index v = 0; v < carried.size() / 3; ++v)
+                carried.segment<3>(3 * v) = obstacles_[o]->velocity();
+            candidates.push_back(std::move(carried));
+            names.push_back(str("moving with obstacle ", o, " (", obstacles_[o]->name(), ")"));
+        }
+    for (std::size_t c = 0; c < candidates.size(); ++c) {
+        Eigen::VectorXd v = body.pin_velocity();
+        body.dofs().scatter(body.dofs().gather(candidates[c]), v);
+        const auto reached = [&]() -> std::string {
+            for (int vertex : surface_) {
+                const Eigen::Vector3d x = position(state.u, vertex);
+                for (std::size_t o = 0; o < obstacles_.size(); ++o) {
+                    const Obstacle& obstacle = *obstacles_[o];
+                    const Eigen::Vector3d relative =
+                        time_step * v.segment<3>(3 * vertex) - (obstacle_time - state.time) * obstacle.velocity();
+                    if (obstacle.time_of_impact(x, relative, state.time) <= 1.0)
+                        return str("vertex ", vertex, " at (", x.transpose(), ") meets obstacle ", o, " (",
+                                   obstacle.name(), ")");
+                }
+            }
+            return {};
+        }();
+        if (reached.empty())
+            return v;
+        if (blocked != nullptr)
+            *blocked += str(c == 0 ? "" : "; ", names[c], ": ", reached);
+    }
+    return {};
+}
+
+bool ContactPotential::has_free_start(const dynamics::Body& body, const dynamics::State& state, double time_step) const
+{
+    return free_start(body, state, time_step, state.time + time_step, nullptr).size() > 0;
+}
+
+Eigen::VectorXd ContactPotential::start_velocity(const dynamics::Body& body, const dynamics::State& state,
+                                                 double time_step) const
+{
+    if (start_.size() > 0) {  // a stage of contact_step: the last stage's solution, free by obstacle_advance
+        Eigen::VectorXd v = body.pin_velocity();
+        body.dofs().scatter(body.dofs().gather(start_), v);
+        return v;
+    }
+    std::string blocked;
+    Eigen::VectorXd v = free_start(body, state, time_step, time_, &blocked);
+    if (v.size() == 0)
+        throw Error(str("contact: step ", state.step + 1, " (t = ", state.time + time_step,
+                        " s): the obstacles leave the body no room: every start of the step reaches an obstacle (",
+                        blocked, ")"));
+    return v;
+}
+
+namespace {
+
+/// The first tet whose signed volume is > 0 at u_start and ≤ 0 at u_end, or −1.
+int first_turned_tet(const dynamics::Body& body, const Eigen::VectorXd& u_start, const Eigen::VectorXd& u_end,
+                     double* volume)
+{
+    const TetMesh& mesh = body.mesh();
+    const MatrixX3d start = body.positions(u_start), end = body.positions(u_end);
+    for (int t = 0; t < static_cast<int>(mesh.T.rows()); ++t) {
+        const double after = tet::signed_volume(tet::tet_vertices(mesh, end, t));
+        if (after <= 0.0 && tet::signed_volume(tet::tet_vertices(mesh, start, t)) > 0.0) {
+            *volume = after;
+            return t;
+        }
+    }
+    return -1;
+}
+
+}  // namespace
+
+dynamics::StepInfo contact_step(hyper::NewtonBackwardEuler& newton, ContactPotential& contact, dynamics::Body& body,
+                                double time_step, dynamics::State& state, int updates, int* solves, int* stages)
+{
+    dynamics::State next = state;
+    dynamics::StepInfo info;
+    int staged = 1;
+    if (contact.has_free_start(body, state, time_step)) {
+        info = step_with_friction_updates(newton, contact, body, time_step, next, updates, solves);
+    } else {
+        // The stages: the obstacles moved part of the way, the body pushed there, and so on to t + Δt.
+        double fraction = 0.0;
+        Eigen::VectorXd start = Eigen::VectorXd::Zero(state.v.size());
+        for (staged = 1;; ++staged) {
+            const double advance = contact.obstacle_advance(state.u + time_step * start, state.time, time_step, fraction);
+            if (advance - fraction < 1e-9 || staged > most_obstacle_stages)
+                throw Error(str("contact: step ", state.step + 1, " (t = ", state.time + time_step,
+                                " s): the obstacles leave the body no room: after ", staged - 1,
+                                " stages they have made ", fraction, " of the step's motion and can advance no further",
+                                " without reaching a surface vertex"));
+            contact.stage_next_step(advance, start);
+            next = state;
+            try {
+                info = step_with_friction_updates(newton, contact, body, time_step, next, updates, solves);
+            } catch (const Error& e) {
+                throw Error(str("contact: step ", state.step + 1, " (t = ", state.time + time_step,
+                                " s): the obstacles leave the body no room: stage ", staged, ", with ", advance,
+                                " of the step's obstacle motion made, cannot be solved: ", e.what()));
+            }
+            fraction = advance;
+            start = next.v;
+            if (fraction == 1.0)
+                break;
+        }
+    }
+    if (stages != nullptr)
+        *stages = staged;
+    double volume = 0.0;
+    const int turned = first_turned_tet(body, state.u, next.u, &volume);
+    if (turned >= 0)
+        throw Error(str("contact: step ", state.step + 1, " (t = ", next.time, " s) would turn tet ", turned,
+                        " inside out (volume ", volume, " m^3): only the surface vertices carry the barrier, and ",
+                        "this impact or squeeze is more than the mesh can resolve; use a smaller dt, a finer or ",
+                        "stiffer body, or slower obstacles"));
+    // κ is the step's now (begin_step set it): B at the start with it, against B at the end.
+    info.boundary_work += contact.barrier_energy(state.u, state.time) - contact.barrier_energy(next.u, next.time) +
+                          contact.obstacle_work(next.u, time_step);
+    state = std::move(next);
+    return info;
 }
 
 }  // namespace fem::contact

@@ -14,7 +14,13 @@ namespace fem::contact {
 
 dynamics::StepInfo BlockScene::step(int* solves)
 {
-    return step_with_friction_updates(*integrator, *contact, *body, time_step, state, friction_updates, solves);
+    return contact_step(*integrator, *contact, *body, time_step, state, friction_updates, solves);
+}
+
+void BlockScene::set_obstacles(std::vector<std::shared_ptr<const Obstacle>> obstacles, const ContactOptions& options)
+{
+    contact = std::make_unique<ContactPotential>(*body, std::move(obstacles), options);
+    integrator->set_potential(contact.get());
 }
 
 BlockScene block_scene(const BlockSettings& settings)
