@@ -148,6 +148,11 @@ struct BoxHierarchy {
 /// docs/13_skinning.md#an-aabb-tree
 BoxHierarchy box_hierarchy(const std::vector<Eigen::Matrix<double, 2, 3>>& boxes, int leaf_size);
 
+/// The items of tree (built over boxes) whose boxes meet the box [low, high] (touching counts),
+/// found by descending into every node whose box meets it; in the tree's order.
+std::vector<int> boxes_meeting(const BoxHierarchy& tree, const std::vector<Eigen::Matrix<double, 2, 3>>& boxes,
+                               const Eigen::Vector3d& low, const Eigen::Vector3d& high);
+
 /// A bounding-volume hierarchy: a binary tree of axis-aligned boxes, each node's box holding its
 /// tets' padded boxes, split at the median of the tet centroids along the box's longest axis until
 /// a leaf holds at most `leaf_size` tets (box_hierarchy). A query descends into every child whose

@@ -49,6 +49,9 @@ struct TrianglePoint {
 TrianglePoint closest_triangle_point(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                      const Eigen::Vector3d& c);
 
+/// Below this sine of the angle between two neighbouring triangles' normals their shared edge is flat.
+inline constexpr double flat_mesh_edge_sine = 1e-3;
+
 /// A static (or translating) triangle surface as an obstacle, with the unsigned distance of the
 /// header. docs/14_contact.md#mesh-obstacles
 class MeshObstacle final : public Obstacle {
@@ -75,6 +78,12 @@ public:
     /// triangle's plane misses it unless it runs in that plane, where conservative_time_of_impact
     /// answers; 0 when d₀(p) = 0.
     double local_time_of_impact(const Eigen::Vector3d& p, const Eigen::Vector3d& dp) const override;
+    /// Its sharp edges — on the border (one triangle), shared by three or more, or where two
+    /// triangles meet at an angle, |n₁ × n₂| > flat_mesh_edge_sine or n₁·n₂ < 0 (unit normals, of
+    /// the two triangles oriented alike across the edge) — and
+    /// the corners on them. An edge between two coplanar triangles is no feature: the triangles'
+    /// own barriers already hold the body there.
+    ObstacleFeatures local_features() const override;
 
     /// The nearest triangle of p (the lowest-numbered one of equal distance found first), its
     /// closest point and the distance.

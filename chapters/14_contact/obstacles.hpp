@@ -24,6 +24,14 @@ struct DistancePiece {
     Eigen::Matrix3d hessian = Eigen::Matrix3d::Zero();
 };
 
+/// The sharp features of an obstacle at its rest placement: corners (#c×3) [m] and edges (#e×2, rows
+/// of two corners), which chapter 14's FeatureBarrier keeps the body's surface triangles and edges
+/// away from (feature_barrier.hpp). Empty for a smooth obstacle.
+struct ObstacleFeatures {
+    Eigen::MatrixX3d corners;
+    Eigen::MatrixX2i edges;
+};
+
 /// A rigid obstacle. The body's vertices are kept at d > 0 by chapter 14's barrier.
 class Obstacle {
 public:
@@ -51,6 +59,9 @@ public:
     /// meet at an angle (a mesh's creases) the nearest one's distance has a kink, the sum of their
     /// barriers does not. docs/14_contact.md#mesh-obstacles
     virtual void local_pieces(const Eigen::Vector3d& p, double reach, std::vector<DistancePiece>& pieces) const;
+
+    /// Its corners and edges at the rest placement (ObstacleFeatures; default: none, a smooth shape).
+    virtual ObstacleFeatures local_features() const { return {}; }
 
     /// d(x, t) = d₀(x − t w) [m].
     double distance(const Eigen::Vector3d& x, double time) const { return local_distance(x - time * velocity_); }
@@ -138,6 +149,8 @@ public:
     Eigen::Vector3d local_gradient(const Eigen::Vector3d& p) const override;
     Eigen::Matrix3d local_hessian(const Eigen::Vector3d& p) const override;
     double local_time_of_impact(const Eigen::Vector3d& p, const Eigen::Vector3d& dp) const override;
+    /// Its 8 corners c + R (±h₀, ±h₁, ±h₂) and 12 edges.
+    ObstacleFeatures local_features() const override;
 
 private:
     Eigen::Vector3d centre_, half_;
