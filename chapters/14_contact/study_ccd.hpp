@@ -22,7 +22,7 @@ void check_ccd_query_file(const std::string& file);
 /// Runs cubic_ccd and inclusion_ccd (default settings) on every query of every file and writes
 /// ccd_queries_table.csv: per file and method the queries, the collisions reported, the false
 /// negatives and false positives against the file's truth, and the median and mean time per query
-/// (each query's best of repeated calls) [µs].
+/// (per query, the best of a few batches of calls, divided by the calls in a batch) [µs].
 void ccd_study(const RunContext& run, const std::vector<std::string>& files);
 
 }  // namespace fem::contact::study
