@@ -92,7 +92,7 @@ struct InclusionSettings {
 /// range is [min, max] of its 8 corner values. Boxes are bisected breadth-first, one level at a
 /// time, t then u then v, each level in order of increasing t; a box is discarded when for some k
 /// all 8 computed corner values are finite and > ε_k, or all < −ε_k, where
-///     ε_k = 4 γ₆ M_k + 2⁻¹⁰⁷⁰,   γ₆ = 6 u / (1 − 6 u),  u = 2⁻⁵³,   M_k = max |x_k| over the 8 inputs
+///     ε_k = 4 γ₆ M_k + 2⁻¹⁰⁷⁰,   γ₆ = 6 r / (1 − 6 r),  r = 2⁻⁵³,   M_k = max |x_k| over the 8 inputs
 /// bounds the round-off of evaluating F_k at a corner (docs/14_contact.md#primitive-ccd). The first
 /// box of a level with every side ≤ δ that survives gives the time of impact, its lowest t. Never a
 /// false negative; the reported time is never later than the first contact.

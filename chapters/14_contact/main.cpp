@@ -21,7 +21,8 @@
 //   ch14_contact --dhat 1e-3 --kappa 0 --dt 0.01   one configuration
 //   ch14_contact --ccd-queries data/ccd-unit-tests/edge-edge/data_0_0.csv   CCD on one query file
 //
-// Writes (under out/14_contact): drop_table.csv, slope_table.csv, mesh_table.csv, ccd_queries_table.csv, drop.pvd (frames drop/drop_NNNN.vtu).
+// Writes (under out/14_contact): drop_table.csv, slope_table.csv, mesh_table.csv, drop.pvd (frames drop/drop_NNNN.vtu),
+// ccd_queries_table.csv.
 // docs/14_contact.md
 
 #include "14_contact/studies.hpp"
@@ -59,7 +60,7 @@ int main(int argc, char** argv)
         ->check(check::real(0.0, 5.0, check::Ends::open_closed))->capture_default_str();
     std::vector<std::string> ccd_files;
     cli.app.add_option("--ccd-queries", ccd_files,
-                       "CCD benchmark query files (in a folder vertex-face or edge-edge): run only the CCD study on them")
+                       "CCD benchmark query files, each in a folder vertex-face or edge-edge: run only the CCD study")
         ->check(check::accepted_by(study::check_ccd_query_file));
     cli.check_options([&] {
         if (!ccd_files.empty()) {  // runs the CCD study alone: another study's option would be ignored

@@ -46,7 +46,8 @@ void ccd_study(const RunContext& run, const std::vector<std::string>& files)
     };
     const Method methods[] = {
         {"cubic (naive)", [](PrimitivePair pair, const PrimitiveMotion& m) { return cubic_ccd(pair, m); }},
-        {"inclusion (conservative)", [](PrimitivePair pair, const PrimitiveMotion& m) { return inclusion_ccd(pair, m); }},
+        {"inclusion (conservative)",
+         [](PrimitivePair pair, const PrimitiveMotion& m) { return inclusion_ccd(pair, m); }},
     };
     Table table("Primitive CCD on the benchmark's queries: collisions reported, errors against the truth, time",
                 {{"file", Format::text}, {"method", Format::text}, {"queries", Format::integer},

@@ -203,7 +203,7 @@ bool excludes_contact(PrimitivePair pair, const PrimitiveMotion& motion, const B
 /// ε_k = 4 γ₆ M_k + 2⁻¹⁰⁷⁰: the round-off bound of one corner value of F_k (docs: #primitive-ccd).
 Eigen::Vector3d evaluation_error_bound(const PrimitiveMotion& motion)
 {
-    constexpr double unit_roundoff = std::numeric_limits<double>::epsilon() / 2.0;  // u = 2⁻⁵³
+    constexpr double unit_roundoff = std::numeric_limits<double>::epsilon() / 2.0;  // r = 2⁻⁵³
     const double gamma6 = 6.0 * unit_roundoff / (1.0 - 6.0 * unit_roundoff);
     const Eigen::Vector3d largest =
         motion.start.cwiseAbs().rowwise().maxCoeff().cwiseMax(motion.end.cwiseAbs().rowwise().maxCoeff());
@@ -355,7 +355,8 @@ std::vector<CcdQuery> read_ccd_queries(const std::filesystem::path& path)
             throw Error(str(where(line), "the truth ", row[6], " differs from the ", queries.back().collides ? 1 : 0,
                             " of the query's first row (line ", queries.back().first_line, ")"));
         }
-        Eigen::Matrix<double, 3, 4>& points = row_in_query < 4 ? queries.back().motion.start : queries.back().motion.end;
+        PrimitiveMotion& motion = queries.back().motion;
+        Eigen::Matrix<double, 3, 4>& points = row_in_query < 4 ? motion.start : motion.end;
         for (int k = 0; k < 3; ++k)
             points(k, row_in_query % 4) = row[std::size_t(2 * k)] / row[std::size_t(2 * k + 1)];
     }

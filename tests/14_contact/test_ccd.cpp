@@ -1,8 +1,8 @@
 // Chapter 14: continuous collision detection of a point and a triangle and of two edges — the
-// inclusion method has no false negative on the CCD benchmark's unit-test queries (their truth is
-// exact, computed by the benchmark's authors with rational arithmetic), and its time of impact is
-// never later than the cubic's root; hand-made motions whose answer is known in closed form; the
-// naive cubic's false negatives; the query-file reader's errors. docs/14_contact.md#primitive-ccd
+// inclusion method has no false negative on the CCD benchmark's unit-test queries (against the
+// benchmark's ground truth), and its time of impact is never later than the cubic's root;
+// hand-made motions whose answer is known in closed form; the naive cubic's false negatives; the
+// query-file reader's errors. docs/14_contact.md#primitive-ccd
 #include "14_contact/ccd.hpp"
 
 #include "common/error.hpp"
@@ -141,11 +141,12 @@ TEST_CASE("primitive CCD: a point falling straight onto a triangle's face at t =
 
 TEST_CASE("primitive CCD: a touch exactly at t = 1, and misses by a small margin")
 {
-    const CcdResult touch = inclusion_ccd(PrimitivePair::point_triangle, point_over_unit_triangle({0.2, 0.3, 1.0}, {0.2, 0.3, 0.0}));
+    const PrimitiveMotion landing = point_over_unit_triangle({0.2, 0.3, 1.0}, {0.2, 0.3, 0.0});
+    const CcdResult touch = inclusion_ccd(PrimitivePair::point_triangle, landing);
     CHECK(touch.collides);
     CHECK(touch.time_of_impact <= 1.0);
     CHECK(touch.time_of_impact >= 1.0 - delta - 1e-15);
-    const CcdResult naive_touch = cubic_ccd(PrimitivePair::point_triangle, point_over_unit_triangle({0.2, 0.3, 1.0}, {0.2, 0.3, 0.0}));
+    const CcdResult naive_touch = cubic_ccd(PrimitivePair::point_triangle, landing);
     CHECK(naive_touch.collides);
     CHECK(naive_touch.time_of_impact == 1.0);
 
