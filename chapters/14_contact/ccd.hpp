@@ -26,6 +26,7 @@
 #include <Eigen/Core>
 
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -52,7 +53,7 @@ struct CcdResult {
     bool collides = false;
     /// The time of impact in [0, 1] when collides (for inclusion_ccd: never later than the first
     /// true contact); +∞ otherwise.
-    double time_of_impact = 0.0;
+    double time_of_impact = std::numeric_limits<double>::infinity();
     /// inclusion_ccd: the boxes whose corners were evaluated; cubic_ccd: the roots in [0, 1] tested.
     long long work = 0;
     /// inclusion_ccd: stopped at max_boxes with boxes still queued (time_of_impact is then the lowest
@@ -77,8 +78,9 @@ CcdResult cubic_ccd(PrimitivePair pair, const PrimitiveMotion& motion);
 /// The inclusion method's parameters.
 struct InclusionSettings {
     /// δ: a box whose sides in t, u and v are all ≤ δ and that is not discarded ends the search; its
-    /// lowest t is the time of impact, within δ before the earliest box that holds a root. In (0, 1],
-    /// at least 2⁻⁴⁰ ≈ 9.1·10⁻¹³ (so that every corner and 1 − u − v are exact binary fractions).
+    /// lowest t is the time of impact: never later than the first contact, and a time at which the
+    /// primitives are within about δ × (the motion's size and speed) of touching. In [2⁻⁴⁰, 1]
+    /// (2⁻⁴⁰ ≈ 9.1·10⁻¹³: every corner and 1 − u − v stay exact binary fractions).
     double tolerance = 1e-6;
     /// The most boxes evaluated before the search stops and answers the lowest t still queued
     /// (conservative). At least 1.
@@ -112,8 +114,9 @@ struct CcdQuery {
 /// every 8 rows are one query, the four vertices at t = 0 then the four at t = 1 (vertex–face:
 /// v, f₀, f₁, f₂; edge–edge: a₀, a₁, b₀, b₁), the same truth on all 8. fem::Error, naming the file and
 /// line, for a file that cannot be read or holds no row, a row without exactly 7 integers, an
-/// integer beyond a double's range, a zero denominator, a truth other than 0 or 1 or not the same on a query's
-/// rows, and a row count that is not a multiple of 8.
+/// integer beyond a double's range, a zero denominator, a truth other than 0 or 1 or not the same
+/// on a query's rows, and a row count that is not a multiple of 8. Each integer is read as the
+/// nearest double (exact below 2⁵³ and for any power of two), the coordinate as their quotient.
 std::vector<CcdQuery> read_ccd_queries(const std::filesystem::path& path);
 
 /// The pair a benchmark file holds, from the name of its folder: "vertex-face" (point_triangle) or

@@ -223,7 +223,6 @@ CcdResult cubic_ccd(PrimitivePair pair, const PrimitiveMotion& motion)
 {
     require_finite_motion(motion, "cubic_ccd");
     CcdResult result;
-    result.time_of_impact = infinity;
     for (double t : cubic_roots_in_unit_interval(coplanarity_cubic(motion))) {
         ++result.work;
         if (touches_in_plane(pair, motion, t)) {
@@ -247,7 +246,6 @@ CcdResult inclusion_ccd(PrimitivePair pair, const PrimitiveMotion& motion, const
     const Eigen::Vector3d epsilon = evaluation_error_bound(motion);
 
     CcdResult result;
-    result.time_of_impact = infinity;
     std::vector<Box> level{Box{}}, next;
     for (int depth = 0; !level.empty(); ++depth) {
         const int axis = depth % 3;  // every box of a level has the same sides

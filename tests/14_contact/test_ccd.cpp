@@ -155,7 +155,9 @@ TEST_CASE("primitive CCD: a touch exactly at t = 1, and misses by a small margin
     for (const PrimitiveMotion& miss : {point_over_unit_triangle({0.2, 0.3, 1.0}, {0.2, 0.3, 1e-3}),
                                         point_over_unit_triangle({-1e-3, 0.3, 1.0}, {-1e-3, 0.3, -1.0}),
                                         point_over_unit_triangle({0.5005, 0.5005, 1.0}, {0.5005, 0.5005, -1.0})}) {
-        CHECK_FALSE(inclusion_ccd(PrimitivePair::point_triangle, miss).collides);
+        const CcdResult safe = inclusion_ccd(PrimitivePair::point_triangle, miss);
+        CHECK_FALSE(safe.collides);
+        CHECK(std::isinf(safe.time_of_impact));
         CHECK_FALSE(cubic_ccd(PrimitivePair::point_triangle, miss).collides);
     }
     // Edges crossing at right angles with a gap of 10⁻³ at their closest.
