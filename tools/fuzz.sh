@@ -10,7 +10,7 @@
 #   tools/fuzz.sh --runs 1000000 obj stl  until a million inputs each
 #
 # Targets: obj ply stl tetgen pvd vtu (whole files: the checks before VTK, VTK's XML reader, the
-# checks after it), vtu_grid (the checks after VTK, on any grid VTK could return) and scene (a scene
+# checks after it), vtu_grid (the checks after VTK, on any grid VTK could return), scene (a scene
 # file and --set overrides, split at a line ===; read_scene without TetGen and with 256 MB for the run)
 # and ccd_queries (chapter 14's reader of the CCD benchmark's query files, then both CCD methods).
 # Limits: an input may take 10 s and allocate 512 MB at once (2 GB in all); a reader must refuse a
