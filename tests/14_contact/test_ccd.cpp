@@ -233,6 +233,36 @@ TEST_CASE("primitive CCD: the naive cubic's false negatives are real: on the ben
     CHECK(safe.time_of_impact >= 0.5 - 1e-3);
 }
 
+TEST_CASE("inclusion CCD: the bound eps is needed: a point landing on an edge where F's computed value is "
+          "round-off")
+{
+    // The triangle (a, b, c) fixed in the plane z = 0 and the point falling straight down onto
+    // q = (3/4) a + (1/4) b, on the edge ab, at t = 1: b = 4q − 3a exactly (checked below in long
+    // double, whose 64 bits hold these sums exactly). F = 0 at the corner (t, u, v) = (1, 1/4, 0) of the
+    // boxes, but its computed x or y there is the rounding of (3/4) a, not 0 — with ε = 0 every box
+    // touching that corner would be discarded (found by a search over random a and q; this is one).
+    const Eigen::Vector3d a(-0.57391473863983855, -0.71793962358741026, 0.0);
+    const Eigen::Vector3d c(-0.92077770850113749, -0.28044855689828785, 0.0);
+    const Eigen::Vector3d q(-0.28615496110971739, -0.70876633081530827, 0.0);
+    Eigen::Vector3d b;
+    for (int k = 0; k < 3; ++k) {
+        const long double exact = 4.0L * q[k] - 3.0L * a[k];
+        b[k] = double(exact);
+        REQUIRE(static_cast<long double>(b[k]) == exact);
+    }
+    // F at (1, 1/4, 0) summed as inclusion_ccd sums it: q − (3/4) a − (1/4) b − 0 c.
+    const Eigen::Vector3d corner = ((q + (-0.75 * a)) + (-0.25 * b)) + (-0.0 * c);
+    CHECK(corner.cwiseAbs().maxCoeff() > 0.0);       // round-off, where the exact value is 0
+    CHECK(corner.cwiseAbs().maxCoeff() < 1e-15);     // and within ε ≈ 2.7·10⁻¹⁵ M (M ≤ 1 here)
+    Eigen::Matrix<double, 4, 3> start, end;
+    start << (q + Eigen::Vector3d(0, 0, 1)).transpose(), a.transpose(), b.transpose(), c.transpose();
+    end << q.transpose(), a.transpose(), b.transpose(), c.transpose();
+    const CcdResult safe = inclusion_ccd(PrimitivePair::point_triangle, motion(start, end));
+    CHECK(safe.collides);
+    CHECK(safe.time_of_impact <= 1.0);
+    CHECK(safe.time_of_impact >= 1.0 - delta - 1e-15);
+}
+
 TEST_CASE("inclusion CCD: stopped at its box limit it still answers conservatively")
 {
     const PrimitiveMotion m = point_over_unit_triangle({0.2, 0.3, 1.0}, {0.2, 0.3, -1.0});
