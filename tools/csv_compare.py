@@ -2,7 +2,7 @@
 
 A column is *measured* (depends on the machine: wall times, rates, bandwidths) when its header ends
 with a unit in brackets that contains a time: "time [s]", "rate [1/s]", "bandwidth [GB/s]",
-"[ms]", "[us]", "[ns]", or with "[measured]" for a machine-dependent ratio ("fraction of triad
+"[ms]", "[us]" or "[µs]", "[ns]", or with "[measured]" for a machine-dependent ratio ("fraction of triad
 [measured]"). Measured columns are reported but never compared; every other column must
 reproduce (numbers within a relative tolerance, text exactly). common/table.hpp states the same rule.
 
@@ -43,7 +43,7 @@ import re
 PROSE_NUMBER = re.compile(r"(?P<mantissa>[-+]?\d{1,3}(?:[ \u2009\u202f]\d{3})+|[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?)?"
                           r"(?:\s*[·×]?\s*10(?P<power>[⁻]?[⁰¹²³⁴⁵⁶⁷⁸⁹]+))?")
 SUPERSCRIPTS = str.maketrans("⁰¹²³⁴⁵⁶⁷⁸⁹⁻", "0123456789-")
-MEASURED = re.compile(r"\[(s|ms|us|ns|measured|[^\]]*/\s*(s|ms|us|ns))\]\s*$")
+MEASURED = re.compile(r"\[(s|ms|us|µs|ns|measured|[^\]]*/\s*(s|ms|us|µs|ns))\]\s*$")
 ROUNDOFF = re.compile(r"\[round-off\]\s*$")
 ROUNDOFF_LEVEL = 1e-12
 ROUNDOFF_BOUND = 1e-10
@@ -159,6 +159,7 @@ def self_test():
     assert close(6.1103777e-9, 6.1101246e-9, 1e-6) and not close(6.1e-9, 6.2e-9, 1e-6)  # below 1e-12 apart
     assert not close(float("nan"), 1e-15, 1e-6) and not close(1e-15, float("nan"), 1e-6)
     assert is_measured("time [s]") and is_measured("rate [1/s]") and not is_measured("residual")
+    assert is_measured("median time per query [µs]") and is_measured("time per query [us]")
     header = ["x", "error", "time [s]"]
     assert compare_tables(header, [["1", "1e-15", "3"]], header, [["1", "4e-14", "9"]], 1e-6, "t") == []
     assert len(compare_tables(header, [["1", "1e-15", "3"]], header, [["2", "4e-10", "9"]], 1e-6, "t")) == 2

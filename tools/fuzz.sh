@@ -10,8 +10,9 @@
 #   tools/fuzz.sh --runs 1000000 obj stl  until a million inputs each
 #
 # Targets: obj ply stl tetgen pvd vtu (whole files: the checks before VTK, VTK's XML reader, the
-# checks after it), vtu_grid (the checks after VTK, on any grid VTK could return) and scene (a scene
-# file and --set overrides, split at a line ===; read_scene without TetGen and with 256 MB for the run).
+# checks after it), vtu_grid (the checks after VTK, on any grid VTK could return), scene (a scene
+# file and --set overrides, split at a line ===; read_scene without TetGen and with 256 MB for the run)
+# and ccd_queries (chapter 14's reader of the CCD benchmark's query files, then both CCD methods).
 # Limits: an input may take 10 s and allocate 512 MB at once (2 GB in all); a reader must refuse a
 # huge count with an fem::Error before it reserves memory for it. Leaks are not reported: VTK's XML
 # reader leaks on some errors.
@@ -27,12 +28,12 @@ while [ $# -gt 0 ]; do
     case "$1" in
         --seconds) seconds="$2"; shift 2 ;;
         --runs) runs="$2"; seconds=0; shift 2 ;;
-        -h|--help) sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        -h|--help) sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         -*) echo "error: unknown option '$1'; allowed: --seconds N, --runs N, formats" >&2; exit 1 ;;
         *) formats+=("$1"); shift ;;
     esac
 done
-[ ${#formats[@]} -eq 0 ] && formats=(obj ply stl tetgen pvd vtu vtu_grid scene)
+[ ${#formats[@]} -eq 0 ] && formats=(obj ply stl tetgen pvd vtu vtu_grid scene ccd_queries)
 for format in "${formats[@]}"; do
     [ -d "fuzz/corpus/$format" ] || { echo "error: no fuzz target '$format'; allowed: $(ls fuzz/corpus | xargs)" >&2; exit 1; }
 done

@@ -10,17 +10,23 @@
 //      that sticks (tan θ < μ), its creep per step against ε_v Δt, over the same sweep and with the
 //      friction lagged once a step or updated within it;
 //   3. mesh obstacles: the distance to a triangle mesh (the bowl, the bunny) by every triangle, by
-//      chapter 13's AABB tree and by sampled grids — time per query and error against the first.
+//      chapter 13's AABB tree and by sampled grids — time per query and error against the first;
+//   4. primitive CCD: point–triangle and edge–edge continuous collision detection, the naive
+//      coplanarity cubic against the conservative inclusion method, on the CCD benchmark's queries
+//      (data/ccd-unit-tests; --ccd-queries FILE... runs only this study, on those files).
 //
 // Sample runs:
 //   ch14_contact                                   full run
 //   ch14_contact --quick                           the small run ctest checks
 //   ch14_contact --dhat 1e-3 --kappa 0 --dt 0.01   one configuration
+//   ch14_contact --ccd-queries data/ccd-unit-tests/edge-edge/data_0_0.csv   CCD on one query file
 //
-// Writes (under out/14_contact): drop_table.csv, slope_table.csv, mesh_table.csv, drop.pvd (frames drop/drop_NNNN.vtu).
+// Writes (under out/14_contact): drop_table.csv, slope_table.csv, mesh_table.csv, drop.pvd (frames drop/drop_NNNN.vtu),
+// ccd_queries_table.csv.
 // docs/14_contact.md
 
 #include "14_contact/studies.hpp"
+#include "14_contact/study_ccd.hpp"
 
 #include "09_conjugate_gradient/linear_solver.hpp"
 
@@ -52,7 +58,18 @@ int main(int argc, char** argv)
         ->check(check::real(0.0, 1.0, check::Ends::open_closed))->capture_default_str();
     cli.app.add_option("--duration", settings.duration, "Length of each run [s]")
         ->check(check::real(0.0, 5.0, check::Ends::open_closed))->capture_default_str();
+    std::vector<std::string> ccd_files;
+    cli.app.add_option("--ccd-queries", ccd_files,
+                       "CCD benchmark query files, each in a folder vertex-face or edge-edge: run only the CCD study")
+        ->check(check::accepted_by(study::check_ccd_query_file));
     cli.check_options([&] {
+        if (!ccd_files.empty()) {  // runs the CCD study alone: another study's option would be ignored
+            for (const char* other : {"--dhat", "--kappa", "--dt", "--tolerance", "--friction-updates", "--height",
+                                      "--duration"})
+                if (cli.app.count(other) > 0)
+                    throw Error(str(other, ": --ccd-queries runs only the CCD study and would ignore it"));
+            cli.protect_inputs({ccd_files.begin(), ccd_files.end()});
+        }
         // --quick runs one fixed configuration: a swept option beside it would be silently ignored.
         if (cli.app.count("--quick") > 0)
             for (const char* swept : {"--dhat", "--kappa", "--dt", "--tolerance"})
@@ -67,6 +84,10 @@ int main(int argc, char** argv)
             }
     });
     return cli.run(argc, argv, [&](const RunContext& run) {
+        if (!ccd_files.empty()) {
+            study::ccd_study(run, ccd_files);
+            return;
+        }
         if (run.quick) {
             settings.activation_distances = {1e-3};
             settings.stiffnesses = {0.0};
@@ -80,5 +101,6 @@ int main(int argc, char** argv)
         study::drop_study(run, settings);
         study::slope_study(run, settings);
         study::mesh_study(run, settings);
+        study::ccd_study(run, study::ccd_benchmark_files());
     });
 }
