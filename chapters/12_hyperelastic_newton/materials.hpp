@@ -198,8 +198,8 @@ double volume_change(const Eigen::Matrix3d& H);
 Eigen::Matrix3d cofactor_change(const Eigen::Matrix3d& H);
 
 /// The nearest positive semi-definite matrix by an eigen-decomposition of the symmetric part of
-/// A = Q Λ Qᵀ: Q max(Λ, 0) Qᵀ (clamp) or Q |Λ| Qᵀ (absolute). 3×3 (chapter 14's contact blocks), 9×9 or
-/// 12×12.
+/// A = Q Λ Qᵀ: Q max(Λ, 0) Qᵀ (clamp) or Q |Λ| Qᵀ (absolute). 3×3 (chapter 14's vertex blocks), 6×6
+/// (its edge pairs), 9×9 or 12×12.
 template <int N>
 Eigen::Matrix<double, N, N> project_to_psd(const Eigen::Matrix<double, N, N>& A, Projection projection);
 

@@ -128,8 +128,8 @@ public:
     virtual double energy(const Eigen::VectorXd& u) const = 0;
     /// ∇P(u) (3n) [N].
     virtual Eigen::VectorXd gradient(const Eigen::VectorXd& u) const = 0;
-    /// A positive semi-definite ∇²P(u) (3n×3n) [N/m] whose entries lie in the vertex-diagonal 3×3
-    /// blocks (the pattern of every stiffness matrix of the course holds them).
+    /// A positive semi-definite ∇²P(u) (3n×3n) [N/m] whose entries lie in the 3×3 blocks of vertices
+    /// that share a tet (the pattern of every stiffness matrix of the course holds them).
     virtual dynamics::SparseMatrix hessian(const Eigen::VectorXd& u) const = 0;
     /// The largest α in (0, 1] with P finite on the whole segment u + s·du, s ∈ [0, α], shrunk by
     /// a safety factor (default: 1, a potential that is finite everywhere).

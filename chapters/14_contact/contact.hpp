@@ -14,6 +14,7 @@
 // λ_k = κ Σ_p |b'(d_{o,p}(x_vᵗ))| its lagged normal force [N], T_k (3×2)
 // an orthonormal basis of the tangent plane ⟂ ∇d_o(x_vᵗ), w_o the obstacle's velocity (IPC: lagged friction).
 
+#include "14_contact/feature_barrier.hpp"
 #include "14_contact/obstacles.hpp"
 
 #include "12_hyperelastic_newton/newton.hpp"
@@ -160,6 +161,7 @@ private:
 
     std::vector<std::shared_ptr<const Obstacle>> obstacles_;
     ContactOptions options_;
+    FeatureBarrier features_;  // the obstacles' edges and corners against the body's surface
     Eigen::MatrixX3d rest_;            // X (#V × 3)
     std::vector<int> surface_;
     double average_mass_ = 0.0, diagonal_ = 0.0;

@@ -21,20 +21,20 @@ namespace {
 
 constexpr double infinity = std::numeric_limits<double>::infinity();
 
-using Box = Eigen::Matrix<double, 2, 3>;
+using BoundingBox = Eigen::Matrix<double, 2, 3>;
 
-Box box_of(const Eigen::Vector3d& a, const Eigen::Vector3d& b)
+BoundingBox box_of(const Eigen::Vector3d& a, const Eigen::Vector3d& b)
 {
-    Box box;
+    BoundingBox box;
     box.row(0) = a.cwiseMin(b).transpose();
     box.row(1) = a.cwiseMax(b).transpose();
     return box;
 }
 
 /// The boxes of a set of segments (rows of edges into points) or of points (edges empty).
-std::vector<Box> boxes_of(const Eigen::MatrixX3d& points, const Eigen::MatrixX2i& edges)
+std::vector<BoundingBox> boxes_of(const Eigen::MatrixX3d& points, const Eigen::MatrixX2i& edges)
 {
-    std::vector<Box> boxes;
+    std::vector<BoundingBox> boxes;
     if (edges.rows() == 0)
         for (Eigen::Index i = 0; i < points.rows(); ++i)
             boxes.push_back(box_of(points.row(i).transpose(), points.row(i).transpose()));
@@ -120,7 +120,7 @@ bool FeatureBarrier::for_each_pair(const Eigen::VectorXd& u, double time, double
             for (Eigen::Index e = 0; e < edges_.rows(); ++e) {
                 const int i = edges_(e, 0), j = edges_(e, 1);
                 const Eigen::Vector3d a0 = x(i), a1 = x(j);
-                const Box box = box_of(a0, a1);
+                const BoundingBox box = box_of(a0, a1);
                 for (int k : skin::boxes_meeting(features.edge_tree, features.edge_boxes,
                                                  box.row(0).transpose() - shift - grow,
                                                  box.row(1).transpose() - shift + grow)) {
