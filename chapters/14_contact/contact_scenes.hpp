@@ -1,6 +1,7 @@
 #pragma once
 // Chapter 14: the small scenes its checks and studies run — a block dropped on, resting on or sliding
-// along the floor z = 0 — and the closed forms they are measured against. docs/14_contact.md#checks
+// along the floor z = 0 (or dropped into other obstacles: the bowl) — and the closed forms they are
+// measured against. docs/14_contact.md#checks
 //
 // A slope of angle θ is the floor with gravity tilted by θ: g = g (sin θ, 0, −cos θ), the same
 // physics as a tilted plane with vertical gravity, with the block's faces on the axes.
@@ -16,6 +17,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace fem::contact {
 
@@ -24,6 +26,7 @@ struct BlockSettings {
     double edge = 0.1;                  ///< the cube's edge [m]
     int cells = 1;                      ///< cubes along an edge (box_mesh)
     double height = 5e-4;               ///< the gap under its lowest face at t = 0 [m]
+    Eigen::Vector2d corner = Eigen::Vector2d::Zero();  ///< x and y of its lowest corner [m]
     double slope = 0.0;                 ///< θ [rad] in [0, π/2): gravity tilted along +x
     double friction = 0.0;              ///< μ of the floor
     double gravity = 9.81;              ///< |g| [m/s²]
@@ -36,9 +39,11 @@ struct BlockSettings {
     hyper::NewtonOptions newton;        ///< chapter 12's Newton
     ContactOptions contact;             ///< d̂, κ, ε_v, …
     int friction_updates = 1;           ///< lagged friction updates per step, 0: until converged (step_with_friction_updates)
+    /// What the block meets; empty: the floor z = 0 (a HalfSpace with μ = friction).
+    std::vector<std::shared_ptr<const Obstacle>> obstacles;
 };
 
-/// A block of settings.model on the floor z = 0 (a HalfSpace with μ), its Newton
+/// A block of settings.model on the floor z = 0 (a HalfSpace with μ) or among settings.obstacles, its Newton
 /// integrator with the contact potential set, and its state at rest. Not copyable (the integrator
 /// points at the potential).
 struct BlockScene {
@@ -67,5 +72,10 @@ double lowest_height(const dynamics::Body& body, const Eigen::VectorXd& u);
 double slope_acceleration(double gravity, double slope, double friction);
 /// The speed of a fall from rest through height h: √(2 g h) [m/s].
 double drop_speed(double gravity, double height);
+/// The steady creep of a block that sticks (tan θ < μ), per step and as a fraction of ε_v Δt:
+/// 1 − √(1 − tan θ/μ). The friction μλ f₁(y) holds the tangential load λ tan θ, so f₁(y) = 2y/ε − y²/ε²
+/// = tan θ/μ, whose root below ε = ε_v Δt is y = ε (1 − √(1 − tan θ/μ)). fem::Error when it slides
+/// (tan θ ≥ μ).
+double sticking_creep(double slope, double friction);
 
 }  // namespace fem::contact

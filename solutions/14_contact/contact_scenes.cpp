@@ -26,6 +26,8 @@ BlockScene block_scene(const BlockSettings& settings)
         throw Error(str("block: the slope angle must lie in [0, pi/2), got ", settings.slope));
     dynamics::Scene scene;
     scene.mesh = box_mesh(settings.cells, settings.cells, settings.cells, Eigen::Vector3d::Constant(settings.edge));
+    scene.mesh.V.col(0).array() += settings.corner.x();
+    scene.mesh.V.col(1).array() += settings.corner.y();
     scene.mesh.V.col(2).array() += settings.height;
     scene.material = settings.material;
     scene.gravity = settings.gravity * Eigen::Vector3d(std::sin(settings.slope), 0.0, -std::cos(settings.slope));
@@ -34,9 +36,10 @@ BlockScene block_scene(const BlockSettings& settings)
     block.time_step = settings.time_step;
     block.friction_updates = settings.friction_updates;
     block.body = std::make_unique<dynamics::Body>(scene, hyper::make_force_model(settings.model, scene.mesh, scene.material));
-    std::vector<std::shared_ptr<const Obstacle>> floor{
-        std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), settings.friction)};
-    block.contact = std::make_unique<ContactPotential>(*block.body, floor, settings.contact);
+    std::vector<std::shared_ptr<const Obstacle>> obstacles = settings.obstacles;
+    if (obstacles.empty())
+        obstacles.push_back(std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), settings.friction));
+    block.contact = std::make_unique<ContactPotential>(*block.body, obstacles, settings.contact);
     block.integrator = std::make_unique<hyper::NewtonBackwardEuler>(settings.newton);
     block.integrator->set_potential(block.contact.get());
     block.state = dynamics::initial_state(*block.body);
@@ -68,6 +71,14 @@ double slope_acceleration(double gravity, double slope, double friction)
 double drop_speed(double gravity, double height)
 {
     return std::sqrt(2.0 * gravity * height);
+}
+
+double sticking_creep(double slope, double friction)
+{
+    const double load = std::tan(slope) / friction;
+    if (!(load < 1.0))
+        throw Error(str("sticking_creep: tan(theta) / mu = ", load, " >= 1: the block slides, it does not creep"));
+    return 1.0 - std::sqrt(1.0 - load);
 }
 
 }  // namespace fem::contact
