@@ -87,7 +87,10 @@ void slope_study(const RunContext& run, const Settings& settings)
     std::vector<fig::Series> paths;
     fig::LineChart costs;
     costs.title = "The sticking cube over d̂, κ and Δt: the cost against the error of its creep";
-    costs.x_label = "Newton iterations per simulated second";
+    std::string time_steps;
+    for (double dt : settings.time_steps)
+        time_steps += (time_steps.empty() ? "" : ", ") + time_step_label(dt);
+    costs.x_label = str("Newton iterations per simulated second (along a line: Δt = ", time_steps, " s)");
     costs.y_label = "creep's error: |mean creep / closed form − 1|";
     costs.log_x = costs.log_y = true;
     double gravity = 0.0, friction_velocity = 0.0;
