@@ -43,24 +43,52 @@ struct BlockSettings {
     std::vector<std::shared_ptr<const Obstacle>> obstacles;
 };
 
+/// A step with contact as a chapter 10 integrator, so that chapter 10's time loop (dynamics::Simulation:
+/// its energy books, its divergence check) runs a contact scene: step_with_friction_updates of a
+/// Newton backward Euler whose potential is contact, `updates` lagged friction updates a step. The
+/// barrier's work on the body over the step, B(uᵗ, t) − B(u⁺, t + Δt) with B =
+/// ContactPotential::barrier_energy at the step's κ, is booked as StepInfo::boundary_work (as the
+/// scenes runner books it), so that the energy the barrier stores and gives back is neither
+/// dissipation nor divergence in the loop's books.
+class ContactStep final : public dynamics::Integrator {
+public:
+    /// newton (with contact set as its potential) and contact are not owned and must outlive it;
+    /// updates as step_with_friction_updates takes them (0: until converged; < 0 fails at the step).
+    ContactStep(hyper::NewtonBackwardEuler& newton, ContactPotential& contact, int updates);
+    std::string name() const override;
+    int order() const override { return 1; }
+    /// One step of Δt (header comment); fem::Error as step_with_friction_updates.
+    dynamics::StepInfo step(dynamics::Body& body, double time_step, dynamics::State& state) override;
+    /// The solves the last step took (one for IPC's one lag).
+    int last_solves() const { return last_solves_; }
+
+private:
+    hyper::NewtonBackwardEuler& newton_;
+    ContactPotential& contact_;
+    int updates_;
+    int last_solves_ = 0;
+};
+
 /// A block of settings.model on the floor z = 0 (a HalfSpace with μ) or among settings.obstacles, its Newton
-/// integrator with the contact potential set, and its state at rest. Not copyable (the integrator
-/// points at the potential).
+/// integrator with the contact potential set, its step as a chapter 10 integrator, and its state at
+/// rest. Not copyable (the integrators point at the potential).
 struct BlockScene {
     std::unique_ptr<dynamics::Body> body;
     std::unique_ptr<ContactPotential> contact;
     std::unique_ptr<hyper::NewtonBackwardEuler> integrator;
+    /// The step with contact (Δt and friction updates of the settings) for chapter 10's time loop:
+    /// dynamics::Simulation(*body, *stepper, state).
+    std::unique_ptr<ContactStep> stepper;
     dynamics::State state;
 
-    /// One backward Euler step with contact (Δt and friction updates of the settings); solves (when
-    /// set) receives the number of solves it took.
+    /// One step of stepper from state (Δt of the settings); solves (when set) receives the number
+    /// of solves it took.
     dynamics::StepInfo step(int* solves = nullptr);
     double time_step = 0.0;
-    int friction_updates = 1;
 };
 
 /// The block of settings. fem::Error for an edge ≤ 0, cells < 1, a height < 0, θ outside [0, π/2),
-/// and what Scene, ContactPotential and NewtonBackwardEuler refuse.
+/// and what Scene, ContactPotential and NewtonBackwardEuler refuse (friction updates < 0: at the step).
 BlockScene block_scene(const BlockSettings& settings);
 
 /// The mass-weighted mean of the vertex velocities (3) [m/s]: the block's centre-of-mass velocity.

@@ -10,7 +10,6 @@
 #include "common/mesh_io.hpp"
 #include "common/motion.hpp"
 #include "common/table.hpp"
-#include "common/timer.hpp"
 
 #include <algorithm>
 #include <array>
@@ -40,18 +39,19 @@ void bowl_study(const RunContext& run)
               << " tets, " << steps << " steps of " << time_step_label(setup.time_step) << " s\n\n";
 
     io::MotionRecorder recorder(run.file("bowl.pvd"), run.figures ? 5 : 0);
-    recorder.add(0.0, dynamics::body_frame(*block.body, block.state));
     double smallest = std::numeric_limits<double>::infinity(), seconds = 0.0;
     int iterations = 0, most = 0;
-    for (int step = 0; step < steps; ++step) {
-        Timer timer;
-        const dynamics::StepInfo info = block.step();
-        seconds += timer.seconds();
-        iterations += info.newton_iterations;
-        most = std::max(most, info.newton_iterations);
-        smallest = std::min(smallest, block.contact->smallest_distance(block.state.u));
-        recorder.add(block.state.time, dynamics::body_frame(*block.body, block.state));
-    }
+    dynamics::Simulation simulation(*block.body, *block.stepper, block.state);
+    simulation.run(steps, [&](const dynamics::State& state, const dynamics::StepRecord& record) {
+        recorder.add(state.time, dynamics::body_frame(*block.body, state));
+        if (state.step == 0)
+            return;  // the start: no step yet
+        seconds += record.seconds;
+        iterations += record.newton_iterations;
+        most = std::max(most, record.newton_iterations);
+        smallest = std::min(smallest, block.contact->smallest_distance(state.u));
+    });
+    block.state = simulation.state();
     const Eigen::Vector3d centre = block.body->positions(block.state.u).colwise().mean().transpose();
     Table table("The block dropped into the bowl: cost, the smallest distance, where it ends",
                 {{"tets", Format::integer}, {"steps", Format::integer}, {"Newton iterations per step", Format::fixed, 2},

@@ -7,7 +7,6 @@
 #include "common/error.hpp"
 #include "common/figures.hpp"
 #include "common/table.hpp"
-#include "common/timer.hpp"
 #include "common/vtk_io.hpp"
 
 #include <algorithm>
@@ -104,37 +103,36 @@ void drop_study(const RunContext& run, const Settings& settings)
         std::optional<io::PvdSeries> series;
         if (first)
             series.emplace(run.file("drop.pvd"));
-        if (series)
-            series->add(0.0, dynamics::body_frame(*block.body, block.state));
         const bool charted = c.activation_distance == settings.activation_distances.front() &&
                              c.stiffness == settings.stiffnesses.front() && c.tolerance == settings.tolerances.front();
-        fig::Series height{str("Δt = ", time_step_label(c.time_step), " s"), {0.0}, {settings.drop_height}};
-        fig::Series force{height.name, {0.0}, {0.0}};
+        fig::Series height{str("Δt = ", time_step_label(c.time_step), " s"), {}, {}};
+        fig::Series force{height.name, {}, {}};
         gravity = block_setup.gravity;
         mass = block.body->dof_masses().sum() / 3.0;
         double fastest = 0.0, smallest = std::numeric_limits<double>::infinity(), rebound = 0.0, seconds = 0.0;
         int iterations = 0;
         bool bounced = false;
-        for (int step = 0; step < steps; ++step) {
-            Timer timer;
-            const dynamics::StepInfo info = block.step();
-            seconds += timer.seconds();
-            iterations += info.newton_iterations;
-            const double falling = -mean_velocity(*block.body, block.state.v).z();
+        dynamics::Simulation simulation(*block.body, *block.stepper, block.state);
+        simulation.run(steps, [&](const dynamics::State& state, const dynamics::StepRecord& record) {
+            if (series && state.step % 2 == 0)
+                series->add(state.time, dynamics::body_frame(*block.body, state));
+            if (charted) {
+                height.x.push_back(state.time);
+                height.y.push_back(lowest_height(*block.body, state.u));
+                force.x.push_back(state.time);
+                force.y.push_back(contact_force(*block.contact, state.u));
+            }
+            if (state.step == 0)
+                return;  // the start: no step yet
+            seconds += record.seconds;
+            iterations += record.newton_iterations;
+            const double falling = -mean_velocity(*block.body, state.v).z();
             fastest = std::max(fastest, falling);
-            smallest = std::min(smallest, block.contact->smallest_distance(block.state.u));
+            smallest = std::min(smallest, block.contact->smallest_distance(state.u));
             bounced = bounced || falling < 0.0;  // moving up: after the first contact
             if (bounced)
-                rebound = std::max(rebound, lowest_height(*block.body, block.state.u));
-            if (series && (step + 1) % 2 == 0)
-                series->add(block.state.time, dynamics::body_frame(*block.body, block.state));
-            if (charted) {
-                height.x.push_back(block.state.time);
-                height.y.push_back(lowest_height(*block.body, block.state.u));
-                force.x.push_back(block.state.time);
-                force.y.push_back(contact_force(*block.contact, block.state.u));
-            }
-        }
+                rebound = std::max(rebound, lowest_height(*block.body, state.u));
+        });
         first = false;
         if (charted) {
             heights.push_back(std::move(height));

@@ -8,7 +8,6 @@
 #include "common/error.hpp"
 #include "common/figures.hpp"
 #include "common/table.hpp"
-#include "common/timer.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -109,29 +108,35 @@ void slope_study(const RunContext& run, const Settings& settings)
             double seconds = 0.0, creep = 0.0, half_speed = 0.0, half_time = 0.0, half_place = 0.0;
             int iterations = 0, solves = 0;
             const bool charted = &c == &cases.front() && updates == settings.friction_updates.front();
-            const double start = block.body->positions(block.state.u).col(0).mean();
+            const auto along = [&](const dynamics::State& state) {  // the mean x of the vertices [m]
+                return block.body->positions(state.u).col(0).mean();
+            };
+            const double start = along(block.state);
+            double before = start;
             fig::Series path{str(slope.name, " (θ = ", std::lround(slope.angle / degree), "°, μ = ", slope.friction,
-                                 ", Δt = ", time_step_label(c.time_step), " s)"), {0.0}, {0.0}};
-            for (int step = 0; step < steps; ++step) {
-                const double before = block.body->positions(block.state.u).col(0).mean();
-                Timer timer;
-                int solved = 0;
-                const dynamics::StepInfo info = block.step(&solved);
-                seconds += timer.seconds();
-                iterations += info.newton_iterations;
-                solves += solved;
-                if (step + 1 > half)
-                    creep = std::max(creep, std::abs(block.body->positions(block.state.u).col(0).mean() - before));
-                if (step + 1 == half) {
-                    half_speed = mean_velocity(*block.body, block.state.v).x();
-                    half_time = block.state.time;
-                    half_place = block.body->positions(block.state.u).col(0).mean();
-                }
+                                 ", Δt = ", time_step_label(c.time_step), " s)"), {}, {}};
+            dynamics::Simulation simulation(*block.body, *block.stepper, block.state);
+            simulation.run(steps, [&](const dynamics::State& state, const dynamics::StepRecord& record) {
+                const double place = along(state);
                 if (charted) {
-                    path.x.push_back(block.state.time);
-                    path.y.push_back(block.body->positions(block.state.u).col(0).mean() - start);
+                    path.x.push_back(state.time);
+                    path.y.push_back(place - start);
                 }
-            }
+                if (state.step == 0)
+                    return;  // the start: no step yet
+                seconds += record.seconds;
+                iterations += record.newton_iterations;
+                solves += block.stepper->last_solves();
+                if (state.step > half)
+                    creep = std::max(creep, std::abs(place - before));
+                if (state.step == half) {
+                    half_speed = mean_velocity(*block.body, state.v).x();
+                    half_time = state.time;
+                    half_place = place;
+                }
+                before = place;
+            });
+            block.state = simulation.state();
             if (charted)
                 paths.push_back(std::move(path));
             gravity = setup.gravity;
@@ -144,7 +149,7 @@ void slope_study(const RunContext& run, const Settings& settings)
                                            [&](const fig::Series& s) { return s.name == name; });
                 if (series == costs.series.end())
                     series = costs.series.insert(costs.series.end(), fig::Series{name, {}, {}});
-                const double mean_creep = (block.body->positions(block.state.u).col(0).mean() - half_place) / (steps - half);
+                const double mean_creep = (along(block.state) - half_place) / (steps - half);
                 const double expected = sticking_creep(slope.angle, slope.friction) * setup.contact.friction_velocity * c.time_step;
                 series->x.push_back(iterations / settings.duration);
                 series->y.push_back(std::abs(mean_creep / expected - 1.0));

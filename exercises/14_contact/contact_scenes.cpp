@@ -12,9 +12,32 @@
 
 namespace fem::contact {
 
+ContactStep::ContactStep(hyper::NewtonBackwardEuler& newton, ContactPotential& contact, int updates)
+    : newton_(newton), contact_(contact), updates_(updates)
+{
+}
+
+std::string ContactStep::name() const
+{
+    return newton_.name() + " with contact";
+}
+
+dynamics::StepInfo ContactStep::step(dynamics::Body& body, double time_step, dynamics::State& state)
+{
+    const Eigen::VectorXd start = state.u;
+    const double start_time = state.time;
+    dynamics::StepInfo info = step_with_friction_updates(newton_, contact_, body, time_step, state, updates_, &last_solves_);
+    // κ is the step's now (begin_step set it): B at the start with it, against B at the end.
+    info.boundary_work += contact_.barrier_energy(start, start_time) - contact_.barrier_energy(state.u, state.time);
+    return info;
+}
+
 dynamics::StepInfo BlockScene::step(int* solves)
 {
-    return step_with_friction_updates(*integrator, *contact, *body, time_step, state, friction_updates, solves);
+    const dynamics::StepInfo info = stepper->step(*body, time_step, state);
+    if (solves != nullptr)
+        *solves = stepper->last_solves();
+    return info;
 }
 
 BlockScene block_scene(const BlockSettings& settings)
@@ -36,7 +59,6 @@ BlockScene block_scene(const BlockSettings& settings)
     scene.time_step = settings.time_step;
     BlockScene block;
     block.time_step = settings.time_step;
-    block.friction_updates = settings.friction_updates;
     block.body = std::make_unique<dynamics::Body>(scene, hyper::make_force_model(settings.model, scene.mesh, scene.material));
     std::vector<std::shared_ptr<const Obstacle>> obstacles = settings.obstacles;
     if (obstacles.empty())
@@ -44,6 +66,7 @@ BlockScene block_scene(const BlockSettings& settings)
     block.contact = std::make_unique<ContactPotential>(*block.body, obstacles, settings.contact);
     block.integrator = std::make_unique<hyper::NewtonBackwardEuler>(settings.newton);
     block.integrator->set_potential(block.contact.get());
+    block.stepper = std::make_unique<ContactStep>(*block.integrator, *block.contact, settings.friction_updates);
     block.state = dynamics::initial_state(*block.body);
     return block;
 }
