@@ -101,9 +101,9 @@ double slope_acceleration(double gravity, double slope, double friction);
 /// The speed of a fall from rest through height h: √(2 g h) [m/s].
 double drop_speed(double gravity, double height);
 /// The steady creep of a block that sticks (tan θ < μ), per step and as a fraction of ε_v Δt:
-/// 1 − √(1 − tan θ/μ). The friction μλ f₁(y) holds the tangential load λ tan θ, so f₁(y) = 2y/ε − y²/ε²
-/// = tan θ/μ, whose root below ε = ε_v Δt is y = ε (1 − √(1 − tan θ/μ)). fem::Error when it slides
-/// (tan θ ≥ μ).
+/// 1 − √(1 − tan θ/μ). The friction μλ f₁(y) holds the tangential load λ tan θ, so
+/// f₁(y) = 2y/ε − y²/ε² = tan θ/μ, whose root below ε = ε_v Δt is y = ε (1 − √(1 − tan θ/μ)).
+/// fem::Error when it slides (tan θ ≥ μ).
 double sticking_creep(double slope, double friction);
 
 }  // namespace fem::contact

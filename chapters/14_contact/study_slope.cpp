@@ -150,7 +150,8 @@ void slope_study(const RunContext& run, const Settings& settings)
                 if (series == costs.series.end())
                     series = costs.series.insert(costs.series.end(), fig::Series{name, {}, {}});
                 const double mean_creep = (along(block.state) - half_place) / (steps - half);
-                const double expected = sticking_creep(slope.angle, slope.friction) * setup.contact.friction_velocity * c.time_step;
+                const double expected =
+                    sticking_creep(slope.angle, slope.friction) * setup.contact.friction_velocity * c.time_step;
                 series->x.push_back(iterations / settings.duration);
                 series->y.push_back(std::abs(mean_creep / expected - 1.0));
             }

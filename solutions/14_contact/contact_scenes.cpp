@@ -24,7 +24,8 @@ dynamics::StepInfo ContactStep::step(dynamics::Body& body, double time_step, dyn
 {
     const Eigen::VectorXd start = state.u;
     const double start_time = state.time;
-    dynamics::StepInfo info = step_with_friction_updates(newton_, contact_, body, time_step, state, updates_, &last_solves_);
+    dynamics::StepInfo info =
+        step_with_friction_updates(newton_, contact_, body, time_step, state, updates_, &last_solves_);
     // κ is the step's now (begin_step set it): B at the start with it, against B at the end.
     info.boundary_work += contact_.barrier_energy(start, start_time) - contact_.barrier_energy(state.u, state.time);
     return info;
