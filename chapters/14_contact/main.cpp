@@ -5,12 +5,13 @@
 // The studies, in order:
 //   1. the drop: a cube falls h onto the floor; its speed at contact against √(2gh), how high it
 //      rebounds, the smallest distance ever seen, Newton iterations and time per step, swept over
-//      d̂, κ, Δt and the Newton tolerance; a .pvd of the drop;
+//      d̂, κ, Δt and the Newton tolerance; a .pvd of the drop, its height and force against time;
 //   2. the slope: a cube on a slope that slides (tan θ > μ) against a = g (sin θ − μ cos θ), and one
 //      that sticks (tan θ < μ), its creep per step against ε_v Δt, over the same sweep and with the
-//      friction lagged once a step or updated within it;
+//      friction lagged once a step or updated within it; the paths and the cost against the creep's error;
 //   3. mesh obstacles: the distance to a triangle mesh (the bowl, the bunny) by every triangle, by
 //      chapter 13's AABB tree and by sampled grids — time per query and error against the first;
+//      a block dropped into the bowl, its frames;
 //   4. primitive CCD: point–triangle and edge–edge continuous collision detection, the naive
 //      coplanarity cubic against the conservative inclusion method, on the CCD benchmark's queries
 //      (data/ccd-unit-tests; --ccd-queries FILE... runs only this study, on those files).
@@ -21,8 +22,9 @@
 //   ch14_contact --dhat 1e-3 --kappa 0 --dt 0.01   one configuration
 //   ch14_contact --ccd-queries data/ccd-unit-tests/edge-edge/data_0_0.csv   CCD on one query file
 //
-// Writes (under out/14_contact): drop_table.csv, slope_table.csv, mesh_table.csv, drop.pvd (frames drop/drop_NNNN.vtu),
-// ccd_queries_table.csv.
+// Writes (under out/14_contact): drop_table.csv, slope_table.csv, mesh_table.csv, bowl_table.csv,
+// ccd_queries_table.csv, drop.pvd and bowl.pvd (frames drop/drop_NNNN.vtu, …), charts drop_height,
+// drop_force, slope_slide, slope_stick, slope_cost (.csv, .png, .svg) and the bowl's frames bowl_NNNN.png.
 // docs/14_contact.md
 
 #include "14_contact/studies.hpp"

@@ -6,6 +6,7 @@
 
 #include "common/cli.hpp"
 
+#include <string>
 #include <vector>
 
 namespace fem::contact::study {
@@ -31,9 +32,14 @@ struct Case {
 std::vector<Case> sweep(const Settings& settings);
 /// The block settings of one case.
 BlockSettings block_settings(const Case& c);
+/// Δt as the tables write it: "1/100" for 0.01 s.
+std::string time_step_label(double time_step);
 
 void drop_study(const RunContext& run, const Settings& settings);
 void slope_study(const RunContext& run, const Settings& settings);
+/// The distance to a mesh three ways, then bowl_study.
 void mesh_study(const RunContext& run, const Settings& settings);
+/// A block dropped into the bowl (the mesh obstacle in use): bowl.pvd, its PNG frames, bowl_table.csv.
+void bowl_study(const RunContext& run);
 
 }  // namespace fem::contact::study

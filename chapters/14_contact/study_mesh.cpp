@@ -1,7 +1,8 @@
 // Study 3 of ch14_contact: the distance to a triangle mesh obstacle, three ways — every triangle
 // (the reference), chapter 13's AABB tree (exact, fewer triangles tested), and a sampled grid
 // (one cell a query, but only approximate) — timed per query and measured against the reference on
-// the same random points, over the whole box and near the surface, where the barrier looks.
+// the same random points, over the whole box and near the surface, where the barrier looks; then the
+// mesh obstacle in use, a block dropped into the bowl (study_bowl.cpp).
 // docs/14_contact.md#tree-or-grid
 #include "14_contact/mesh_obstacle.hpp"
 #include "14_contact/studies.hpp"
@@ -113,6 +114,7 @@ void mesh_study(const RunContext& run, const Settings& settings)
     }
     table.print(std::cout);
     table.write_csv(run.file("mesh_table.csv"));
+    bowl_study(run);
 }
 
 }  // namespace fem::contact::study

@@ -434,6 +434,7 @@ Eigen::Matrix<double, N, N> project_to_psd(const Eigen::Matrix<double, N, N>& A,
 }
 
 template Eigen::Matrix<double, 3, 3> project_to_psd<3>(const Eigen::Matrix<double, 3, 3>&, Projection);
+template Eigen::Matrix<double, 6, 6> project_to_psd<6>(const Eigen::Matrix<double, 6, 6>&, Projection);
 template Eigen::Matrix<double, 9, 9> project_to_psd<9>(const Eigen::Matrix<double, 9, 9>&, Projection);
 template Eigen::Matrix<double, 12, 12> project_to_psd<12>(const Eigen::Matrix<double, 12, 12>&, Projection);
 

@@ -243,6 +243,36 @@ int build_node(BoxHierarchy& tree, int first, int count, int leaf_size,
 
 }  // namespace
 
+std::vector<int> boxes_meeting(const BoxHierarchy& tree, const std::vector<Eigen::Matrix<double, 2, 3>>& boxes,
+                               const Eigen::Vector3d& low, const Eigen::Vector3d& high)
+{
+    const auto apart = [&](const Eigen::Vector3d& box_low, const Eigen::Vector3d& box_high) {
+        return (box_low.array() > high.array()).any() || (box_high.array() < low.array()).any();
+    };
+    std::vector<int> found;
+    if (tree.nodes.empty())
+        return found;
+    std::vector<int> stack{0};
+    while (!stack.empty()) {
+        const BoxNode& node = tree.nodes[static_cast<std::size_t>(stack.back())];
+        stack.pop_back();
+        if (apart(node.low, node.high))
+            continue;
+        if (node.left >= 0) {
+            stack.push_back(node.left);
+            stack.push_back(node.right);
+            continue;
+        }
+        for (int k = node.first; k < node.first + node.count; ++k) {
+            const int item = tree.items[static_cast<std::size_t>(k)];
+            const Eigen::Matrix<double, 2, 3>& box = boxes[static_cast<std::size_t>(item)];
+            if (!apart(box.row(0).transpose(), box.row(1).transpose()))
+                found.push_back(item);
+        }
+    }
+    return found;
+}
+
 BoxHierarchy box_hierarchy(const std::vector<Eigen::Matrix<double, 2, 3>>& boxes, int leaf_size)
 {
     if (leaf_size < 1)

@@ -26,6 +26,21 @@ namespace {
 
 constexpr double infinity = std::numeric_limits<double>::infinity();
 
+std::vector<std::shared_ptr<const Obstacle>> checked_obstacles(std::vector<std::shared_ptr<const Obstacle>> obstacles)
+{
+    if (obstacles.empty())
+        throw Error("contact: no obstacle given");
+    for (const auto& obstacle : obstacles)
+        if (!obstacle)
+            throw Error("contact: an obstacle is null");
+    return obstacles;
+}
+
+double checked_activation_distance(double activation_distance)
+{
+    require_positive(activation_distance, "contact activation distance d̂ [m]");
+    return activation_distance;
+}
 
 }  // namespace
 
@@ -59,14 +74,11 @@ double smallest_stiffness(double average_mass, double time_step, double activati
 
 ContactPotential::ContactPotential(const dynamics::Body& body, std::vector<std::shared_ptr<const Obstacle>> obstacles,
                                    ContactOptions options)
-    : obstacles_(std::move(obstacles)), options_(options), rest_(body.mesh().V)
+    : obstacles_(checked_obstacles(std::move(obstacles))),
+      options_(options),
+      features_(body.mesh(), obstacles_, checked_activation_distance(options.activation_distance)),
+      rest_(body.mesh().V)
 {
-    if (obstacles_.empty())
-        throw Error("contact: no obstacle given");
-    for (const auto& obstacle : obstacles_)
-        if (!obstacle)
-            throw Error("contact: an obstacle is null");
-    require_positive(options_.activation_distance, "contact activation distance d̂ [m]");
     if (!(std::isfinite(options_.stiffness) && options_.stiffness >= 0.0))
         throw Error(str("contact: the barrier stiffness kappa must be >= 0 (0: adaptive), got ", options_.stiffness));
     if (!(options_.safety > 0.0 && options_.safety < 1.0))
@@ -98,7 +110,7 @@ Eigen::Vector3d ContactPotential::position(const Eigen::VectorXd& u, int vertex)
 
 double ContactPotential::smallest_distance(const Eigen::VectorXd& u) const
 {
-    double smallest = infinity;
+    double smallest = features_.smallest_distance(u, time_, options_.activation_distance);
     for (int v : surface_)
         for (const auto& obstacle : obstacles_)
             smallest = std::min(smallest, obstacle->distance(position(u, v), time_));
@@ -120,7 +132,10 @@ bool ContactPotential::out_of_contact(const Eigen::VectorXd& u, double time, con
                 obstacle->time_of_impact(x, x_end - x - (end_time - time) * obstacle->velocity(), time) <= 1.0)
                 return false;
     }
-    return true;
+    // The obstacles' edges and corners against the body's edges and triangles, likewise.
+    const double near = std::min({features_.smallest_distance(u, time, reach), features_.smallest_distance(u, end_time, reach),
+                                  features_.smallest_distance(u_end, end_time, reach)});
+    return near >= reach && features_.relative_time_of_impact(u, time, u_end, end_time) > 1.0;
 }
 
 void ContactPotential::begin_step(dynamics::Body& body, const dynamics::State& state, double time_step)
@@ -236,7 +251,7 @@ double ContactPotential::barrier_energy(const Eigen::VectorXd& u, double time) c
             for (const DistancePiece& piece : pieces)
                 total += stiffness_ * barrier(piece.distance, options_.activation_distance).value;
         }
-    return total;
+    return total + features_.energy(u, time, stiffness_);
 }
 
 double ContactPotential::energy(const Eigen::VectorXd& u) const
@@ -277,7 +292,9 @@ Eigen::VectorXd ContactPotential::barrier_forces(const Eigen::VectorXd& u) const
     for (int v : surface_)
         for (const auto& obstacle : obstacles_)
             forces.segment<3>(3 * v) += barrier_force(*obstacle, position(u, v));
-    return forces;
+    Eigen::VectorXd feature_gradient = Eigen::VectorXd::Zero(u.size());
+    features_.add_gradient(u, time_, stiffness_, feature_gradient);
+    return forces - feature_gradient;
 }
 
 Eigen::VectorXd ContactPotential::gradient(const Eigen::VectorXd& u) const
@@ -300,7 +317,7 @@ double ContactPotential::obstacle_work(const Eigen::VectorXd& u, double time_ste
     }
     for (const FrictionPair& pair : pairs_)
         work += obstacles_[static_cast<std::size_t>(pair.obstacle)]->velocity().dot(friction_force(pair, u));
-    return time_step * work;
+    return time_step * (work + features_.obstacle_power(u, time_, stiffness_));
 }
 
 dynamics::SparseMatrix ContactPotential::hessian(const Eigen::VectorXd& u) const
@@ -342,6 +359,7 @@ dynamics::SparseMatrix ContactPotential::hessian(const Eigen::VectorXd& u) const
             for (int j = 0; j < 3; ++j)
                 triplets.emplace_back(3 * vertex + i, 3 * vertex + j, projected(i, j));
     }
+    features_.add_hessian(u, time_, stiffness_, triplets);
     dynamics::SparseMatrix H(u.size(), u.size());
     H.setFromTriplets(triplets.begin(), triplets.end());
     return H;
@@ -357,7 +375,7 @@ double ContactPotential::largest_safe_step(const Eigen::VectorXd& u, const Eigen
         for (const auto& obstacle : obstacles_)
             step = std::min(step, options_.safety * obstacle->time_of_impact(position(u, v), change, time_));
     }
-    return step;
+    return std::min(step, options_.safety * features_.time_of_impact(u, du, time_));
 }
 
 double ContactPotential::obstacle_advance(const Eigen::VectorXd& u, double time, double time_step, double from) const
@@ -371,6 +389,7 @@ double ContactPotential::obstacle_advance(const Eigen::VectorXd& u, double time,
         for (int v : surface_)
             earliest = std::min(earliest, obstacle->time_of_impact(position(u, v), travel, time + from * time_step));
     }
+    earliest = std::min(earliest, features_.relative_time_of_impact(u, time + from * time_step, u, time + time_step));
     return earliest > 1.0 ? 1.0 : from + options_.safety * earliest * (1.0 - from);
 }
 
@@ -415,6 +434,8 @@ Eigen::VectorXd ContactPotential::free_start(const dynamics::Body& body, const d
                                    obstacle.name(), ")");
                 }
             }
+            if (features_.relative_time_of_impact(state.u, state.time, state.u + time_step * v, obstacle_time) <= 1.0)
+                return "an obstacle's edge or corner meets the body's surface";
             return {};
         }();
         if (reached.empty())

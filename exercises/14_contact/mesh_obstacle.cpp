@@ -12,6 +12,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <map>
 
 namespace fem::contact {
 namespace {
@@ -111,25 +112,50 @@ MeshObstacle::Nearest MeshObstacle::nearest_brute_force(const Eigen::Vector3d& p
 
 std::vector<int> MeshObstacle::triangles_meeting(const Eigen::Vector3d& low, const Eigen::Vector3d& high) const
 {
-    std::vector<int> found, stack{0};
-    while (!stack.empty()) {
-        const skin::BoxNode& node = tree_.nodes[stack.back()];
-        stack.pop_back();
-        if ((node.low.array() > high.array()).any() || (node.high.array() < low.array()).any())
-            continue;
-        if (node.left >= 0) {
-            stack.push_back(node.left);
-            stack.push_back(node.right);
-            continue;
+    return skin::boxes_meeting(tree_, boxes_, low, high);
+}
+
+ObstacleFeatures MeshObstacle::local_features() const
+{
+    // Each edge (as its sorted corner pair) with the triangles on it, each signed by the direction it
+    // runs the edge in (+f + 1 from the lower corner to the higher, −f − 1 back).
+    std::map<std::pair<int, int>, std::vector<int>> sides;
+    for (int f = 0; f < static_cast<int>(surface_.F.rows()); ++f)
+        for (int i = 0; i < 3; ++i) {
+            const int a = surface_.F(f, i), b = surface_.F(f, (i + 1) % 3);
+            sides[{std::min(a, b), std::max(a, b)}].push_back(a < b ? f + 1 : -f - 1);
         }
-        for (int k = node.first; k < node.first + node.count; ++k) {
-            const int f = tree_.items[k];
-            if (!((boxes_[f].row(0).transpose().array() > high.array()).any() ||
-                  (boxes_[f].row(1).transpose().array() < low.array()).any()))
-                found.push_back(f);
+    const auto normal = [&](int f) {
+        const Eigen::Vector3d a = surface_.V.row(surface_.F(f, 0)), b = surface_.V.row(surface_.F(f, 1)),
+                              c = surface_.V.row(surface_.F(f, 2));
+        return Eigen::Vector3d((b - a).cross(c - a).normalized());
+    };
+    std::vector<std::pair<int, int>> sharp;
+    for (const auto& [edge, faces] : sides) {
+        bool is_sharp = faces.size() != 2;
+        if (!is_sharp) {
+            // Oriented alike, two neighbours run their edge in opposite directions; else one is flipped.
+            const Eigen::Vector3d n0 = normal(std::abs(faces[0]) - 1);
+            const Eigen::Vector3d n1 = (faces[0] > 0) == (faces[1] > 0) ? Eigen::Vector3d(-normal(std::abs(faces[1]) - 1))
+                                                                         : normal(std::abs(faces[1]) - 1);
+            is_sharp = n0.dot(n1) < 0.0 || n0.cross(n1).norm() > flat_mesh_edge_sine;
         }
+        if (is_sharp)
+            sharp.push_back(edge);
     }
-    return found;
+    ObstacleFeatures features;
+    features.edges.resize(static_cast<Eigen::Index>(sharp.size()), 2);
+    std::map<int, int> corner_of;  // mesh vertex → corner row
+    for (std::size_t e = 0; e < sharp.size(); ++e)
+        for (int end = 0; end < 2; ++end) {
+            const int vertex = end == 0 ? sharp[e].first : sharp[e].second;
+            const auto [slot, fresh] = corner_of.try_emplace(vertex, static_cast<int>(corner_of.size()));
+            features.edges(static_cast<Eigen::Index>(e), end) = slot->second;
+        }
+    features.corners.resize(static_cast<Eigen::Index>(corner_of.size()), 3);
+    for (const auto& [vertex, row] : corner_of)
+        features.corners.row(row) = surface_.V.row(vertex);
+    return features;
 }
 
 bool MeshObstacle::crosses(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1) const

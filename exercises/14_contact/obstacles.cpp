@@ -192,4 +192,23 @@ double conservative_time_of_impact(const Obstacle& obstacle, const Eigen::Vector
     return s;
 }
 
+ObstacleFeatures Box::local_features() const
+{
+    ObstacleFeatures features;
+    features.corners.resize(8, 3);
+    // Corner k has the sign pattern of k's bits: bit i set → +h_i.
+    for (int k = 0; k < 8; ++k) {
+        const Eigen::Vector3d sign((k & 1) ? 1.0 : -1.0, (k & 2) ? 1.0 : -1.0, (k & 4) ? 1.0 : -1.0);
+        features.corners.row(k) = (centre_ + rotation_ * sign.cwiseProduct(half_)).transpose();
+    }
+    // An edge joins two corners that differ in one bit.
+    features.edges.resize(12, 2);
+    int e = 0;
+    for (int k = 0; k < 8; ++k)
+        for (int bit = 1; bit < 8; bit <<= 1)
+            if ((k & bit) == 0)
+                features.edges.row(e++) << k, k | bit;
+    return features;
+}
+
 }  // namespace fem::contact

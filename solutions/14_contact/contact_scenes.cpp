@@ -10,15 +10,27 @@
 
 namespace fem::contact {
 
-dynamics::StepInfo BlockScene::step(int* solves)
+ContactStep::ContactStep(hyper::NewtonBackwardEuler& newton, ContactPotential& contact, int updates)
+    : newton_(newton), contact_(contact), updates_(updates)
 {
-    return contact_step(*integrator, *contact, *body, time_step, state, friction_updates, solves);
 }
 
-void BlockScene::set_obstacles(std::vector<std::shared_ptr<const Obstacle>> obstacles, const ContactOptions& options)
+std::string ContactStep::name() const
 {
-    contact = std::make_unique<ContactPotential>(*body, std::move(obstacles), options);
-    integrator->set_potential(contact.get());
+    return newton_.name() + " with contact";
+}
+
+dynamics::StepInfo ContactStep::step(dynamics::Body& body, double time_step, dynamics::State& state)
+{
+    return contact_step(newton_, contact_, body, time_step, state, updates_, &last_solves_);
+}
+
+dynamics::StepInfo BlockScene::step(int* solves)
+{
+    const dynamics::StepInfo info = stepper->step(*body, time_step, state);
+    if (solves != nullptr)
+        *solves = stepper->last_solves();
+    return info;
 }
 
 BlockScene block_scene(const BlockSettings& settings)
@@ -32,19 +44,22 @@ BlockScene block_scene(const BlockSettings& settings)
         throw Error(str("block: the slope angle must lie in [0, pi/2), got ", settings.slope));
     dynamics::Scene scene;
     scene.mesh = box_mesh(settings.cells, settings.cells, settings.cells, Eigen::Vector3d::Constant(settings.edge));
+    scene.mesh.V.col(0).array() += settings.corner.x();
+    scene.mesh.V.col(1).array() += settings.corner.y();
     scene.mesh.V.col(2).array() += settings.height;
     scene.material = settings.material;
     scene.gravity = settings.gravity * Eigen::Vector3d(std::sin(settings.slope), 0.0, -std::cos(settings.slope));
     scene.time_step = settings.time_step;
     BlockScene block;
     block.time_step = settings.time_step;
-    block.friction_updates = settings.friction_updates;
     block.body = std::make_unique<dynamics::Body>(scene, hyper::make_force_model(settings.model, scene.mesh, scene.material));
-    std::vector<std::shared_ptr<const Obstacle>> floor{
-        std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), settings.friction)};
-    block.contact = std::make_unique<ContactPotential>(*block.body, floor, settings.contact);
+    std::vector<std::shared_ptr<const Obstacle>> obstacles = settings.obstacles;
+    if (obstacles.empty())
+        obstacles.push_back(std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), settings.friction));
+    block.contact = std::make_unique<ContactPotential>(*block.body, obstacles, settings.contact);
     block.integrator = std::make_unique<hyper::NewtonBackwardEuler>(settings.newton);
     block.integrator->set_potential(block.contact.get());
+    block.stepper = std::make_unique<ContactStep>(*block.integrator, *block.contact, settings.friction_updates);
     block.state = dynamics::initial_state(*block.body);
     return block;
 }
@@ -74,6 +89,14 @@ double slope_acceleration(double gravity, double slope, double friction)
 double drop_speed(double gravity, double height)
 {
     return std::sqrt(2.0 * gravity * height);
+}
+
+double sticking_creep(double slope, double friction)
+{
+    const double load = std::tan(slope) / friction;
+    if (!(load < 1.0))
+        throw Error(str("sticking_creep: tan(theta) / mu = ", load, " >= 1: the block slides, it does not creep"));
+    return 1.0 - std::sqrt(1.0 - load);
 }
 
 }  // namespace fem::contact

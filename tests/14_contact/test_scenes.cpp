@@ -72,7 +72,6 @@ TEST_CASE("a cube at rest on the floor: its contact forces sum to its weight at 
     settings.height = 0.5 * settings.contact.activation_distance;
     settings.time_step = 0.05;  // backward Euler's damping brings the block to rest in a few steps
     settings.newton.relative_tolerance = 1e-10;
-    BlockScene block = block_scene(settings);
     for (int step = 0; step < 40; ++step) {
         block.step();
         REQUIRE(lowest_height(*block.body, block.state.u) > 0.0);
@@ -225,7 +224,8 @@ double fire_at(std::shared_ptr<const Obstacle> obstacle)
     settings.gravity = 0.0;
     settings.newton.max_iterations = 500;
     BlockScene block = block_scene(settings);
-    block.set_obstacles({std::move(obstacle)}, settings.contact);
+    settings.obstacles = {std::move(obstacle)};
+    BlockScene block = block_scene(settings);
     const ContactPotential& contact = *block.contact;
     WatchedContact watched(*block.contact);
     block.integrator->set_potential(&watched);
@@ -278,11 +278,10 @@ TEST_CASE("a conveyor floor (moving along x) drags a resting block up to its spe
 {
     BlockSettings settings;
     settings.height = 1e-4;
-    BlockScene block = block_scene(settings);
     const double belt = 0.1, mu = 0.5;
-    block.set_obstacles({std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), mu,
-                                                     Eigen::Vector3d(belt, 0.0, 0.0))},
-                        settings.contact);
+    settings.obstacles = {std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), mu,
+                                                     Eigen::Vector3d(belt, 0.0, 0.0))};
+    BlockScene block = block_scene(settings);
     // Coulomb: it slides with a = μ g until it moves with the belt, after t = w/(μ g) ≈ 0.02 s.
     for (int step = 0; step < 30; ++step) {
         block.step();
@@ -301,10 +300,9 @@ TEST_CASE("a rising floor lifts the block at its speed, however fast, and the en
     const double rise = GENERATE(2e-3, 1e-2, 1e-1, 1.0);  // [m/s]
     BlockSettings settings;
     settings.height = 1e-4;
+    settings.obstacles = {std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.0,
+                                                     Eigen::Vector3d(0.0, 0.0, rise))};
     BlockScene block = block_scene(settings);
-    block.set_obstacles({std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.0,
-                                                     Eigen::Vector3d(0.0, 0.0, rise))},
-                        settings.contact);
     // Chapter 10's books: H = K + U + gravity's potential, W_in the work put in (the barrier's store
     // and the floor's push, contact_step's boundary work). Backward Euler only dissipates.
     const double start_energy = dynamics::energies(*block.body, block.state).total();
@@ -333,14 +331,12 @@ TEST_CASE("two plates squeezing a block stop the run with a clear error before a
     settings.height = 1e-4;
     settings.gravity = 0.0;
     settings.model = GENERATE(as<std::string>{}, "corotational", "stable-neo-hookean");
-    BlockScene block = block_scene(settings);
     const double closing = GENERATE(0.01, 0.5);  // [m/s] each: 0.1 mm and 5 mm a step, a gap of 0.1 mm: in stages
-    block.set_obstacles(
-        {std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.0,
+    settings.obstacles = {std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.0,
                                      Eigen::Vector3d(0.0, 0.0, closing)),
          std::make_shared<HalfSpace>(Eigen::Vector3d(0.0, 0.0, settings.edge + 2.0 * settings.height),
-                                     -Eigen::Vector3d::UnitZ(), 0.0, Eigen::Vector3d(0.0, 0.0, -closing))},
-        settings.contact);
+                                     -Eigen::Vector3d::UnitZ(), 0.0, Eigen::Vector3d(0.0, 0.0, -closing))};
+    BlockScene block = block_scene(settings);
     std::string error;
     int steps = 0;
     for (; steps < 600 && error.empty(); ++steps) {
@@ -370,13 +366,11 @@ TEST_CASE("a block dropped on a turned box comes to rest on its top face, never 
 {
     BlockSettings settings;
     settings.height = 0.01;
-    BlockScene block = block_scene(settings);
     // A slab under the block, turned 0.3 rad about z: its top face is z = 0, its time of impact
     // conservative advancement.
     const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-    block.set_obstacles(
-        {std::make_shared<Box>(Eigen::Vector3d(0.05, 0.05, -0.05), Eigen::Vector3d(0.2, 0.2, 0.05), turn)},
-        settings.contact);
+    settings.obstacles = {std::make_shared<Box>(Eigen::Vector3d(0.05, 0.05, -0.05), Eigen::Vector3d(0.2, 0.2, 0.05), turn)};
+    BlockScene block = block_scene(settings);
     const ContactPotential& contact = *block.contact;
     for (int step = 0; step < 60; ++step) {
         block.step();
