@@ -20,6 +20,7 @@ namespace fem::contact {
 namespace {
 
 constexpr double infinity = std::numeric_limits<double>::infinity();
+constexpr long long line_search_ccd_boxes = 4000;
 
 using BoundingBox = Eigen::Matrix<double, 2, 3>;
 
@@ -67,6 +68,68 @@ PrimitiveFunction mollified_barrier(const PrimitiveFunction& squared, const Prim
     result.hessian = mollifier.value * barrier_hessian + barrier_gradient * mollifier.gradient.transpose() +
                      mollifier.gradient * barrier_gradient.transpose() + b.value * mollifier.hessian;
     return result;
+}
+
+/// The squared distance of the primitives of motion at s ∈ [0, 1].
+double squared_distance_at(PrimitivePair kind, const PrimitiveMotion& motion, double s)
+{
+    const Eigen::Matrix<double, 3, 4> x = (1.0 - s) * motion.start + s * motion.end;
+    if (kind == PrimitivePair::point_triangle)
+        return point_triangle_squared_distance(x.col(0), x.col(1), x.col(2), x.col(3),
+                                               point_triangle_type(x.col(0), x.col(1), x.col(2), x.col(3)))
+            .value;
+    return edge_edge_squared_distance(x.col(0), x.col(1), x.col(2), x.col(3),
+                                      edge_edge_type(x.col(0), x.col(1), x.col(2), x.col(3)))
+        .value;
+}
+
+/// Additive conservative advancement (after Li et al. 2021): with the common part of the vertices'
+/// moves taken out (it moves neither primitive relative to the other), M = the largest move of the
+/// first primitive's vertices plus the largest of the second's bounds how fast their distance d
+/// can fall, so from s the distance stays above g for a further (d(s) − g)/M. Advanced until that
+/// step is below 10⁻³ of s (at most 100 times), with g = d(0)/10, it answers an s at which the
+/// distance is still ≥ g > 0: a lower bound of the time of impact, and one that a step can be cut
+/// to without coming nearer than a tenth of the distance it started at; +∞ when s passes 1.
+double additive_time_of_impact(PrimitivePair kind, const PrimitiveMotion& motion)
+{
+    Eigen::Matrix<double, 3, 4> change = motion.end - motion.start;
+    change.colwise() -= change.rowwise().mean();
+    const int first = kind == PrimitivePair::point_triangle ? 1 : 2;  // vertices of the first primitive
+    double first_move = 0.0, second_move = 0.0;
+    for (int i = 0; i < 4; ++i) {
+        double& move = i < first ? first_move : second_move;
+        move = std::max(move, change.col(i).norm());
+    }
+    const double bound = first_move + second_move;
+    const double gap = 0.1 * std::sqrt(squared_distance_at(kind, motion, 0.0));
+    if (bound == 0.0)
+        return infinity;
+    double s = 0.0;
+    for (int advance = 0; advance < 100; ++advance) {
+        const double step = (std::sqrt(squared_distance_at(kind, motion, s)) - gap) / bound;
+        if (step <= 0.0)
+            return s;
+        s += step;
+        if (s > 1.0)
+            return infinity;
+        if (step < 1e-3 * s)
+            break;
+    }
+    return s;
+}
+
+/// A lower bound of the first s ∈ [0, 1] at which the primitives of motion touch (+∞: never): the
+/// larger of the inclusion method's time of impact (ccd.hpp; stopped at line_search_ccd_boxes, so
+/// that edges moving in one plane cost no more than that) and additive_time_of_impact's, which
+/// keeps the answer above 0 while they are apart, where the first may answer 0 within its
+/// tolerance of a contact or at its box limit.
+double impact_time(PrimitivePair kind, const PrimitiveMotion& motion)
+{
+    const double inclusion =
+        inclusion_ccd(kind, motion, {.tolerance = 1e-6, .max_boxes = line_search_ccd_boxes}).time_of_impact;
+    if (!std::isfinite(inclusion))
+        return inclusion;
+    return std::max(inclusion, additive_time_of_impact(kind, motion));
 }
 
 }  // namespace
@@ -273,7 +336,7 @@ double FeatureBarrier::earliest_impact(const MatrixX3d& x0, const MatrixX3d& x1,
                     const Eigen::Vector3d b0 = corner(features.edges(k, 0)), b1 = corner(features.edges(k, 1));
                     motion.start << start(i), start(j), b0, b1;
                     motion.end << end(i), end(j), b0, b1;
-                    earliest = std::min(earliest, inclusion_ccd(PrimitivePair::edge_edge, motion).time_of_impact);
+                    earliest = std::min(earliest, impact_time(PrimitivePair::edge_edge, motion));
                 }
             }
         for (Eigen::Index t = 0; t < triangles_.rows(); ++t) {
@@ -286,7 +349,7 @@ double FeatureBarrier::earliest_impact(const MatrixX3d& x0, const MatrixX3d& x1,
                 const Eigen::Vector3d p = corner(k);
                 motion.start << p, start(a), start(b), start(c);
                 motion.end << p, end(a), end(b), end(c);
-                earliest = std::min(earliest, inclusion_ccd(PrimitivePair::point_triangle, motion).time_of_impact);
+                earliest = std::min(earliest, impact_time(PrimitivePair::point_triangle, motion));
             }
         }
     }

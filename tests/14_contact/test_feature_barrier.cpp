@@ -1,0 +1,156 @@
+// Chapter 14: the obstacles' edges and corners against the body's surface (feature_barrier.hpp):
+// its derivatives against central differences, and the knife — a wedge's ridge and a box's edge
+// pressed into a one-cell block's face between its vertices, which the vertices' barrier alone let
+// in 3–4 cm. docs/14_contact.md#edges-and-corners-of-obstacles
+#include "14_contact/contact.hpp"
+#include "14_contact/contact_scenes.hpp"
+#include "14_contact/mesh_obstacle.hpp"
+#include "14_contact/obstacles.hpp"
+
+#include "04_tet_jacobians/tet_jacobians.hpp"
+
+#include "common/random.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+using namespace fem;
+using namespace fem::contact;
+
+namespace {
+
+/// A wedge lying along y, edge down: its ridge the segment from (0.05, −0.1, ridge) to
+/// (0.05, 0.2, ridge), its flanks rising 1 in 1 to z = ridge + 0.1 (an open sheet of four
+/// triangles), moving with velocity.
+std::shared_ptr<const Obstacle> wedge(double ridge, const Eigen::Vector3d& velocity)
+{
+    TriMesh sheet;
+    sheet.V.resize(6, 3);
+    sheet.V << 0.05, -0.1, ridge, 0.05, 0.2, ridge, -0.05, -0.1, ridge + 0.1, -0.05, 0.2, ridge + 0.1, 0.15, -0.1,
+        ridge + 0.1, 0.15, 0.2, ridge + 0.1;
+    sheet.F.resize(4, 3);
+    sheet.F << 0, 1, 3, 0, 3, 2, 0, 4, 5, 0, 5, 1;
+    return std::make_shared<MeshObstacle>(sheet, 0.0, velocity);
+}
+
+/// Whether some obstacle edge crosses a tet of the body at u: the segment–tet test by the signs of
+/// the tet's barycentric coordinates along the segment, sampled finely (the knife's check).
+bool edge_inside_body(const dynamics::Body& body, const Eigen::VectorXd& u, const ObstacleFeatures& features,
+                      const Eigen::Vector3d& shift)
+{
+    const MatrixX3d x = body.positions(u);
+    for (Eigen::Index e = 0; e < features.edges.rows(); ++e) {
+        const Eigen::Vector3d a = features.corners.row(features.edges(e, 0)).transpose() + shift;
+        const Eigen::Vector3d b = features.corners.row(features.edges(e, 1)).transpose() + shift;
+        for (int k = 0; k <= 2000; ++k) {
+            const Eigen::Vector3d p = a + (b - a) * (k / 2000.0);
+            for (int t = 0; t < static_cast<int>(body.mesh().T.rows()); ++t)
+                if ((tet::shape_functions(tet::tet_vertices(body.mesh(), x, t), p).array() > 0.0).all())
+                    return true;
+        }
+    }
+    return false;
+}
+
+}  // namespace
+
+TEST_CASE("edge and corner barrier: energy, gradient and Hessian against central differences", "[ex14.1]")
+{
+    // A one-cube block over a box turned so that its top corner and two top edges come within d̂ of
+    // the block's lower face and edges, not at its vertices.
+    BlockSettings settings;
+    settings.height = 0.0;
+    settings.contact.stiffness = 50.0;
+    const Eigen::Matrix3d turn = (Eigen::AngleAxisd(0.6, Eigen::Vector3d::UnitZ()) *
+                                  Eigen::AngleAxisd(0.61548, Eigen::Vector3d::UnitX()) *
+                                  Eigen::AngleAxisd(0.7854, Eigen::Vector3d::UnitY()))
+                                     .toRotationMatrix();
+    const Eigen::Vector3d half(0.03, 0.03, 0.03);
+    // The box's highest corner, 0.4 mm under the block's lower face at (0.043, 0.057).
+    Eigen::Vector3d highest = Eigen::Vector3d::Constant(-1e9);
+    for (int k = 0; k < 8; ++k) {
+        const Eigen::Vector3d sign((k & 1) ? 1.0 : -1.0, (k & 2) ? 1.0 : -1.0, (k & 4) ? 1.0 : -1.0);
+        const Eigen::Vector3d corner = turn * sign.cwiseProduct(half);
+        if (corner.z() > highest.z())
+            highest = corner;
+    }
+    const Eigen::Vector3d centre = Eigen::Vector3d(0.043, 0.057, -4e-4) - highest;
+    settings.obstacles = {std::make_shared<Box>(centre, half, turn)};
+    BlockScene block = block_scene(settings);
+    ContactPotential& contact = *block.contact;
+    contact.begin_step(*block.body, block.state, settings.time_step);
+    const Eigen::Index n = block.state.u.size();
+    for (int seed : {1, 2, 3}) {
+        const Eigen::VectorXd u = 5e-5 * random_vector(n, seed);
+        const double energy = contact.energy(u);
+        REQUIRE(std::isfinite(energy));
+        REQUIRE(energy > 0.0);  // the corner is within d̂ of the face, no vertex is
+        const Eigen::VectorXd g = contact.gradient(u);
+        const Eigen::MatrixXd H = Eigen::MatrixXd(contact.hessian(u));
+        Eigen::VectorXd g_fd(n);
+        Eigen::MatrixXd H_fd(n, n);
+        const double h = 1e-8;
+        for (Eigen::Index i = 0; i < n; ++i) {
+            Eigen::VectorXd e = Eigen::VectorXd::Zero(n);
+            e[i] = h;
+            g_fd[i] = (contact.energy(u + e) - contact.energy(u - e)) / (2.0 * h);
+            H_fd.col(i) = (contact.gradient(u + e) - contact.gradient(u - e)) / (2.0 * h);
+        }
+        INFO("seed " << seed << ", energy " << energy << ", |g| " << g.norm() << ", |g - g_fd| " << (g - g_fd).norm());
+        CHECK((g - g_fd).norm() <= 1e-5 * g.norm());
+        // The Hessian is the sum of each pair's PSD projection: PSD itself, and it adds to the exact
+        // Hessian only what the projections add, so H − H_exact is PSD too.
+        const Eigen::MatrixXd symmetric = 0.5 * (H_fd + H_fd.transpose());
+        INFO("|H| " << H.norm() << ", |H_fd| " << symmetric.norm());
+        CHECK(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(H).eigenvalues().minCoeff() >= -1e-8 * H.norm());
+        CHECK(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(H - symmetric).eigenvalues().minCoeff() >=
+              -1e-4 * H.norm());
+    }
+}
+
+TEST_CASE("the knife: a wedge's ridge and a box's edge pressed into a one-cell block never enter it", "[ex14.1]")
+{
+    // The block (10 cm, one cell: its top face two triangles) on the floor; a ridge along y over the
+    // middle of its top face, between its vertices, 0.5 mm above it, comes down at 2 cm/s for
+    // 0.2 s: 3.5 mm into where the face was. With the vertices' barrier alone it cut in that far.
+    const std::string kind = GENERATE(as<std::string>{}, "wedge", "box edge");
+    BlockSettings settings;
+    settings.height = 1e-4;
+    const double top = settings.height + settings.edge, gap = 5e-4, speed = 0.02;
+    const Eigen::Vector3d down(0.0, 0.0, -speed);
+    std::shared_ptr<const Obstacle> knife;
+    if (kind == "wedge") {
+        knife = wedge(top + gap, down);
+    } else {
+        // A box turned 45° about y: its lowest edge the line x = 0.05, z = top + gap along y.
+        const Eigen::Matrix3d turn = Eigen::AngleAxisd(std::acos(-1.0) / 4.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
+        knife = std::make_shared<Box>(Eigen::Vector3d(0.05, 0.05, top + gap + 0.05 * std::sqrt(2.0)),
+                                      Eigen::Vector3d(0.05, 0.15, 0.05), turn, 0.0, down);
+    }
+    settings.obstacles = {std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ()), knife};
+    BlockScene block = block_scene(settings);
+    const ObstacleFeatures features = knife->local_features();
+    REQUIRE(features.edges.rows() > 0);
+    for (int step = 0; step < 20; ++step) {
+        block.step();
+        INFO(kind << ", step " << step + 1);
+        REQUIRE(block.contact->smallest_distance(block.state.u) > 0.0);
+        REQUIRE_FALSE(edge_inside_body(*block.body, block.state.u, features, block.state.time * down));
+    }
+    // The block carries the press: its top vertices pushed down with the ridge (edge_inside_body
+    // says the face was not cut instead), 5 cm beside it.
+    const MatrixX3d x = block.body->positions(block.state.u);
+    const double ridge = top + gap - speed * block.state.time;
+    double highest = -1.0;
+    for (Eigen::Index v = 0; v < x.rows(); ++v)
+        highest = std::max(highest, x(v, 2));
+    INFO(kind << ": ridge at " << ridge << " m, the block's highest vertex at " << highest << " m");
+    CHECK(highest < top - 3e-3);
+}
