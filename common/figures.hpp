@@ -1,11 +1,11 @@
 #pragma once
-// PNG figures drawn with VTK offscreen: line charts (log-log where it fits) and meshes or grids
-// coloured by a field. Every chart is also saved as CSV with the same numbers.
-//
-// Debian's VTK renders only through an X display and aborts without one, so every function here
-// first checks that a display can be opened. Without one it draws nothing, returns false, and the
-// first such call prints one line saying that PNGs were skipped and how to get them
-// (run under `xvfb-run -a`). VTK files and CSVs never depend on a display.
+// Figures drawn with VTK: line charts (log-log where it fits) offscreen to PNG and SVG, with a CSV of
+// the same numbers (figures_chart.cpp); meshes or grids coloured by a field, offscreen to PNG
+// (figures_mesh.cpp); an on-screen window showing a mesh as its PNG would (MeshWindow,
+// figures_window.cpp); what they share, figures.cpp. Debian's VTK renders only through an X display
+// and aborts without one, so every function here first checks that a display can be opened: without
+// one the PNG writers draw nothing, return false and say once how to get them (`xvfb-run -a`), and a
+// MeshWindow refuses with fem::Error. VTK files and CSVs never depend on a display.
 
 #include "common/vtk_io.hpp"
 
@@ -19,7 +19,7 @@
 
 namespace fem::fig {
 
-/// The version of the drawing code in figures.cpp (and motion.cpp's frames), defined in figures.cpp
+/// The version of the drawing code in figures*.cpp (and motion.cpp's frames), defined in figures.cpp
 /// (so that a bump recompiles one file). Every PNG written here carries it as a PNG text chunk, key
 /// figure_version_key, value this number; bump it whenever a change alters what a figure looks
 /// like. tools/check_figures.py (ctest figures_current) fails for a figure under docs/figures with

@@ -1,3 +1,10 @@
+# The executable's studies, one file each (studies.hpp); not part of the chapter's library.
+target_sources(${exe} PRIVATE
+  ${FEM_ROOT}/chapters/08_direct_solvers/study_support.cpp ${FEM_ROOT}/chapters/08_direct_solvers/study_dense.cpp
+  ${FEM_ROOT}/chapters/08_direct_solvers/study_hilbert.cpp ${FEM_ROOT}/chapters/08_direct_solvers/study_orderings.cpp
+  ${FEM_ROOT}/chapters/08_direct_solvers/study_speed.cpp ${FEM_ROOT}/chapters/08_direct_solvers/study_solve_many.cpp
+  ${FEM_ROOT}/chapters/08_direct_solvers/study_threads.cpp ${FEM_ROOT}/chapters/08_direct_solvers/study_failures.cpp
+  ${FEM_ROOT}/chapters/08_direct_solvers/study_box.cpp)
 # Chapter 08's executable compares our sparse Cholesky with CHOLMOD's supernodal one (through
 # Eigen's CholmodSupport) when SuiteSparse is installed (Debian: libsuitesparse-dev). Optional:
 # without it the executable prints "CHOLMOD not installed" rows. Included by fem_add_chapter.

@@ -1,3 +1,12 @@
+# The executable's studies, one file each (studies.hpp); not part of the chapter's library.
+target_sources(${exe} PRIVATE
+  ${FEM_ROOT}/chapters/09_conjugate_gradient/study_support.cpp
+  ${FEM_ROOT}/chapters/09_conjugate_gradient/study_conditioning.cpp
+  ${FEM_ROOT}/chapters/09_conjugate_gradient/study_operator.cpp
+  ${FEM_ROOT}/chapters/09_conjugate_gradient/study_preconditioners.cpp
+  ${FEM_ROOT}/chapters/09_conjugate_gradient/study_speed.cpp
+  ${FEM_ROOT}/chapters/09_conjugate_gradient/study_hard_cases.cpp
+  ${FEM_ROOT}/chapters/09_conjugate_gradient/study_pictures.cpp)
 # Chapter 09's solver interface (linear_solver.hpp) offers "cholmod" when chapter 08's
 # chapter.cmake found SuiteSparse's CHOLMOD (FEM_CHOLMOD_INCLUDE_DIR, FEM_CHOLMOD_LIBRARY).
 # The library links it publicly, so every later chapter that picks a solver by name can use it.

@@ -1,0 +1,61 @@
+#pragma once
+// The readers of a scene file's parts, the steps of read_scene (solutions/scenes/scene_file.cpp):
+// selectors and motions (scene_selectors.cpp), obstacles (scene_obstacles.cpp), the memory budget
+// (scene_memory.cpp), a body's mesh (scene_mesh.cpp), a body (scene_body.cpp) and the overrides of
+// [quick] and --set (scene_overrides.cpp). Internal to the scene reader. docs/scenes.md#the-scene-file
+
+#include "scenes/scene_fields.hpp"
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace fem::scenes::detail {
+
+/// A selector table's one of box = [[x0, y0, z0], [x1, y1, z1]], plane = { point, normal, side } or
+/// vertices = [...]; its `where` names the table. docs/scenes.md#selecting-vertices
+Selector read_selector(const Fields& fields);
+
+/// A pin's motion: fixed, rotate (axis, center, angle in degrees) or translate (displacement) over
+/// [start, end] (end defaults to the scene's duration); a field of another motion is refused.
+Motion read_motion(const Fields& fields, double duration);
+
+/// One [[obstacle]]: its type's fields only (the others are refused, naming the type they belong to),
+/// μ, and a velocity that moves it (towards a vertex) less than d̂ per step: faster, it could reach
+/// a vertex from beyond d̂ within one step, where no barrier force has yet pushed back. A mesh's file
+/// is read (beside the scene file, then in data/) and placed: its coordinates × scale + translate.
+ObstacleSpec read_obstacle(const toml::table& table, const std::string& name, const Source& source,
+                           const std::filesystem::path& scene_file, double time_step, double activation_distance);
+
+/// Refuses a scene whose bodies start inside its last obstacle (scene.obstacles.back(), read from
+/// node, called name): no vertex may start inside, where its barrier energy would be infinite. A
+/// mesh's distance is unsigned (no inside): a body must start beyond d̂ of it, and no edge of its
+/// tets may pass through a triangle (a body through a sheet may have every vertex far from it).
+void check_bodies_clear(const Fields& top, const toml::node& node, const std::string& name, const SceneSpec& scene);
+
+/// Refuses a body whose run would need more memory than the scene may use (see memory_estimate),
+/// the bodies read before it included: the error is at field, the field to change.
+void check_memory(const Fields& fields, const toml::node& node, const std::string& key, long long vertices,
+                  long long tets, const std::string& change);
+
+/// A body's size: the longest edge of its vertices' bounding box [m].
+double body_size(const TetMesh& mesh);
+
+/// The rest mesh of a [body.mesh] table (fields), with its spec filled in: a generated box, or a
+/// file's tets (.node, .ele, .vtu), a surface's tets (TetGen) or the lattice enclosing a surface,
+/// scaled and translated. Refused: a mesh without tets, a body too small or too large, a vertex no
+/// tet uses, or one that needs more memory than allowed.
+TetMesh build_mesh(const Fields& fields, const std::filesystem::path& scene_file, MeshSpec& spec);
+
+/// One [[body]] (table, called name, the index-th): its name, mesh, material, mass, damping,
+/// initial velocity, pins (their vertices selected, none pinned twice) and loads.
+BodySpec read_body(const toml::table& table, const std::string& name, const Source& file,
+                   const std::filesystem::path& scene_file, double duration, double time_step, int index);
+
+/// Applies the [quick] table's leaves to root (each as an override source records), when root has one.
+void apply_quick_table(toml::table& root, Source& source);
+
+/// Applies each "key=value" of settings (the --set options) to root, recorded in source.
+void apply_set_options(toml::table& root, const std::vector<std::string>& settings, Source& source);
+
+}  // namespace fem::scenes::detail
