@@ -21,11 +21,11 @@ Selector read_selector(const Fields& fields);
 Motion read_motion(const Fields& fields, double duration);
 
 /// One [[obstacle]]: its type's fields only (the others are refused, naming the type they belong to),
-/// μ, and a velocity that moves it (towards a vertex) less than d̂ per step: faster, it could reach
-/// a vertex from beyond d̂ within one step, where no barrier force has yet pushed back. A mesh's file
-/// is read (beside the scene file, then in data/) and placed: its coordinates × scale + translate.
+/// μ and a velocity, of any speed (chapter 14's contact_step starts each step where the obstacles'
+/// motion reaches no vertex, in stages when it must). A mesh's file is read (beside the scene file,
+/// then in data/) and placed: its coordinates × scale + translate.
 ObstacleSpec read_obstacle(const toml::table& table, const std::string& name, const Source& source,
-                           const std::filesystem::path& scene_file, double time_step, double activation_distance);
+                           const std::filesystem::path& scene_file);
 
 /// Refuses a scene whose bodies start inside its last obstacle (scene.obstacles.back(), read from
 /// node, called name): no vertex may start inside, where its barrier energy would be infinite. A

@@ -221,8 +221,8 @@ void read_obstacles(const Fields& top, SceneSpec& scene)
     const toml::array& list = *obstacles->as_array();
     for (std::size_t i = 0; i < list.size(); ++i) {
         const std::string name = str("obstacle[", i, "]");
-        scene.obstacles.push_back(read_obstacle(table_in_array(top, *list.get(i), "obstacle"), name, top.source(),
-                                                scene.file, scene.time_step, scene.contact.activation_distance));
+        scene.obstacles.push_back(
+            read_obstacle(table_in_array(top, *list.get(i), "obstacle"), name, top.source(), scene.file));
         check_bodies_clear(top, *list.get(i), name, scene);
     }
     if (scene.integrator != "backward-euler") {

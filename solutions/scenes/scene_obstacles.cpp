@@ -16,7 +16,7 @@ namespace fem::scenes {
 namespace detail {
 
 ObstacleSpec read_obstacle(const toml::table& table, const std::string& name, const Source& source,
-                           const std::filesystem::path& scene_file, double time_step, double activation_distance)
+                           const std::filesystem::path& scene_file)
 {
     const std::vector<std::string> types{"half-space", "sphere", "box", "mesh"};
     const std::vector<std::vector<std::string>> own{
@@ -72,13 +72,6 @@ ObstacleSpec read_obstacle(const toml::table& table, const std::string& name, co
     }
     o.friction = fields.number("friction", 0.0, [](double mu) { return mu >= 0.0 && mu <= 10.0; }, "a number in [0, 10]");
     o.velocity = fields.vector("velocity", o.velocity);
-    // A half-space moves towards the bodies only along its normal; a sphere or a box in every direction.
-    const double approach = o.kind == ObstacleSpec::Kind::half_space ? std::abs(o.normal.dot(o.velocity)) : o.velocity.norm();
-    if (approach * time_step >= activation_distance)
-        fields.fail(*fields.get("velocity"), "velocity",
-                    str("moves the obstacle ", approach * time_step, " m towards the bodies in one step of ", time_step,
-                        " s, not less than contact.activation_distance = ", activation_distance,
-                        " m; allowed: a speed below ", activation_distance / time_step, " m/s (or a smaller time.step)"));
     return o;
 }
 

@@ -11,6 +11,7 @@
 
 #include "common/error.hpp"
 #include "common/random.hpp"
+#include "common/test_support.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -240,15 +241,9 @@ void check_contact_derivatives(const std::string& kind)
         REQUIRE(std::isfinite(contact.energy(u)));
         const Eigen::VectorXd g = contact.gradient(u);
         const Eigen::MatrixXd H = Eigen::MatrixXd(contact.hessian(u));
-        Eigen::VectorXd g_fd(n);
-        Eigen::MatrixXd H_fd(n, n);
-        const double h = 1e-9;
-        for (Eigen::Index i = 0; i < n; ++i) {
-            Eigen::VectorXd e = Eigen::VectorXd::Zero(n);
-            e[i] = h;
-            g_fd[i] = (contact.energy(u + e) - contact.energy(u - e)) / (2.0 * h);
-            H_fd.col(i) = (contact.gradient(u + e) - contact.gradient(u - e)) / (2.0 * h);
-        }
+        const CentralDifferences differences = central_differences(contact, u, 1e-9);
+        const Eigen::VectorXd& g_fd = differences.gradient;
+        const Eigen::MatrixXd& H_fd = differences.hessian;
         INFO(kind << ", scale " << scale);
         CHECK((g - g_fd).norm() <= 1e-6 * g.norm());
         if (kind != "mesh") {

@@ -10,6 +10,7 @@
 #include "04_tet_jacobians/tet_jacobians.hpp"
 
 #include "common/random.hpp"
+#include "common/test_support.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -94,15 +95,9 @@ TEST_CASE("edge and corner barrier: energy, gradient and Hessian against central
         REQUIRE(energy > 0.0);  // the corner is within d̂ of the face, no vertex is
         const Eigen::VectorXd g = contact.gradient(u);
         const Eigen::MatrixXd H = Eigen::MatrixXd(contact.hessian(u));
-        Eigen::VectorXd g_fd(n);
-        Eigen::MatrixXd H_fd(n, n);
-        const double h = 1e-8;
-        for (Eigen::Index i = 0; i < n; ++i) {
-            Eigen::VectorXd e = Eigen::VectorXd::Zero(n);
-            e[i] = h;
-            g_fd[i] = (contact.energy(u + e) - contact.energy(u - e)) / (2.0 * h);
-            H_fd.col(i) = (contact.gradient(u + e) - contact.gradient(u - e)) / (2.0 * h);
-        }
+        const CentralDifferences differences = central_differences(contact, u, 1e-8);
+        const Eigen::VectorXd& g_fd = differences.gradient;
+        const Eigen::MatrixXd& H_fd = differences.hessian;
         INFO("seed " << seed << ", energy " << energy << ", |g| " << g.norm() << ", |g - g_fd| " << (g - g_fd).norm());
         CHECK((g - g_fd).norm() <= 1e-5 * g.norm());
         // The Hessian is the sum of each pair's PSD projection: PSD itself, and it adds to the exact

@@ -63,6 +63,27 @@ inline std::vector<double> central_difference_errors(const std::function<Eigen::
     return errors;
 }
 
+/// Central differences of a potential (anything with energy(u) and gradient(u), u of n entries) at
+/// u with step h along each coordinate eᵢ: gradient[i] = (E(u + h eᵢ) − E(u − h eᵢ))/(2h) (n) and
+/// hessian's column i = (∇E(u + h eᵢ) − ∇E(u − h eᵢ))/(2h) (n×n, not symmetrised).
+struct CentralDifferences {
+    Eigen::VectorXd gradient;
+    Eigen::MatrixXd hessian;
+};
+template <typename Potential>
+CentralDifferences central_differences(const Potential& potential, const Eigen::VectorXd& u, double h)
+{
+    const Eigen::Index n = u.size();
+    CentralDifferences differences{Eigen::VectorXd(n), Eigen::MatrixXd(n, n)};
+    for (Eigen::Index i = 0; i < n; ++i) {
+        Eigen::VectorXd e = Eigen::VectorXd::Zero(n);
+        e[i] = h;
+        differences.gradient[i] = (potential.energy(u + e) - potential.energy(u - e)) / (2.0 * h);
+        differences.hessian.col(i) = (potential.gradient(u + e) - potential.gradient(u - e)) / (2.0 * h);
+    }
+    return differences;
+}
+
 /// The entries of a matrix or vector, dense or sparse, as compared by EntriesNear. Catch2 prints
 /// it as its shape only ("a 12×12 matrix"): the matcher names the entries that matter.
 struct MatrixEntries {

@@ -233,7 +233,7 @@ TEST_CASE("a rising floor lifts the block through the scene file, its push booke
 {
     // The floor's push Δt Σ F·w is work put in (contact::contact_step): unbooked, the lift read as a
     // rise of H − W_in, and at 2 mm/s the run ended as "diverged".
-    const double rise = GENERATE(0.002, 0.05);  // [m/s]
+    const double rise = GENERATE(0.002, 0.05, 1.0);  // [m/s]: 1 m/s is 10 mm a step, 10 d̂
     const std::string floor = str("type = \"half-space\"\nfriction = 0.5\nvelocity = [0.0, 0.0, ", rise, "]\n");
     const SceneSpec scene = read_scene(drop_scene(str("rising_floor_", rise), floor), {"time.duration=0.8"});
     const RunResult run = run_positions(scene);
