@@ -241,7 +241,7 @@ void check_contact_derivatives(const std::string& kind)
         REQUIRE(std::isfinite(contact.energy(u)));
         const Eigen::VectorXd g = contact.gradient(u);
         const Eigen::MatrixXd H = Eigen::MatrixXd(contact.hessian(u));
-        const CentralDifferences differences = central_differences(contact, u, 1e-9);
+        const test::CentralDifferences differences = test::central_differences(contact, u, 1e-9);
         const Eigen::VectorXd& g_fd = differences.gradient;
         const Eigen::MatrixXd& H_fd = differences.hessian;
         INFO(kind << ", scale " << scale);

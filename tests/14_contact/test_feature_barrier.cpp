@@ -95,7 +95,7 @@ TEST_CASE("edge and corner barrier: energy, gradient and Hessian against central
         REQUIRE(energy > 0.0);  // the corner is within d̂ of the face, no vertex is
         const Eigen::VectorXd g = contact.gradient(u);
         const Eigen::MatrixXd H = Eigen::MatrixXd(contact.hessian(u));
-        const CentralDifferences differences = central_differences(contact, u, 1e-8);
+        const test::CentralDifferences differences = test::central_differences(contact, u, 1e-8);
         const Eigen::VectorXd& g_fd = differences.gradient;
         const Eigen::MatrixXd& H_fd = differences.hessian;
         INFO("seed " << seed << ", energy " << energy << ", |g| " << g.norm() << ", |g - g_fd| " << (g - g_fd).norm());
