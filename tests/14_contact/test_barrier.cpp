@@ -161,6 +161,26 @@ TEST_CASE("sphere time of impact: the first root, on the sphere, none for a path
     }
 }
 
+TEST_CASE("sphere time of impact where the textbook root cancels: close to the sphere, off its centre", "[ex14.3]")
+{
+    // p = (1 + 2⁻²⁰, 0, 0) just outside the unit ball, so that k = |p|² − 1 = 2⁻¹⁹ + 2⁻⁴⁰ is exact in
+    // double, moving in at dp = (−1024, 32 j, 0): −b and √(b² − 4ak) agree in their first 20 digits
+    // (bits), so (−b − √Δ)/(2a) keeps only the rest of √Δ's rounding, while 2k/(−b + √Δ) keeps all.
+    // The reference: the same stable formula in long double (a, b and k are exact).
+    const Sphere ball(Eigen::Vector3d::Zero(), 1.0);
+    const Eigen::Vector3d p(1.0 + std::ldexp(1.0, -20), 0.0, 0.0);
+    for (int j = 1; j <= 20; ++j) {
+        const Eigen::Vector3d dp(-1024.0, 32.0 * j, 0.0);
+        const long double a = static_cast<long double>(dp.squaredNorm()), b = 2.0L * static_cast<long double>(dp.dot(p));
+        const long double k = static_cast<long double>(p.squaredNorm()) - 1.0L;
+        const long double expected = 2.0L * k / (-b + std::sqrt(b * b - 4.0L * a * k));
+        const double s = ball.local_time_of_impact(p, dp);
+        INFO("p = (" << p.transpose() << "), dp = (" << dp.transpose() << "): s = " << s << ", expected "
+                     << static_cast<double>(expected));
+        CHECK(std::abs(static_cast<long double>(s) - expected) <= 1e-14L * expected);
+    }
+}
+
 TEST_CASE("continuous collision: no point of a randomised safe step is inside any obstacle (fuzzed)", "[ex14.3]")
 {
     BlockSettings settings;

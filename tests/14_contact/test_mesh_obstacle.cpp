@@ -203,6 +203,44 @@ TEST_CASE("mesh obstacle: the time of impact is the first crossing of the path, 
     }
 }
 
+TEST_CASE("mesh obstacle: a path through a shared edge of two random triangles is caught there, whatever the round-off",
+          "[ex14.6]")
+{
+    // Two triangles (a, b, c) and (b, a, d) sharing the edge ab, all corners random (not representable
+    // in binary); a path from above through a random point q of ab, reaching it at s = 1/2. Without
+    // the triangles grown at their edges, round-off puts q outside both on about a quarter of them.
+    int missed = 0;
+    for (unsigned seed = 1; seed <= 2000; ++seed) {
+        const Eigen::Vector3d a = random_vector(3, seed), b = random_vector(3, 3000 + seed);
+        const Eigen::Vector3d side = random_vector(3, 6000 + seed);
+        const Eigen::Vector3d normal = (b - a).cross(side).normalized();
+        // c and d on either side of ab, in planes tilted a little against each other (a crease).
+        const Eigen::Vector3d across = normal.cross(b - a).normalized();
+        const Eigen::Vector3d c = 0.5 * (a + b) + 0.7 * across + 0.1 * normal;
+        const Eigen::Vector3d d = 0.5 * (a + b) - 0.7 * across + 0.1 * normal;
+        TriMesh pair;
+        pair.V.resize(4, 3);
+        pair.V << a.transpose(), b.transpose(), c.transpose(), d.transpose();
+        pair.F.resize(2, 3);
+        pair.F << 0, 1, 2, 1, 0, 3;
+        const MeshObstacle mesh(pair);
+        const double t = 0.05 + 0.9 * (0.5 + 0.5 * random_vector(1, 9000 + seed)[0]);
+        const Eigen::Vector3d q = a + t * (b - a);
+        const Eigen::Vector3d wobble = random_vector(3, 12000 + seed);
+        const Eigen::Vector3d p = q + 0.3 * normal + 0.1 * wobble.cross(b - a);
+        const Eigen::Vector3d dp = 2.0 * (q - p);
+        const double s = mesh.local_time_of_impact(p, dp);
+        const bool caught = s >= 0.5 - 1e-9 && s <= 0.5 + 1e-9;
+        if (!caught) {
+            ++missed;
+            UNSCOPED_INFO("seed " << seed << ": a = (" << a.transpose() << "), b = (" << b.transpose() << "), t = " << t
+                                  << ", p = (" << p.transpose() << "), dp = (" << dp.transpose() << "): s = " << s
+                                  << ", expected 0.5");
+        }
+    }
+    CHECK(missed == 0);
+}
+
 TEST_CASE("mesh obstacle: degenerate and empty meshes are refused, naming the triangle")
 {
     TriMesh flat = one_triangle();
