@@ -29,6 +29,13 @@
 
 namespace fem::scenes {
 
+/// Newton iterations a contact step may take (chapter 12's default is 50). The contact Hessian is
+/// projected to PSD per vertex and per pair, so where the barrier's exact curvature is negative (a
+/// vertex near a mesh's edge or corner, an edge pair) the model is stiffer than the energy and Newton
+/// converges linearly: measured on bowl_drop's --compare reference (Δt = 1/1600 s), 0.94 per
+/// iteration at the slowest step. docs/scenes.md#obstacles
+inline constexpr int contact_newton_iterations = 200;
+
 /// Chapter 14's obstacles of a scene (make_obstacle of each spec).
 std::vector<std::shared_ptr<const contact::Obstacle>> scene_obstacles(const SceneSpec& scene);
 

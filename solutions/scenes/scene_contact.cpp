@@ -23,6 +23,14 @@ contact::ContactOptions contact_options(const SceneSpec& scene)
     return options;
 }
 
+hyper::NewtonOptions contact_newton_options(const SceneSpec& scene)
+{
+    hyper::NewtonOptions options =
+        hyper::newton_options_for({.solver = scene.solver, .newton_tolerance = scene.newton_tolerance});
+    options.max_iterations = contact_newton_iterations;
+    return options;
+}
+
 }  // namespace
 
 ContactIntegrator::ContactIntegrator(dynamics::Integrator& own, SceneForces& levels, const dynamics::Body& body,
@@ -31,7 +39,7 @@ ContactIntegrator::ContactIntegrator(dynamics::Integrator& own, SceneForces& lev
     : own_(own),
       levels_(levels),
       potential_(std::make_unique<contact::ContactPotential>(body, std::move(obstacles), contact_options(scene))),
-      newton_(hyper::newton_options_for({.solver = scene.solver, .newton_tolerance = scene.newton_tolerance}))
+      newton_(contact_newton_options(scene))
 {
     newton_.set_potential(potential_.get());
 }
