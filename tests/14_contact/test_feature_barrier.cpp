@@ -17,6 +17,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -41,8 +42,10 @@ std::shared_ptr<const Obstacle> wedge(double ridge, const Eigen::Vector3d& veloc
     return std::make_shared<MeshObstacle>(sheet, 0.0, velocity);
 }
 
-/// Whether some obstacle edge crosses a tet of the body at u: the segment–tet test by the signs of
-/// the tet's barycentric coordinates along the segment, sampled finely (the knife's check).
+/// Whether some obstacle edge (shifted by shift) has a point inside a tet of the body at u: along
+/// the segment a + λ (b − a) each of the tet's barycentric coordinates is linear in λ, so the
+/// segment is inside the tet on the interval of λ ∈ [0, 1] where all four are > 0 — nonempty
+/// exactly when the edge enters the tet (the knife's check, exact up to round-off).
 bool edge_inside_body(const dynamics::Body& body, const Eigen::VectorXd& u, const ObstacleFeatures& features,
                       const Eigen::Vector3d& shift)
 {
@@ -50,11 +53,21 @@ bool edge_inside_body(const dynamics::Body& body, const Eigen::VectorXd& u, cons
     for (Eigen::Index e = 0; e < features.edges.rows(); ++e) {
         const Eigen::Vector3d a = features.corners.row(features.edges(e, 0)).transpose() + shift;
         const Eigen::Vector3d b = features.corners.row(features.edges(e, 1)).transpose() + shift;
-        for (int k = 0; k <= 2000; ++k) {
-            const Eigen::Vector3d p = a + (b - a) * (k / 2000.0);
-            for (int t = 0; t < static_cast<int>(body.mesh().T.rows()); ++t)
-                if ((tet::shape_functions(tet::tet_vertices(body.mesh(), x, t), p).array() > 0.0).all())
-                    return true;
+        for (int t = 0; t < static_cast<int>(body.mesh().T.rows()); ++t) {
+            const tet::TetVertices corners = tet::tet_vertices(body.mesh(), x, t);
+            const Eigen::Vector4d at_a = tet::shape_functions(corners, a), at_b = tet::shape_functions(corners, b);
+            double low = 0.0, high = 1.0;  // the λ where every coordinate is > 0
+            for (int i = 0; i < 4; ++i) {
+                const double slope = at_b[i] - at_a[i];
+                if (slope > 0.0)
+                    low = std::max(low, -at_a[i] / slope);
+                else if (slope < 0.0)
+                    high = std::min(high, -at_a[i] / slope);
+                else if (!(at_a[i] > 0.0))
+                    high = -1.0;  // this coordinate is ≤ 0 all along
+            }
+            if (low < high)
+                return true;
         }
     }
     return false;
