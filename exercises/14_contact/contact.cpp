@@ -422,6 +422,10 @@ Eigen::VectorXd ContactPotential::free_start(const dynamics::Body& body, const d
     for (std::size_t c = 0; c < candidates.size(); ++c) {
         Eigen::VectorXd v = body.pin_velocity();
         body.dofs().scatter(body.dofs().gather(candidates[c]), v);
+        // Fixed obstacles and a body at rest, pins included: nothing moves relative to anything, so
+        // staying put reaches nothing (every contact step with fixed obstacles, without a search).
+        if (candidates.size() == 1 && v.isZero(0.0))
+            return v;
         const auto reached = [&]() -> std::string {
             for (int vertex : surface_) {
                 const Eigen::Vector3d x = position(state.u, vertex);
