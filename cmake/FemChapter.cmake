@@ -32,7 +32,7 @@ endif()
 
 include(${CMAKE_CURRENT_LIST_DIR}/FemExercises.cmake)
 
-# fem_discover_tests(target label): one ctest entry per Catch2 test case of target, named
+# fem_discover_tests(target label [sources...]): one ctest entry per Catch2 test case of target, named
 # "<label>: <test case>" and labelled <label>. Each entry runs with --warn NoTests, so an entry that
 # matches no test case fails instead of passing quietly (a test name ctest cannot carry, e.g. one
 # with a ';', which CMake splits into two lists items, would otherwise count as passed while
@@ -40,10 +40,29 @@ include(${CMAKE_CURRENT_LIST_DIR}/FemExercises.cmake)
 # A test that cannot run here (the live view without an X display) ends with
 # WARN("SKIPPED: why") and returns: Catch2 2.13, Debian 12's, has no SKIP(), but it prints warnings
 # of passing tests, and SKIP_REGULAR_EXPRESSION makes ctest report such an entry as skipped.
+# Test cases tagged [slow] (many steps of a contact scene: tens of seconds under the sanitizers) are
+# labelled <label>_slow instead: `ctest -L <label>` still runs them, the release stage of
+# tools/test.sh runs them, and the sanitizer stage leaves them out (CMakePresets.json, asan), since
+# the shorter tests of the same code run there. Optional after the label: the test sources whose
+# tags are looked at (none: no test is slow).
 function(fem_discover_tests target label)
+  set(has_slow OFF)
+  foreach(source IN LISTS ARGN)
+    file(STRINGS ${source} slow_lines REGEX "\\[slow\\]")
+    if(slow_lines)
+      set(has_slow ON)
+    endif()
+  endforeach()
   # One label only: catch_discover_tests splits a list of labels into separate properties.
-  catch_discover_tests(${target} TEST_PREFIX "${label}: " EXTRA_ARGS --warn NoTests
-                       PROPERTIES LABELS "${label}" SKIP_REGULAR_EXPRESSION "SKIPPED: ")
+  if(has_slow)
+    catch_discover_tests(${target} TEST_SPEC "~[slow]" TEST_PREFIX "${label}: " EXTRA_ARGS --warn NoTests
+                         PROPERTIES LABELS "${label}" SKIP_REGULAR_EXPRESSION "SKIPPED: ")
+    catch_discover_tests(${target} TEST_SPEC "[slow]" TEST_PREFIX "${label}: " EXTRA_ARGS --warn NoTests
+                         PROPERTIES LABELS "${label}_slow" SKIP_REGULAR_EXPRESSION "SKIPPED: ")
+  else()
+    catch_discover_tests(${target} TEST_PREFIX "${label}: " EXTRA_ARGS --warn NoTests
+                         PROPERTIES LABELS "${label}" SKIP_REGULAR_EXPRESSION "SKIPPED: ")
+  endif()
 endfunction()
 
 # fem_test_without_avx2(number test_exe): ctest chNN_without_avx2 runs the chapter's unit tests once
@@ -132,7 +151,7 @@ function(fem_add_chapter number name)
     fem_test_pch_for(${test_exe}_objects)
     add_executable(${test_exe})
     target_link_libraries(${test_exe} PRIVATE ${test_exe}_objects ${lib} fem_test_main fem_flags)
-    fem_discover_tests(${test_exe} "ch${number}")
+    fem_discover_tests(${test_exe} "ch${number}" ${test_sources})
     add_dependencies(fem_tests ${test_exe})
     if(FEM_GRADING)
       # The solutions with every exercise region behind a run-time switch (environment variable

@@ -38,6 +38,7 @@ import re
 import subprocess
 import sys
 import xml.etree.ElementTree as ElementTree
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -388,10 +389,13 @@ def command_grade(args):
             continue
         listed = prerequisites(root, chapter)
         chapter_ids = [e.id for e in all_exercises(root) if e.chapter == chapter]
-        for e in in_chapter:
-            row, found = grade_exercise(e, chapter_ids, listed, binary)
-            print(row)
-            problems += found
+        # The exercises' test runs are independent processes: as many at once as there are cores,
+        # the rows printed in order.
+        with ThreadPoolExecutor(max_workers=os.cpu_count() or 1) as pool:
+            graded = pool.map(lambda e: grade_exercise(e, chapter_ids, listed, binary), in_chapter)
+            for row, found in graded:
+                print(row, flush=True)
+                problems += found
         all_stubs = run_tests(binary, None, chapter_ids)
         if all_stubs.crash or all_stubs.failed_untagged:
             problems.append(f"chapter {chapter}: with every exercise a stub, untagged tests fail "

@@ -5,8 +5,8 @@
 #                build/release (-DFEM_GRADING=ON: graded twins of the tests, target fem_graded_tests)
 #   2. exercises every chapter compiles from exercises/ (the stubs students start from)
 #   3. asan      under AddressSanitizer + UndefinedBehaviorSanitizer (and float-cast-overflow):
-#                the unit tests, and each executable's --quick run, bad command lines and the
-#                output-folder rule
+#                the unit tests (but those tagged [slow], which stage 4 runs), and each
+#                executable's --quick run, bad command lines and the output-folder rule
 #   4. release   (the rest of build/release) every test passes on the reference solutions: unit
 #                tests, the layout and exercise-sync checks, each executable's --quick run against
 #                stored numbers, and each chapter's docs against its executable

@@ -123,7 +123,7 @@ TEST_CASE("edge and corner barrier: energy, gradient and Hessian against central
     }
 }
 
-TEST_CASE("the knife: a wedge's ridge and a box's edge pressed into a one-cell block never enter it", "[ex14.6]")
+TEST_CASE("the knife: a wedge's ridge and a box's edge pressed into a one-cell block never enter it", "[ex14.6][slow]")
 {
     // The block (10 cm, one cell: its top face two triangles) on the floor; a ridge along y over the
     // middle of its top face, between its vertices, 0.5 mm above it, comes down at 2 cm/s for

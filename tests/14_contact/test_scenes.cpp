@@ -258,7 +258,7 @@ TEST_CASE("fired at a ball at 100 times a drop's speed, no vertex gets inside or
 }
 
 TEST_CASE("fired at a triangle mesh at 30 times a drop's speed, no vertex gets through its sheet or onto it",
-          "[ex14.6]")
+          "[ex14.6][slow]")
 {
     // A tent: the square [-1, 1]² at z = 0 cut into four triangles at a raised apex (0.05, 0.05, 0.02)
     // under the block's centre; the block's lower corners come down over two of its ridges (edge
@@ -327,7 +327,7 @@ TEST_CASE("a rising floor lifts the block at its speed, however fast, and the en
     CHECK(work_in > 0.5 * (block.body->dof_masses().sum() / 3.0) * rise * rise);
 }
 
-TEST_CASE("two plates squeezing a block stop the run with a clear error before any tet turns inside out", "[ex14.2]")
+TEST_CASE("two plates squeezing a block stop the run with a clear error before any tet turns inside out", "[ex14.2][slow]")
 {
     BlockSettings settings;
     settings.height = 1e-4;

@@ -208,7 +208,7 @@ TEST_CASE("a cube turned by half a turn stays free of ghost forces under auto", 
         CHECK((segment.level != Level::linear || segment.last_step < 10));
 }
 
-TEST_CASE("every gallery scene's first switch is where its linear run first crosses a threshold", "[scenes]")
+TEST_CASE("every gallery scene's first switch is where its linear run first crosses a threshold", "[scenes][slow]")
 {
     // The switch points reproduced independently for every body that runs auto in the gallery's
     // quick runs: the measures of the fixed linear run, step by step, say where auto must leave linear.

@@ -138,7 +138,7 @@ TEST_CASE("the run's summary names the model it ran, for every fixed model", "[s
     }
 }
 
-TEST_CASE("every model runs a damped scene, so --compare never refuses one", "[scenes]")
+TEST_CASE("every model runs a damped scene, so --compare never refuses one", "[scenes][slow]")
 {
     // Chapter 12's Newton step has Rayleigh damping too (D = alpha M + beta K at the step's start):
     // the comparison used to refuse damped scenes because its reference could not damp.

@@ -171,7 +171,7 @@ TEST_CASE("a linear body cannot meet obstacles: the run refuses it before any st
 }
 
 TEST_CASE("the gallery's slopes: the block slides with g (sin - mu cos) when tan > mu, and sticks when tan < mu",
-          "[scenes][contact]")
+          "[scenes][contact][slow]")
 {
     // slope_slide.toml and slope_stick.toml: 30°, μ = 0.3 and 0.8 (tan 30° = 0.577), gravity tilted
     // along +x over the floor z = 0; one cube (cells = 1) for speed, a frame per step.
@@ -229,7 +229,7 @@ TEST_CASE("a frictionless drop: the barrier's energy is booked as the floor's wo
 }
 
 TEST_CASE("a rising floor lifts the block through the scene file, its push booked as work, so H - W_in never rises",
-          "[scenes][contact]")
+          "[scenes][contact][slow]")
 {
     // The floor's push Δt Σ F·w is work put in (contact::contact_step): unbooked, the lift read as a
     // rise of H − W_in, and at 2 mm/s the run ended as "diverged".
