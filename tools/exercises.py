@@ -217,13 +217,15 @@ def graded_source(path, chapter):
 
 
 def expected_exercise_tree(root):
-    """{relative path under exercises/: content} for every solution file."""
+    """{relative path under exercises/: content} for every solution file with an exercise region:
+    its copy with the regions stubbed. A solution file without one has no copy (a student would
+    find nothing to do in it); a build from exercises/ compiles the solution file itself
+    (fem_add_chapter)."""
     tree = {}
     for chapter in chapters(root):
         for path in sorted((Path(root) / "solutions" / chapter).iterdir()):
-            if path.is_file():
-                relative = Path(chapter) / path.name
-                tree[relative] = stub_source(path, chapter) if path.suffix == ".cpp" else path.read_text()
+            if path.is_file() and path.suffix == ".cpp" and "// BEGIN EXERCISE" in path.read_text():
+                tree[Path(chapter) / path.name] = stub_source(path, chapter)
     return tree
 
 
@@ -240,7 +242,7 @@ def command_generate(args):
     for path in (root / "exercises").rglob("*"):
         if path.is_file() and path.relative_to(root / "exercises") not in tree:
             path.unlink()
-            print(f"removed {path} (no solution file of that name)")
+            print(f"removed {path} (its solution file has no exercise region)")
     print(f"exercises/: {len(tree)} files, {written} rewritten, {len(all_exercises(root))} exercises")
     return 0
 
@@ -262,7 +264,7 @@ def command_check(args):
         for name in stale:
             print(f"exercises/{name} is out of sync with solutions/{name}")
         for name in extra:
-            print(f"exercises/{name} has no solution file")
+            print(f"exercises/{name} has no exercise region in solutions/{name}")
         print("run: python3 tools/exercises.py generate")
         return 1
     print(f"exercises/ is in sync with solutions/ ({len(tree)} files, "

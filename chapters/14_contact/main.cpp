@@ -78,6 +78,12 @@ int main(int argc, char** argv)
                 if (cli.app.count(swept) > 0)
                     throw Error(str(swept, ": --quick runs its one fixed configuration and would ignore it; ",
                                     "leave out --quick or ", swept));
+        // The sweep's work, before any of it is done: a tiny --dt would otherwise run for days.
+        if (ccd_files.empty() && cli.app.count("--quick") == 0 && study::swept_steps(settings) > study::most_swept_steps)
+            throw Error(str("--dt: the drop and slope studies would take ", study::swept_steps(settings),
+                            " steps over the sweep of --dhat, --kappa, --dt, --tolerance and --friction-updates; at "
+                            "most ", study::most_swept_steps, ": raise the smallest --dt, shorten --duration or "
+                            "sweep fewer values"));
         for (double dt : settings.time_steps)
             try {
                 dynamics::step_count(settings.duration, dt);

@@ -30,6 +30,12 @@ struct Case {
 };
 /// Every combination of the settings' sweeps, in the order d̂, κ, Δt, tolerance.
 std::vector<Case> sweep(const Settings& settings);
+/// The time steps the drop and slope studies take together: duration/Δt for every case of the
+/// sweep, once dropped and on each of the two slopes with each friction update count.
+double swept_steps(const Settings& settings);
+/// main.cpp refuses a sweep of more steps than this before any study runs (about 20 minutes at the
+/// block's ~1 ms a step).
+inline constexpr double most_swept_steps = 1e6;
 /// The block settings of one case.
 BlockSettings block_settings(const Case& c);
 /// Δt as the tables write it: "1/100" for 0.01 s.

@@ -25,6 +25,9 @@ struct Slope {
     double angle, friction;
 };
 
+/// The study's two slopes: one the cube slides down, one it sticks to.
+constexpr Slope slopes[] = {{"slides", 30.0 * degree, 0.3}, {"sticks", 20.0 * degree, 0.5}};
+
 /// The charts of the two blocks' paths (the first case of the sweep), the distance each moved down
 /// the slope against time: the sliding one beside ½ a t², a = g (sin θ − μ cos θ); the sticking one
 /// (in mm) beside the steady creep of sticking_creep, a line of slope ε_v (1 − √(1 − tan θ/μ)) through
@@ -68,9 +71,16 @@ void path_charts(const RunContext& run, const fig::Series& sliding, const fig::S
 
 }  // namespace
 
+double swept_steps(const Settings& settings)
+{
+    double steps = 0.0;
+    for (const Case& c : sweep(settings))
+        steps += settings.duration / c.time_step;
+    return steps * (1.0 + std::size(slopes) * double(settings.friction_updates.size()));
+}
+
 void slope_study(const RunContext& run, const Settings& settings)
 {
-    const Slope slopes[] = {{"slides", 30.0 * degree, 0.3}, {"sticks", 20.0 * degree, 0.5}};
     std::cout << "\n== 2. The slope: a 0.1 m cube on a slope of 30 deg with mu = 0.3 (slides) and 20 deg with mu = 0.5 (sticks)\n\n";
     Table table("Slope: acceleration against g (sin theta - mu cos theta), creep per step against eps_v dt",
                 {{"slope", Format::text}, {"dhat [m]", Format::scientific, 1}, {"kappa", Format::text},
