@@ -15,6 +15,7 @@
 #include <array>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <set>
 
 namespace fem::scenes {
@@ -209,6 +210,54 @@ void read_contact(const Fields& top, SceneSpec& scene)
     scene.contact.friction_velocity = c.positive("friction_velocity", scene.contact.friction_velocity);
 }
 
+/// With obstacles, the contact constants and gravity against the size D of the smallest body (the
+/// diagonal of its rest bounding box), so that a value no contact step can work with is refused
+/// before the run and not mid-run by Newton or CG: d̂ in [10⁻⁶ D, 0.1 D] (a smaller one asks for gaps
+/// at the round-off of the positions, a larger one puts every body in contact with every obstacle
+/// from the start); ε_v Δt ≥ 10⁻¹⁰ D (the sticking creep ε_v Δt, friction's stiffness ~1/(ε_v Δt),
+/// above the round-off of a position); |g| Δt² ≤ D (from rest, gravity moves a body at most its own
+/// size in one step, which the collision-free line search can still cut). docs/scenes.md#obstacles
+void check_contact_scales(const Fields& top, const SceneSpec& scene)
+{
+    if (scene.obstacles.empty())
+        return;
+    double size = std::numeric_limits<double>::infinity();
+    std::string smallest;
+    for (const BodySpec& body : scene.bodies) {
+        const double diagonal = (body.mesh.V.colwise().maxCoeff() - body.mesh.V.colwise().minCoeff()).norm();
+        if (diagonal < size) {
+            size = diagonal;
+            smallest = body.name;
+        }
+    }
+    const std::string scale = str("the smallest body, '", smallest, "', is D = ", size, " m across");
+    // A field the file (or --set) gave fails at its line; a default names the field to set.
+    const auto refuse = [&](const char* table, const char* key, const std::string& message) {
+        const toml::table* given = top.subtable(table);
+        if (given != nullptr && given->get(key) != nullptr)
+            Fields(*given, table, top.source(), {}).fail(*given->get(key), key, message);
+        throw Error(str(scene.file.string(), ": ", table, ".", key, ": the default ", message, "; set it in [",
+                        table, "]"));
+    };
+    const double dhat = scene.contact.activation_distance;
+    if (dhat < 1e-6 * size || dhat > 0.1 * size)
+        refuse("contact", "activation_distance",
+               str(dhat, " m is outside [1e-6 D, 0.1 D] = [", 1e-6 * size, ", ", 0.1 * size, "] m: ", scale));
+    const double creep = scene.contact.friction_velocity * scene.time_step;
+    if (creep < 1e-10 * size)
+        refuse("contact", "friction_velocity",
+               str(scene.contact.friction_velocity, " m/s creeps ", creep, " m a step (time.step = ", scene.time_step,
+                   " s), below the 1e-10 D = ", 1e-10 * size, " m that a position resolves: ", scale));
+    const double fall = scene.gravity.norm() * scene.time_step * scene.time_step;
+    if (!(fall <= size)) {
+        const std::string message = str("|g| dt^2 = ", fall, " m: gravity moves a body farther than its size in one ",
+                                        "step (time.step = ", scene.time_step, " s), more than contact can hold: ", scale);
+        if (top.get("gravity") != nullptr)
+            top.fail(*top.get("gravity"), "gravity", message);
+        throw Error(str(scene.file.string(), ": time.step: ", message, "; use a smaller time.step"));
+    }
+}
+
 /// The [[obstacle]] array: each read, the bodies' start clear of it; with obstacles the integrator
 /// must be backward Euler (chapter 14's contact steps).
 void read_obstacles(const Fields& top, SceneSpec& scene)
@@ -295,6 +344,7 @@ SceneSpec read_scene(const std::filesystem::path& path, const std::vector<std::s
     read_bodies(top, scene);
     read_contact(top, scene);
     read_obstacles(top, scene);
+    check_contact_scales(top, scene);
     read_skin(top, scene);
     check_bodies(scene);
     return scene;
