@@ -189,10 +189,26 @@ public:
     /// Draws mesh as render_mesh_png would (fem::Error if the field is missing).
     void show(const io::MeshData& mesh, const RenderOptions& options);
     /// Handles the window's pending events and returns the keys pressed since the last call: one
-    /// character each, ' ' for space, '>' for the right arrow, letters as typed.
+    /// character each, ' ' for space, '>' for the right arrow, letters as typed. Mouse events update
+    /// pointer_drag.
     std::string poll_keys();
+
+    /// A point of the shown mesh dragged by the mouse: pressing the left button within
+    /// pick_radius pixels of some point of the mesh last shown picks, of those, the one nearest the
+    /// camera; while the button is held, target follows the pointer on the plane through the picked
+    /// point that faces the camera (the point's depth kept); releasing ends the drag.
+    struct PointerDrag {
+        int point = -1;  ///< the picked point's index in the shown mesh's points; −1: no drag
+        Eigen::Vector3d target = Eigen::Vector3d::Zero();  ///< world coordinates, as the shown mesh's
+    };
+    /// The drag as of the last poll_keys.
+    PointerDrag pointer_drag() const;
+    /// The pixels around the pointer in which a press picks a mesh point (times RenderOptions::scale).
+    static constexpr double pick_radius = 20.0;
     /// Writes what the window shows to a PNG.
     void save_png(const std::filesystem::path& path);
+    /// Renames the window (its title bar).
+    void set_name(const std::string& name);
 
 private:
     struct Impl;

@@ -59,6 +59,7 @@ std::pair<double, double> text_size(vtkTextProperty* properties, const std::stri
 struct BarLabels {
     vtkSmartPointer<vtkScalarBarActor> bar;  // nullptr: no colour bar (a categorical field)
     vtkSmartPointer<vtkRenderer> texts;
+    vtkSmartPointer<vtkRenderer> data;  // the renderer of the data set (its camera maps world to pixels)
     std::vector<double> ticks;
     double low = 0.0, high = 1.0;
     int font_size = 15;

@@ -278,6 +278,7 @@ BarLabels add_renderers(vtkRenderWindow* window, vtkDataSet* data, bool cell_fie
     vtkNew<vtkRenderer> backdrop, beneath, renderer;
     auto texts = vtkSmartPointer<vtkRenderer>::New();
     bar_labels.texts = texts;
+    bar_labels.data = renderer;
     backdrop->SetBackground(1.0, 1.0, 1.0);
     renderer->SetBackground(1.0, 1.0, 1.0);
     double top = 1.0;

@@ -7,6 +7,7 @@ packages=(
   g++ cmake ninja-build python3           # toolchain
   libeigen3-dev catch2 libcli11-dev       # linear algebra, tests, command lines
   libvtk9-dev libx11-dev xvfb xauth       # VTK files and figures; a virtual display
+  libxtst-dev                             # the live view's mouse test: real pointer input (XTEST)
   zlib1g-dev                              # .vtu data blocks checked before VTK reads them
   fonts-dejavu-core                       # the figures' font (common/figures.cpp)
   libsuitesparse-dev libopenblas0-pthread # CHOLMOD, the speed reference of chapters 08-09

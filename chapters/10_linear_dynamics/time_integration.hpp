@@ -283,6 +283,10 @@ struct StepRecord {
 /// far. A stable integrator never raises it by more than a round-off or O(Δt²) share of that; an
 /// unstable one multiplies H every step and crosses the line within a few steps of becoming visible.
 inline constexpr double divergence_energy_fraction = 0.5;
+/// … and above the elastic energy Y V s² of a uniform strain s of this size (Y: Young's modulus, V:
+/// the body's volume): a rise below it is the round-off of the positions (a strain of ~10⁴ ε), not
+/// growth, e.g. in a body at rest under no load whose energies are 10⁻³⁰ J.
+inline constexpr double divergence_roundoff_strain = 1e-12;
 
 /// Moves a body in time with one integrator and watches every step. docs/10_linear_dynamics.md#the-time-loop
 class Simulation {
@@ -323,6 +327,7 @@ private:
     BeforeStep before_step_;
     double initial_total_ = 0.0;
     double largest_magnitude_ = 0.0;
+    double roundoff_energy_ = 0.0;  // Y V s², s = divergence_roundoff_strain
     StepRecord last_;
     bool started_ = false;
 };

@@ -2,6 +2,7 @@
 // How a scene's frames are drawn, and the live view of --view that plays a run as it computes.
 // docs/scenes.md#the-live-view
 
+#include "scenes/scene_conditions.hpp"
 #include "scenes/scene_file.hpp"
 
 #include "common/figures.hpp"
@@ -48,7 +49,11 @@ std::vector<fig::Prop> obstacle_props(const SceneSpec& scene, const std::array<d
 /// The live view of --view: a window that plays the run's frames as they come, one frame interval of
 /// the video (slow_motion/frame_rate) apart at least, drawn as the PNG frames are. Keys: space pauses and resumes, the
 /// right arrow steps one frame while paused, r restarts the run (throws Restart), c switches the
-/// colour field, q stops the run (fem::request_stop). docs/scenes.md#the-live-view
+/// colour field, q stops the run (fem::request_stop). The mouse pulls the body: pressing the left
+/// button on it picks the vertex under the pointer, which a spring then pulls toward the pointer
+/// (pull(); drawn as a line) until the button is released. The window's name says how long the
+/// last frame took against its screen time, and whether the run keeps up with it.
+/// docs/scenes.md#the-live-view
 class LiveView {
 public:
     /// Thrown by frame() when r is pressed: the caller runs the scene again.
@@ -60,7 +65,16 @@ public:
     /// keys pressed since the last one.
     void frame(const io::MeshData& frame, int step, double time, const std::string& models);
 
+    /// What the mouse pulls as of the last frame (RunOptions::pull): the picked vertex's body and
+    /// vertex, the target the pointer's point at the frame's displacement scale undone
+    /// (X + (p − X)/warp, X the vertex's rest position); body −1 when no button is held on the body.
+    PullRequest pull() const { return pull_; }
+
 private:
+    /// The pull for the window's pointer drag on frame (the merged bodies, rest points).
+    PullRequest pull_of(const fig::MeshWindow::PointerDrag& drag, const io::MeshData& frame) const;
+
+
     const SceneSpec& scene_;
     fig::MeshWindow window_;
     std::vector<std::string> fields_;
@@ -69,6 +83,8 @@ private:
     std::filesystem::path screenshot_;
     int screenshot_step_;
     Timer clock_;  // since the last frame shown
+    PullRequest pull_;
+    std::string name_;  // the window's name, before the timing
 };
 
 }  // namespace fem::scenes

@@ -66,7 +66,15 @@ int main(int argc, char** argv)
     int screenshot = -1;
     cli.app.add_flag("--view", view,
                      "Play the run live in a window (space: pause, right arrow: step, r: restart, c: colour field, "
-                     "q: stop); without a display the run goes on headless");
+                     "q: stop; press the mouse on the body and drag to pull it); without a display the run goes on "
+                     "headless");
+    bool forever = false;
+    cli.app.add_flag("--forever", forever,
+                     "With --view: run until q, past the scene's duration, writing no files (for a lecture)");
+    double pull_stiffness = 0.0;
+    cli.app.add_option("--pull-stiffness", pull_stiffness,
+                       "With --view: the mouse's spring stiffness [N/m] (0: the body's mass x (2 pi 1 Hz)^2)")
+        ->check(check::real(0.0, 1e9, check::Ends::closed))->capture_default_str();
     cli.app.add_option("--screenshot", screenshot, "With --view: save the window at this step as view_<step>.png in --out")
         ->check(check::at_least<int>(0));
     std::vector<SceneSpec> scenes;
@@ -82,6 +90,15 @@ int main(int argc, char** argv)
             throw Error("--screenshot: needs --view");
         if (view && compare)
             throw Error("--view: plays one run; --compare runs many without frames");
+        if (forever && !view)
+            throw Error("--forever: needs --view (it runs until the window's q)");
+        if (forever && !fig::display_available())
+            throw Error("--forever: needs a display for --view (set DISPLAY, or run under xvfb-run -a): it runs "
+                        "until the window's q");
+        if (forever && screenshot >= 0)
+            throw Error("--screenshot: writes a file, and --forever writes none");
+        if (cli.app.count("--pull-stiffness") > 0 && !view)
+            throw Error("--pull-stiffness: needs --view (the mouse pulls in the live view)");
         for (const std::string& file : files) {
             scenes.push_back(read_scene(file, settings, quick));
             cli.protect_inputs(input_files(scenes.back()));  // --out must not overlap what is read
@@ -113,8 +130,9 @@ int main(int argc, char** argv)
             return;
         }
         RunOptions options;
-        options.run = &run;
-        options.progress = !no_progress;
+        options.run = forever ? nullptr : &run;  // --forever: a lecture's live run, no files
+        options.forever = forever;
+        options.progress = !no_progress && !forever;
         options.skin = skin;
         std::unique_ptr<LiveView> live;
         if (view && fig::display_available()) {
@@ -122,6 +140,8 @@ int main(int argc, char** argv)
             options.on_frame = [&](const io::MeshData& frame, int step, double time, const std::string& models) {
                 live->frame(frame, step, time, models);
             };
+            options.pull = [&] { return live->pull(); };
+            options.pull_stiffness = pull_stiffness;
         } else if (view) {
             std::cout << "note: no display for --view (set DISPLAY); the run goes on headless\n";
         }

@@ -76,6 +76,13 @@ struct RunOptions {
     /// bad skin is refused first). Null: run_scene binds the scene's skin itself when it writes
     /// frames (a run that writes nothing has no use for it).
     std::shared_ptr<const SkinObserver> skin;
+    /// Asked before every step what pulls the bodies (e.g. LiveView::pull); unset: nothing does. A
+    /// pull that starts or ends prints one line ("pulling …", "released …").
+    std::function<PullRequest()> pull;
+    /// The pull's spring stiffness k [N/m]; 0: default_pull_stiffness of the pulled body.
+    double pull_stiffness = 0.0;
+    /// Run until stopped (a stop signal or the live view's q) instead of for the scene's duration.
+    bool forever = false;
 };
 
 /// Runs a scene (header comment), writing (when options.run is set) the outputs the scene asks for:

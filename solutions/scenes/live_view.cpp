@@ -190,7 +190,7 @@ std::vector<fig::Prop> obstacle_props(const SceneSpec& scene, const std::array<d
 
 LiveView::LiveView(const SceneSpec& scene, std::filesystem::path screenshot, int screenshot_step)
     : scene_(scene), window_(frame_view(scene), str("fem_scene: ", scene.title)), screenshot_(std::move(screenshot)),
-      screenshot_step_(screenshot_step)
+      screenshot_step_(screenshot_step), name_(str("fem_scene: ", scene.title))
 {
     fields_ = {scene.output.colour};
     for (const std::string& field : scene.output.fields)
@@ -200,8 +200,32 @@ LiveView::LiveView(const SceneSpec& scene, std::filesystem::path screenshot, int
         fields_.push_back(io::displacement_field);
 }
 
+PullRequest LiveView::pull_of(const fig::MeshWindow::PointerDrag& drag, const io::MeshData& frame) const
+{
+    PullRequest pull;
+    if (drag.point < 0)
+        return pull;
+    int first = 0;  // the body's first point in the merged frame (bodies in the scene's order)
+    for (std::size_t b = 0; b < scene_.bodies.size(); ++b) {
+        const int count = static_cast<int>(scene_.bodies[b].mesh.V.rows());
+        if (drag.point < first + count) {
+            pull.body = static_cast<int>(b);
+            pull.vertex = drag.point - first;
+            const Eigen::Vector3d rest = frame.points.row(drag.point).transpose();
+            pull.target = rest + (drag.target - rest) / scene_.output.warp;
+            return pull;
+        }
+        first += count;
+    }
+    return pull;  // a point past the bodies' (none: the frame holds the bodies only)
+}
+
 void LiveView::frame(const io::MeshData& frame, int step, double time, const std::string& models)
 {
+    // The time this frame took to compute (since the last one was shown) against its screen time.
+    const double computed = clock_.seconds(), screen = slow_motion(scene_) / scene_.output.frame_rate;
+    window_.set_name(str(name_, " · frame ", std::lround(1e3 * computed), " ms of ", std::lround(1e3 * screen),
+                         " ms", computed > screen ? " (slower than real time)" : ""));
     const io::MeshData shown = io::warped(frame, scene_.output.warp);
     const auto draw = [&] {
         fig::RenderOptions view = frame_view(scene_);
@@ -227,6 +251,20 @@ void LiveView::frame(const io::MeshData& frame, int step, double time, const std
             }
         }
         view.props = obstacle_props(scene_, box, time);
+        if (pull_.body >= 0) {  // the spring: a line from the pulled vertex to the pointer's point
+            int first = 0;
+            for (int b = 0; b < pull_.body; ++b)
+                first += static_cast<int>(scene_.bodies[static_cast<std::size_t>(b)].mesh.V.rows());
+            const Eigen::Vector3d rest = frame.points.row(first + pull_.vertex).transpose();
+            fig::Prop spring;  // one line cell
+            spring.colour = {0.8, 0.1, 0.1};
+            spring.shape.points.resize(2, 3);
+            spring.shape.points.row(0) = shown.points.row(first + pull_.vertex);
+            spring.shape.points.row(1) = (rest + scene_.output.warp * (pull_.target - rest)).transpose();
+            spring.shape.cells.resize(1, 2);
+            spring.shape.cells << 0, 1;
+            view.props.push_back(std::move(spring));
+        }
         if (!view.frame_bounds) {
             for (const fig::Prop& prop : view.props)
                 fig::grow_bounds(box, prop.shape.points);
@@ -267,6 +305,7 @@ void LiveView::frame(const io::MeshData& frame, int step, double time, const std
         }
         if (paused_ && !advance)
             std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        pull_ = pull_of(window_.pointer_drag(), frame);
     } while (paused_ && !advance && !stop_requested());
 }
 

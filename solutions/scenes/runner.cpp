@@ -72,6 +72,7 @@ struct BodyRun {
     std::unique_ptr<ContactIntegrator> contact;  // null: the scene has no obstacles
     std::unique_ptr<dynamics::Simulation> simulation;
     bool automatic = false;  // the model is auto's choice of the moment
+    std::shared_ptr<Pull> pull = std::make_shared<Pull>();  // what pulls it now (read by its step hook)
     std::vector<Segment> segments;
     std::vector<dynamics::StepRecord> records;
 
@@ -98,7 +99,7 @@ BodyRun start_body(const BodySpec& spec, const SceneSpec& scene, const std::stri
     b.integrator = std::make_unique<LevelIntegrator>(*b.forces, scene);
     if (!obstacles.empty())
         b.contact = std::make_unique<ContactIntegrator>(*b.integrator, *b.forces, *b.body, obstacles, scene);
-    SceneConditions conditions(spec, scene, b.forces, automatic, b.contact.get());
+    SceneConditions conditions(spec, scene, b.forces, automatic, b.contact.get(), b.pull);
     b.body->set_applied_loads(conditions.initial_loads());
     Eigen::VectorXd v0 = Eigen::VectorXd::Zero(3 * spec.mesh.V.rows());
     if (spec.initial_velocity.norm() > 0.0) {
@@ -129,6 +130,30 @@ void step_body(BodyRun& b)
         last.last_step = step;
     else
         b.segments.push_back({step, step, b.forces->level(), b.forces->level_model()});
+}
+
+/// Sets each body's pull from request (stiffness 0: the body's default), printing a line when a
+/// pull starts, moves to another vertex or ends.
+void update_pulls(std::vector<BodyRun>& bodies, const PullRequest& request, double stiffness)
+{
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+        BodyRun& b = bodies[i];
+        Pull& pull = *b.pull;
+        if (request.body == static_cast<int>(i)) {
+            if (pull.vertex != request.vertex) {
+                pull = make_pull(*b.body, request.vertex, request.target,
+                                 stiffness != 0.0 ? stiffness : default_pull_stiffness(*b.body));
+                std::cout << "pulling vertex " << pull.vertex << " of body '" << b.spec->name << "' (k = "
+                          << pull.stiffness << " N/m on " << pull.vertices.size() << " vertices)" << std::endl;
+            }
+            pull.target = request.target;
+        } else if (pull.vertex >= 0) {
+            const Eigen::Vector3d x = b.body->positions(b.state().u).row(pull.vertex).transpose();
+            std::cout << "released vertex " << pull.vertex << " of body '" << b.spec->name << "' "
+                      << (x - pull.target).norm() << " m from the pointer's point" << std::endl;
+            pull = Pull{};
+        }
+    }
 }
 
 /// The frame of every body, merged, with the fields the scene asks for (and "model": each tet's level).
@@ -225,11 +250,13 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
     frame();
     Progress progress(steps, options.progress);
     Timer clock;
-    for (int k = 1; k <= steps; ++k) {
+    for (int k = 1; options.forever || k <= steps; ++k) {
         if (stop_requested()) {
             result.interrupted = true;
             break;
         }
+        if (options.pull)
+            update_pulls(bodies, options.pull(), options.pull_stiffness);
         int newton = 0;
         for (BodyRun& b : bodies) {
             step_body(b);
@@ -240,7 +267,8 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
         log_step();
         if (k % frame_every == 0 || k == steps)
             frame();
-        progress.update(k, newton);
+        if (!options.forever)
+            progress.update(k, newton);
     }
     result.seconds = clock.seconds();
     if (result.interrupted)

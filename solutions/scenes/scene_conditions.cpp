@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <vector>
 
 namespace fem::scenes {
@@ -55,9 +56,56 @@ Eigen::VectorXd applied_loads(const BodySpec& body, const MatrixX3i& boundary, d
     return f;
 }
 
+double default_pull_stiffness(const dynamics::Body& body)
+{
+    const double mass = body.dof_masses().sum() / 3.0;
+    return mass * std::pow(2.0 * std::numbers::pi * 1.0, 2);
+}
+
+Pull make_pull(const dynamics::Body& body, int vertex, const Eigen::Vector3d& target, double stiffness)
+{
+    const MatrixX3d& rest = body.mesh().V;
+    if (vertex < 0 || vertex >= rest.rows())
+        throw Error(str("pull: vertex ", vertex, " is not a vertex of the body (0 to ", rest.rows() - 1, ")"));
+    if (!(stiffness > 0.0) || !std::isfinite(stiffness))
+        throw Error(str("pull: the stiffness must be a number > 0 N/m, got ", stiffness));
+    Pull pull;
+    pull.vertex = vertex;
+    pull.target = target;
+    pull.stiffness = stiffness;
+    const double radius = pull_radius * (rest.colwise().maxCoeff() - rest.colwise().minCoeff()).norm();
+    std::vector<double> masses;
+    for (Eigen::Index v = 0; v < rest.rows(); ++v)
+        if ((rest.row(v) - rest.row(vertex)).norm() <= radius) {
+            pull.vertices.push_back(static_cast<int>(v));
+            masses.push_back(body.dof_masses()[3 * v]);
+        }
+    pull.shares = Eigen::Map<const Eigen::VectorXd>(masses.data(), static_cast<Eigen::Index>(masses.size()));
+    pull.shares /= pull.shares.sum();
+    return pull;
+}
+
+Eigen::VectorXd pull_load(const Pull& pull, const dynamics::Body& body, const Eigen::VectorXd& u)
+{
+    Eigen::VectorXd f = Eigen::VectorXd::Zero(u.size());
+    if (pull.vertex < 0)
+        return f;
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (std::size_t i = 0; i < pull.vertices.size(); ++i) {
+        const int v = pull.vertices[i];
+        centre += pull.shares[static_cast<Eigen::Index>(i)] *
+                  (body.mesh().V.row(v).transpose() + u.segment<3>(3 * v));
+    }
+    const Eigen::Vector3d force = pull.stiffness * (pull.target - centre);
+    for (std::size_t i = 0; i < pull.vertices.size(); ++i)
+        f.segment<3>(3 * pull.vertices[i]) += pull.shares[static_cast<Eigen::Index>(i)] * force;
+    return f;
+}
+
 SceneConditions::SceneConditions(const BodySpec& body, const SceneSpec& scene, SceneForces* forces, bool automatic,
-                                 const ContactIntegrator* contact)
-    : body_(&body), scene_(&scene), forces_(forces), automatic_(automatic && forces != nullptr), contact_(contact)
+                                 const ContactIntegrator* contact, std::shared_ptr<const Pull> pull)
+    : body_(&body), scene_(&scene), forces_(forces), automatic_(automatic && forces != nullptr), contact_(contact),
+      pull_(std::move(pull))
 {
     for (const Pin& pin : body.pins)
         pins_move_ = pins_move_ || pin.motion.kind != Motion::Kind::fixed;
@@ -82,10 +130,15 @@ SceneConditions::SceneConditions(const BodySpec& body, const SceneSpec& scene, S
 bool SceneConditions::operator()(dynamics::Body& body, const dynamics::State& state, double step_end)
 {
     bool changed = false;
-    if (loads_change_) {
-        body.set_applied_loads(applied_loads(*body_, boundary_, step_end));
+    const bool pulled = pull_ != nullptr && pull_->vertex >= 0;
+    if (loads_change_ || pulled || pulled_) {  // pulled_: the pull's load ends with it
+        Eigen::VectorXd loads = loads_change_ ? applied_loads(*body_, boundary_, step_end) : initial_loads_;
+        if (pulled)
+            loads += pull_load(*pull_, body, state.u);
+        body.set_applied_loads(loads);
         changed = true;
     }
+    pulled_ = pulled;
     if (pins_move_) {
         const double dt = step_end - state.time;
         Eigen::VectorXd velocity = Eigen::VectorXd::Zero(state.u.size());

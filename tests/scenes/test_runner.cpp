@@ -12,8 +12,16 @@
 #include <catch2/catch.hpp>
 
 #include <X11/Xlib.h>
+#include <X11/extensions/XTest.h>
 #include <X11/keysym.h>
 
+#include <vtkDataArray.h>
+#include <vtkImageData.h>
+#include <vtkNew.h>
+#include <vtkPNGReader.h>
+#include <vtkPointData.h>
+
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <filesystem>
@@ -426,6 +434,28 @@ private:
     std::string buffer_;
 };
 
+/// A fem_scene started by a test: waited for, or killed when the test ends first (a failed REQUIRE
+/// leaves no window running its 600 s).
+struct RunningScene {
+    pid_t child;
+    bool reaped = false;
+    ~RunningScene()
+    {
+        if (!reaped) {
+            ::kill(child, SIGKILL);
+            ::waitpid(child, nullptr, 0);
+        }
+    }
+    /// Waits for it to end; its waitpid status.
+    int wait()
+    {
+        int status = 0;
+        ::waitpid(child, &status, 0);
+        reaped = true;
+        return status;
+    }
+};
+
 }  // namespace
 
 // Deterministic: after each key the test waits for the line fem_scene prints once it has handled
@@ -448,17 +478,7 @@ TEST_CASE("the live view's keys: space pauses, the right arrow steps, space resu
                                      "--set", "title=" + title, "--out", out.string()}, &output_fd);
     REQUIRE(child > 0);
     LineReader printed(output_fd);
-    struct StopOnFailure {  // a failed REQUIRE leaves no window running its 600 s
-        pid_t child;
-        bool reaped = false;
-        ~StopOnFailure()
-        {
-            if (!reaped) {
-                ::kill(child, SIGKILL);
-                ::waitpid(child, nullptr, 0);
-            }
-        }
-    } running{child};
+    RunningScene running{child};
     Window window = 0;
     for (int poll = 0; poll < 1200 && (window == 0 || frames_so_far(out, "cantilever") < 3); ++poll) {
         std::this_thread::sleep_for(std::chrono::milliseconds(50));
@@ -491,15 +511,130 @@ TEST_CASE("the live view's keys: space pauses, the right arrow steps, space resu
     CHECK(printed.wait_for("paused at step ") == "paused at step 0 (t = 0 s)");
     CHECK(frames_so_far(out, "cantilever") == 1);
     press(display, window, XK_q);  // stop, as Ctrl-C does
-    int status = 0;
-    ::waitpid(child, &status, 0);
-    running.reaped = true;
+    const int status = running.wait();
     XCloseDisplay(display);
     REQUIRE(WIFEXITED(status));
     CHECK(WEXITSTATUS(status) == 130);
     const auto frames = io::read_pvd(out / "cantilever.pvd");
     REQUIRE(frames.size() == 1);  // the restarted run's first frame, not those before the restart
     CHECK(frames.front().first == 0.0);
+}
+
+namespace {
+
+/// Moves the pointer to pixel (x, y) of a window (from its top left), then, for type ButtonPress or
+/// ButtonRelease, presses or releases the left button there (MotionNotify: only the move): real input
+/// through the X server's XTEST extension, as a user's hand gives it. The window is raised first, so
+/// that no other test's window on the same display takes the events.
+void pointer(Display* display, Window window, int type, int x, int y)
+{
+    XRaiseWindow(display, window);
+    int root_x = 0, root_y = 0;
+    Window child = 0;
+    XTranslateCoordinates(display, window, DefaultRootWindow(display), x, y, &root_x, &root_y, &child);
+    XTestFakeMotionEvent(display, -1, root_x, root_y, CurrentTime);
+    if (type != MotionNotify)
+        XTestFakeButtonEvent(display, Button1, type == ButtonPress ? True : False, CurrentTime);
+    XFlush(display);
+}
+
+/// The centre of the body's coloured pixels in a picture of the live view (x, y from the top
+/// left): the pixels that are neither white, grey nor black, left of the colour bar.
+std::pair<int, int> body_centre(const std::filesystem::path& png)
+{
+    vtkNew<vtkPNGReader> reader;
+    reader->SetFileName(png.string().c_str());
+    reader->Update();
+    int size[3];
+    reader->GetOutput()->GetDimensions(size);
+    vtkDataArray* pixels = reader->GetOutput()->GetPointData()->GetScalars();
+    double sum_x = 0.0, sum_y = 0.0, count = 0.0;
+    for (int y = 0; y < size[1]; ++y)
+        for (int x = 0; x < size[0] * 3 / 4; ++x) {
+            const vtkIdType i = static_cast<vtkIdType>(y) * size[0] + x;
+            const double r = pixels->GetComponent(i, 0), g = pixels->GetComponent(i, 1), b = pixels->GetComponent(i, 2);
+            if (std::max({r, g, b}) - std::min({r, g, b}) > 40.0) {
+                sum_x += x;
+                sum_y += size[1] - 1 - y;  // VTK's rows start at the bottom
+                count += 1.0;
+            }
+        }
+    REQUIRE(count > 100.0);
+    return {static_cast<int>(sum_x / count), static_cast<int>(sum_y / count)};
+}
+
+/// The first file of this name in the staging folders of a running fem_scene's --out.
+std::filesystem::path staged(const std::filesystem::path& out, const std::string& name)
+{
+    std::error_code ignored;
+    for (const auto& staging : std::filesystem::directory_iterator(out, ignored))
+        if (std::filesystem::exists(staging.path() / name))
+            return staging.path() / name;
+    return {};
+}
+
+}  // namespace
+
+// Deterministic as the keys' test: after each mouse event it waits for the line fem_scene prints.
+TEST_CASE("the live view's mouse: pressing on the body pulls it toward the pointer, its work booked, until released",
+          "[scenes]")
+{
+    Display* display = std::getenv("DISPLAY") ? XOpenDisplay(nullptr) : nullptr;
+    if (display == nullptr) {
+        WARN("SKIPPED: no X display: run the tests under xvfb-run -a to check the live view's mouse");
+        return;
+    }
+    const std::filesystem::path out = output / "pull";
+    std::filesystem::remove_all(out);
+    const std::string title = "live_view_pull_" + std::to_string(::getpid());
+    int output_fd = -1;
+    // At rest until pulled (no gravity), so that the body stays where the first frame's picture shows
+    // it; corotational throughout: auto's switches would book work of their own.
+    const pid_t child = start_scene({(gallery / "cantilever.toml").string(), "--quick", "--view", "--no-figures",
+                                     "--no-progress", "--set", "time.duration=600", "--set", "title=" + title, "--set",
+                                     "body.material.model=corotational", "--set", "gravity=[0.0, 0.0, 0.0]",
+                                     "--screenshot", "0", "--out", out.string()},
+                                    &output_fd);
+    REQUIRE(child > 0);
+    LineReader printed(output_fd);
+    RunningScene running{child};
+    Window window = 0;
+    std::filesystem::path picture;
+    for (int poll = 0; poll < 1200 && (window == 0 || picture.empty() || frames_so_far(out, "cantilever") < 3); ++poll) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        if (window == 0)
+            window = find_window(display, DefaultRootWindow(display), "fem_scene: " + title);
+        if (picture.empty())
+            picture = staged(out, "view_0.png");
+    }
+    REQUIRE(window != 0);
+    REQUIRE(!picture.empty());
+    const auto [x, y] = body_centre(picture);
+    pointer(display, window, ButtonPress, x, y);
+    pointer(display, window, MotionNotify, x, y - 120);  // up
+    const std::string pulling = printed.wait_for("pulling vertex ");
+    CHECK(pulling.find("of body 'beam'") != std::string::npos);
+    const int frames = frames_so_far(out, "cantilever");
+    for (int poll = 0; poll < 2400 && frames_so_far(out, "cantilever") < frames + 12; ++poll)
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    pointer(display, window, ButtonRelease, x, y - 120);
+    const std::string released = printed.wait_for("released vertex ");
+    CHECK(released != "");
+    press(display, window, XK_q);
+    const int status = running.wait();
+    XCloseDisplay(display);
+    REQUIRE(WIFEXITED(status));
+    CHECK(WEXITSTATUS(status) == 130);
+    // The pull put work in (steps.csv's "work in (J)", the 8th column), which nothing else here does.
+    std::ifstream steps(out / "steps.csv");
+    std::string line, last;
+    while (std::getline(steps, line))
+        last = line;
+    std::stringstream fields(last);
+    std::string field;
+    for (int column = 0; column < 8; ++column)
+        std::getline(fields, field, ',');
+    CHECK(std::stod(field) > 0.0);
 }
 
 TEST_CASE("a skin: the bunny's surface in its body's coordinates, carrying an affine motion exactly", "[scenes]")
