@@ -348,3 +348,18 @@ TEST_CASE("two bars crossed at right angles, pushed together: only their edges m
     const Eigen::Vector3d lower = momentum(*bodies.body, bodies.state.v, 0, half);
     CHECK(lower.z() < 0.0);                 // the lower bar moves down again: they bounced
 }
+
+TEST_CASE("self-contact's refusals: no obstacle without it, and primitives closer than d-hat at rest", "[self]")
+{
+    dynamics::Scene scene;
+    scene.mesh = box_mesh(2, 2, 2, Eigen::Vector3d::Constant(0.1));  // cells of 5 cm
+    const dynamics::Body body(scene);
+    const std::vector<std::shared_ptr<const Obstacle>> none;
+    CHECK_THROWS_AS(ContactPotential(body, none, ContactOptions{}), Error);
+    ContactOptions options;
+    options.self_contact = true;
+    CHECK_NOTHROW(ContactPotential(body, none, options));
+    // d̂ = 6 cm reaches from a surface vertex to the triangles of the neighbouring cell's far side.
+    options.activation_distance = 0.06;
+    CHECK_THROWS_WITH(ContactPotential(body, none, options), Catch::Contains("closer than d̂"));
+}
