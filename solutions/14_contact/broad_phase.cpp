@@ -158,14 +158,24 @@ CandidatePairs tree_candidates(const SurfacePrimitives& surface, const MatrixX3d
                                double inflation)
 {
     const SweptBoxes boxes = checked_boxes(surface, start, end, inflation);
+    CandidatePairs pairs;
+    // BEGIN EXERCISE 14.7 tree_candidates #bodies-against-bodies-and-self-contact
+    // HINT: Build chapter 13's box tree (skin::box_hierarchy(boxes, 4)) over boxes.triangles and one
+    // HINT: over boxes.edges. Then pairs = collect(surface, boxes, found): collect calls found(point, k)
+    // HINT: for each surface vertex k (point = true) and each edge k (point = false), and wants the
+    // HINT: triangles (edges) whose boxes meet that primitive's grown box, boxes.grown_vertices[k]
+    // HINT: (boxes.grown_edges[k]): ask the tree with skin::boxes_meeting(tree, boxes, low, high).
+    // HINT: collect itself applies the box test, leaves out pairs that share a vertex, and sorts.
     const skin::BoxHierarchy triangle_tree = skin::box_hierarchy(boxes.triangles, 4);
     const skin::BoxHierarchy edge_tree = skin::box_hierarchy(boxes.edges, 4);
-    return collect(surface, boxes, [&](bool point, int k) {
+    pairs = collect(surface, boxes, [&](bool point, int k) {
         const BoundingBox& query = point ? boxes.grown_vertices[static_cast<std::size_t>(k)]
                                          : boxes.grown_edges[static_cast<std::size_t>(k)];
         return skin::boxes_meeting(point ? triangle_tree : edge_tree, point ? boxes.triangles : boxes.edges,
                                    query.row(0).transpose(), query.row(1).transpose());
     });
+    // END EXERCISE
+    return pairs;
 }
 
 CandidatePairs hash_candidates(const SurfacePrimitives& surface, const MatrixX3d& start, const MatrixX3d& end,

@@ -211,7 +211,7 @@ TEST_CASE("self-contact barrier: energy, gradient and Hessian against central di
 }
 
 TEST_CASE("broad phase: brute force, the AABB tree and the spatial hash find the same pairs, every pair within r",
-          "[self]")
+          "[self][ex14.7]")
 {
     const TetMesh block = box_mesh(3, 2, 2, Eigen::Vector3d(0.3, 0.2, 0.2));
     const TetMesh pair_of_blocks = two_bodies(box_at(Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(0.1), 2),
