@@ -68,8 +68,8 @@ private:
     /// gradient and Hessian. Returns false (stopping) at a pair with d = 0.
     template <class Visit>
     bool for_each_pair(const Eigen::VectorXd& u, double reach, bool with_derivatives, Visit visit) const;
-    /// The positions X + u (#V×3); fem::Error naming what when u's size is not 3n.
-    MatrixX3d positions(const Eigen::VectorXd& u, const char* what) const;
+    /// x (#V×3) moved by u (3n, vertex-major); fem::Error naming what when u's size is not 3n.
+    MatrixX3d moved(const MatrixX3d& x, const Eigen::VectorXd& u, const char* what) const;
 
     MatrixX3d rest_;
     double activation_distance_;

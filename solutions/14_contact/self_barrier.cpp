@@ -27,21 +27,21 @@ SelfContactBarrier::SelfContactBarrier(const TetMesh& mesh, double activation_di
     require_positive(activation_distance, "self-contact activation distance d̂ [m]");
 }
 
-MatrixX3d SelfContactBarrier::positions(const Eigen::VectorXd& u, const char* what) const
+MatrixX3d SelfContactBarrier::moved(const MatrixX3d& x, const Eigen::VectorXd& u, const char* what) const
 {
-    if (u.size() != 3 * rest_.rows())
-        throw Error(str("self-contact: ", what, " needs 3n = ", 3 * rest_.rows(), " entries, got ", u.size()));
-    MatrixX3d x = rest_;
+    if (u.size() != 3 * x.rows())
+        throw Error(str("self-contact: ", what, " needs 3n = ", 3 * x.rows(), " entries, got ", u.size()));
+    MatrixX3d moved = x;
     for (Eigen::Index v = 0; v < x.rows(); ++v)
-        x.row(v) += u.segment<3>(3 * v).transpose();
-    return x;
+        moved.row(v) += u.segment<3>(3 * v).transpose();
+    return moved;
 }
 
 template <class Visit>
 bool SelfContactBarrier::for_each_pair(const Eigen::VectorXd& u, double reach, bool with_derivatives,
                                        Visit visit) const
 {
-    const MatrixX3d x = positions(u, "the displacement u");
+    const MatrixX3d x = moved(rest_, u, "the displacement u");
     const auto at = [&](int v) -> Eigen::Vector3d { return x.row(v).transpose(); };
     const auto rest = [&](int v) -> Eigen::Vector3d { return rest_.row(v).transpose(); };
     const CandidatePairs candidates = tree_candidates(surface_, x, x, reach);
@@ -127,8 +127,8 @@ double SelfContactBarrier::smallest_distance(const Eigen::VectorXd& u, double re
 
 double SelfContactBarrier::time_of_impact(const Eigen::VectorXd& u, const Eigen::VectorXd& du) const
 {
-    const MatrixX3d x0 = positions(u, "the displacement u");
-    const MatrixX3d x1 = x0 + (positions(du, "the step du") - rest_);
+    const MatrixX3d x0 = moved(rest_, u, "the displacement u");
+    const MatrixX3d x1 = moved(x0, du, "the step du");
     const CandidatePairs candidates = tree_candidates(surface_, x0, x1, 0.0);
     double earliest = infinity;
     PrimitiveMotion motion;

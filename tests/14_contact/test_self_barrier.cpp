@@ -363,3 +363,38 @@ TEST_CASE("self-contact's refusals: no obstacle without it, and primitives close
     options.activation_distance = 0.06;
     CHECK_THROWS_WITH(ContactPotential(body, none, options), Catch::Contains("closer than d̂"));
 }
+
+TEST_CASE("self-contact's time of impact: never after the first contact, never far before it", "[self][ex14.7]")
+{
+    // Two cubes 1 cm apart closing by 4 cm (first contact at s = 1/4, face on face: point–triangle
+    // pairs), and two crossed one-cell bars 2 mm apart closing by 4 mm (first contact at s = 1/2,
+    // where only edges meet: edge–edge pairs). Moving apart instead, no impact.
+    struct Case {
+        const char* name;
+        TetMesh mesh;
+        Eigen::Index half;
+        int axis;
+        double closing, first_contact;
+    };
+    const TetMesh cube = box_at(Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(0.1));
+    const TetMesh bar_one = box_at(Eigen::Vector3d(0.0, 0.1, 0.0), Eigen::Vector3d(0.3, 0.1, 0.05));
+    const std::vector<Case> cases{
+        {"cubes", two_bodies(cube, box_at(Eigen::Vector3d(0.11, 0.03, 0.02), Eigen::Vector3d::Constant(0.1))),
+         cube.V.rows(), 0, 0.04, 0.25},
+        {"crossed bars",
+         two_bodies(bar_one, box_at(Eigen::Vector3d(0.1, 0.0, 0.052), Eigen::Vector3d(0.1, 0.3, 0.05))),
+         bar_one.V.rows(), 2, 0.004, 0.5}};
+    for (const Case& c : cases) {
+        const SelfContactBarrier barrier(c.mesh, 1e-3);
+        const Eigen::Index n = c.mesh.V.rows();
+        Eigen::VectorXd du = Eigen::VectorXd::Zero(3 * n);
+        for (Eigen::Index v = 0; v < n; ++v)
+            du[3 * v + c.axis] = (v < c.half ? 0.5 : -0.5) * c.closing;
+        const Eigen::VectorXd u = Eigen::VectorXd::Zero(3 * n);
+        const double s = barrier.time_of_impact(u, du);
+        INFO(c.name << ": time of impact " << s << ", first contact at " << c.first_contact);
+        CHECK(s <= c.first_contact);
+        CHECK(s >= 0.9 * c.first_contact);
+        CHECK(barrier.time_of_impact(u, -du) > 1.0);
+    }
+}
