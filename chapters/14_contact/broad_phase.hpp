@@ -24,7 +24,8 @@ namespace fem::contact {
 /// The boundary of a tet mesh as primitives, in indices of the mesh's vertices.
 struct SurfacePrimitives {
     std::vector<int> vertices;  ///< the vertices of the boundary faces, increasing
-    Eigen::MatrixX2i edges;     ///< the edges of the boundary faces, each once (lower index first), in the order the faces meet them
+    /// The edges of the boundary faces, each once (lower index first), in the order the faces meet them.
+    Eigen::MatrixX2i edges;
     MatrixX3i triangles;        ///< chapter 13's boundary faces (skin::boundary_faces), outward
 };
 

@@ -112,7 +112,8 @@ CandidatePairs collect(const SurfacePrimitives& surface, const SweptBoxes& boxes
         std::sort(edges.begin(), edges.end());
         edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
         for (int b : edges)
-            if (b > a && meet(boxes.grown_edges[static_cast<std::size_t>(a)], boxes.edges[static_cast<std::size_t>(b)]) &&
+            if (b > a &&
+                meet(boxes.grown_edges[static_cast<std::size_t>(a)], boxes.edges[static_cast<std::size_t>(b)]) &&
                 !share_vertex(surface, a, b))
                 pairs.edge_edge.push_back({a, b});
     }

@@ -93,7 +93,8 @@ ContactPotential::ContactPotential(const dynamics::Body& body, std::vector<std::
     stiffness_set_ = options_.stiffness > 0.0;
     if (options_.self_contact) {
         self_ = std::make_unique<SelfContactBarrier>(body.mesh(), options_.activation_distance);
-        const double at_rest = self_->smallest_distance(Eigen::VectorXd::Zero(3 * rest_.rows()), options_.activation_distance);
+        const double at_rest =
+            self_->smallest_distance(Eigen::VectorXd::Zero(3 * rest_.rows()), options_.activation_distance);
         if (at_rest < options_.activation_distance)
             throw Error(str("contact: with self-contact, two surface primitives that share no vertex are ", at_rest,
                             " m apart at rest, closer than d̂ = ", options_.activation_distance,

@@ -139,9 +139,10 @@ double SelfContactBarrier::time_of_impact(const Eigen::VectorXd& u, const Eigen:
         }
         earliest = std::min(earliest, line_search_time_of_impact(kind, motion));
     };
-    for (const auto& [vertex, triangle] : candidates.point_triangle)
-        add(PrimitivePair::point_triangle,
-            {vertex, surface_.triangles(triangle, 0), surface_.triangles(triangle, 1), surface_.triangles(triangle, 2)});
+    for (const auto& [vertex, triangle] : candidates.point_triangle) {
+        const auto corners = surface_.triangles.row(triangle);
+        add(PrimitivePair::point_triangle, {vertex, corners(0), corners(1), corners(2)});
+    }
     for (const auto& [first, second] : candidates.edge_edge)
         add(PrimitivePair::edge_edge, {surface_.edges(first, 0), surface_.edges(first, 1), surface_.edges(second, 0),
                                        surface_.edges(second, 1)});
