@@ -13,9 +13,13 @@
 // barrier per pair) and the friction of every pair k = (v, o) that was within d̂ at the step's start:
 // λ_k = κ Σ_p |b'(d_{o,p}(x_vᵗ))| its lagged normal force [N], T_k (3×2)
 // an orthonormal basis of the tangent plane ⟂ ∇d_o(x_vᵗ), w_o the obstacle's velocity (IPC: lagged friction).
+// Added to it: the obstacles' edges and corners against the body's surface (feature_barrier.hpp) and,
+// with ContactOptions::self_contact, the body's surface against itself — several bodies, one mesh of
+// several components, against each other (self_barrier.hpp; no friction between them).
 
 #include "14_contact/feature_barrier.hpp"
 #include "14_contact/obstacles.hpp"
+#include "14_contact/self_barrier.hpp"
 
 #include "12_hyperelastic_newton/newton.hpp"
 
@@ -40,6 +44,10 @@ struct ContactOptions {
     /// ε_d as a fraction of the body's bounding-box diagonal: κ doubles when the smallest distance
     /// is below it and still falling (IPC's value: 10⁻⁹).
     double doubling_distance = 1e-9;
+    /// Whether the body's surface primitives hold each other off too (SelfContactBarrier: bodies
+    /// against bodies, a body against itself; no friction between them). Off: the body passes
+    /// through itself, as every run before it did. docs/14_contact.md#bodies-against-bodies-and-self-contact
+    bool self_contact = false;
 };
 
 /// One lagged friction pair: vertex v against obstacle o, with the normal force and tangent basis
@@ -66,8 +74,11 @@ double smallest_stiffness(double average_mass, double time_step, double activati
 /// NewtonBackwardEuler::set_potential). docs/14_contact.md#the-contact-potential
 class ContactPotential final : public hyper::StepPotential {
 public:
-    /// The surface vertices of body's mesh (chapter 13's boundary faces) against every obstacle.
-    /// fem::Error for no obstacle, d̂ ≤ 0, κ < 0, a safety outside (0, 1), ε_v ≤ 0, ε_d < 0.
+    /// The surface vertices of body's mesh (chapter 13's boundary faces) against every obstacle, and,
+    /// with options.self_contact, its surface primitives against each other (SelfContactBarrier).
+    /// fem::Error for no obstacle without self_contact, d̂ ≤ 0, κ < 0, a safety outside (0, 1),
+    /// ε_v ≤ 0, ε_d < 0, and, with self_contact, two surface primitives that share no vertex closer
+    /// than d̂ at rest (their barrier would push the body at rest: a smaller d̂ is needed).
     ContactPotential(const dynamics::Body& body, std::vector<std::shared_ptr<const Obstacle>> obstacles,
                      ContactOptions options = {});
 
@@ -87,7 +98,8 @@ public:
     /// μλ T [ (f₁'(y) y − f₁(y))/y³ · s sᵀ + f₁(y)/y · I₂ ] Tᵀ; the sum is projected once
     /// (chapter 12's project_to_psd): b' ∇²d of a sphere is negative semi-definite.
     dynamics::SparseMatrix hessian(const Eigen::VectorXd& u) const override;
-    /// min(1, safety × the earliest time of impact of any surface vertex's path x_v + s·Δx_v).
+    /// min(1, safety × the earliest time of impact of any surface vertex's path x_v + s·Δx_v, of the
+    /// features' pairs and (self_contact) of the surface pairs, SelfContactBarrier::time_of_impact).
     double largest_safe_step(const Eigen::VectorXd& u, const Eigen::VectorXd& du) const override;
     /// The step's start velocity (3n) for Newton: a stage's start (stage_next_step), else the first of v = 0 (the body stays put) and
     /// v = w_o (the body carried along with moving obstacle o, in the obstacles' order; the pins
@@ -101,10 +113,13 @@ public:
                                    double time_step) const override;
 
     /// The barrier's part of P: Σ_v Σ_o Σ_p κ b(d_{o,p}(x_v, time)) with the current step's κ [J] (+∞ when
-    /// some surface vertex has d ≤ 0). Its change over a step, with the obstacles at the step's start
-    /// and end times, is the work the obstacles did on the body (the scenes runner books it).
+    /// some surface vertex has d ≤ 0), plus the features' and (self_contact) the self-contact
+    /// barrier's. Its change over a step, with the obstacles at the step's start and end times, is
+    /// the work the obstacles did on the body (the scenes runner books it), and, with self_contact,
+    /// the energy the body's own barrier stored or gave back.
     double barrier_energy(const Eigen::VectorXd& u, double time) const;
-    /// The barrier's force on every vertex, −κ b'(d) ∇d summed over obstacles (3n) [N].
+    /// The barrier's force on every vertex, −κ b'(d) ∇d summed over obstacles, their features and
+    /// (self_contact) the body's own surface pairs (3n) [N].
     Eigen::VectorXd barrier_forces(const Eigen::VectorXd& u) const;
     /// The work the moving obstacles do on the body over the step by carrying their forces along:
     /// Δt Σ_o w_o · F_o(u) [J], F_o the force of obstacle o's barrier and friction pairs on the body
@@ -112,13 +127,16 @@ public:
     /// energy, −(B(u⁺, t + Δt) − B(uᵗ, t)), it is the work of the barrier's forces on the body
     /// (∂B/∂t = −∇B·w); 0 when no obstacle moves. docs/14_contact.md#moving-obstacles
     double obstacle_work(const Eigen::VectorXd& u, double time_step) const;
-    /// The smallest d_o(x_v) over surface vertices and obstacles at the step's end time [m].
+    /// The smallest d_o(x_v) over surface vertices and obstacles at the step's end time [m], and over
+    /// the features' and (self_contact) the surface pairs within d̂.
     double smallest_distance(const Eigen::VectorXd& u) const;
 
     /// Whether the step from u at time t to u_end at t_end (3n each) is out of contact: every surface
     /// vertex is at d ≥ d̂ from every obstacle at its start (the obstacle at t and at t_end) and at its
     /// end (at t_end), and no straight path meets an obstacle: x_v + s (x_v⁺ − x_v − (t_end − t) w_o),
-    /// s ∈ [0, 1], the vertex's path relative to the obstacle, against the obstacle held at t. Then P and ∇P are zero at u_end and no friction pair forms at u: the step solved
+    /// s ∈ [0, 1], the vertex's path relative to the obstacle, against the obstacle held at t; with
+    /// self_contact also no surface pair within d̂ at u or u_end nor meeting on the way u → u_end.
+    /// Then P and ∇P are zero at u_end and no friction pair forms at u: the step solved
     /// without the potential solves it with the potential too (the scenes runner's rule, docs/scenes.md#obstacles).
     /// fem::Error on the sizes.
     bool out_of_contact(const Eigen::VectorXd& u, double time, const Eigen::VectorXd& u_end, double end_time) const;
@@ -162,6 +180,7 @@ private:
     std::vector<std::shared_ptr<const Obstacle>> obstacles_;
     ContactOptions options_;
     FeatureBarrier features_;  // the obstacles' edges and corners against the body's surface
+    std::unique_ptr<SelfContactBarrier> self_;  // the body's surface against itself (self_contact), else null
     Eigen::MatrixX3d rest_;            // X (#V × 3)
     std::vector<int> surface_;
     double average_mass_ = 0.0, diagonal_ = 0.0;

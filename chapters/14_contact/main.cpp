@@ -14,7 +14,10 @@
 //      a block dropped into the bowl, its frames;
 //   4. primitive CCD: point–triangle and edge–edge continuous collision detection, the naive
 //      coplanarity cubic against the conservative inclusion method, on the CCD benchmark's queries
-//      (data/ccd-unit-tests; --ccd-queries FILE... runs only this study, on those files).
+//      (data/ccd-unit-tests; --ccd-queries FILE... runs only this study, on those files);
+//   5. bodies against bodies: the broad phase of self-contact (which surface pairs two blocks can
+//      bring within d̂ over a step) by every pair, chapter 13's AABB tree and a spatial hash, timed
+//      against the number of surface primitives.
 //
 // Sample runs:
 //   ch14_contact                                   full run
@@ -23,7 +26,7 @@
 //   ch14_contact --ccd-queries data/ccd-unit-tests/edge-edge/data_0_0.csv   CCD on one query file
 //
 // Writes (under out/14_contact): drop_table.csv, slope_table.csv, mesh_table.csv, bowl_table.csv,
-// ccd_queries_table.csv, drop.pvd and bowl.pvd (frames drop/drop_NNNN.vtu, …), charts drop_height,
+// ccd_queries_table.csv, self_broad_phase_table.csv, drop.pvd and bowl.pvd (frames drop/drop_NNNN.vtu, …), charts drop_height,
 // drop_force, slope_slide, slope_stick, slope_cost (.csv, .png, .svg) and the bowl's frames bowl_NNNN.png.
 // docs/14_contact.md
 
@@ -110,5 +113,6 @@ int main(int argc, char** argv)
         study::slope_study(run, settings);
         study::mesh_study(run, settings);
         study::ccd_study(run, study::ccd_benchmark_files());
+        study::self_contact_study(run);
     });
 }

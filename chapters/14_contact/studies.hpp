@@ -47,5 +47,9 @@ void slope_study(const RunContext& run, const Settings& settings);
 void mesh_study(const RunContext& run, const Settings& settings);
 /// A block dropped into the bowl (the mesh obstacle in use): bowl.pvd, its PNG frames, bowl_table.csv.
 void bowl_study(const RunContext& run);
+/// The broad phase of self-contact three ways (brute force, AABB tree, spatial hash) on two blocks
+/// of k³ cells closing on each other: candidate pairs, whether they agree, time per search;
+/// self_broad_phase_table.csv (study_self.cpp).
+void self_contact_study(const RunContext& run);
 
 }  // namespace fem::contact::study

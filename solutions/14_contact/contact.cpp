@@ -2,8 +2,6 @@
 
 #include "14_contact/barrier.hpp"
 
-#include "13_skinning/skinning.hpp"
-
 #include "12_hyperelastic_newton/materials.hpp"
 
 #include "04_tet_jacobians/tet_jacobians.hpp"
@@ -24,10 +22,11 @@ namespace {
 
 constexpr double infinity = std::numeric_limits<double>::infinity();
 
-std::vector<std::shared_ptr<const Obstacle>> checked_obstacles(std::vector<std::shared_ptr<const Obstacle>> obstacles)
+std::vector<std::shared_ptr<const Obstacle>> checked_obstacles(std::vector<std::shared_ptr<const Obstacle>> obstacles,
+                                                              bool self_contact)
 {
-    if (obstacles.empty())
-        throw Error("contact: no obstacle given");
+    if (obstacles.empty() && !self_contact)
+        throw Error("contact: no obstacle given (and self-contact is off: nothing to hold off)");
     for (const auto& obstacle : obstacles)
         if (!obstacle)
             throw Error("contact: an obstacle is null");
@@ -72,7 +71,7 @@ double smallest_stiffness(double average_mass, double time_step, double activati
 
 ContactPotential::ContactPotential(const dynamics::Body& body, std::vector<std::shared_ptr<const Obstacle>> obstacles,
                                    ContactOptions options)
-    : obstacles_(checked_obstacles(std::move(obstacles))),
+    : obstacles_(checked_obstacles(std::move(obstacles), options.self_contact)),
       options_(options),
       features_(body.mesh(), obstacles_, checked_activation_distance(options.activation_distance)),
       rest_(body.mesh().V)
@@ -84,21 +83,23 @@ ContactPotential::ContactPotential(const dynamics::Body& body, std::vector<std::
     require_positive(options_.friction_velocity, "friction velocity eps_v [m/s]");
     if (!(std::isfinite(options_.doubling_distance) && options_.doubling_distance >= 0.0))
         throw Error(str("contact: the doubling distance must be >= 0, got ", options_.doubling_distance));
-    const skin::Boundary boundary = skin::boundary_faces(body.mesh());
-    std::vector<bool> on_surface(static_cast<std::size_t>(rest_.rows()), false);
-    for (Eigen::Index f = 0; f < boundary.faces.rows(); ++f)
-        for (int c = 0; c < 3; ++c)
-            on_surface[static_cast<std::size_t>(boundary.faces(f, c))] = true;
+    surface_ = surface_primitives(body.mesh()).vertices;
     double mass = 0.0;
-    for (int v = 0; v < static_cast<int>(on_surface.size()); ++v)
-        if (on_surface[static_cast<std::size_t>(v)]) {
-            surface_.push_back(v);
-            mass += body.dof_masses()[3 * v];
-        }
+    for (int v : surface_)
+        mass += body.dof_masses()[3 * v];
     average_mass_ = mass / static_cast<double>(surface_.size());
     diagonal_ = (rest_.colwise().maxCoeff() - rest_.colwise().minCoeff()).norm();
     stiffness_ = options_.stiffness;
     stiffness_set_ = options_.stiffness > 0.0;
+    if (options_.self_contact) {
+        self_ = std::make_unique<SelfContactBarrier>(body.mesh(), options_.activation_distance);
+        const double at_rest =
+            self_->smallest_distance(Eigen::VectorXd::Zero(3 * rest_.rows()), options_.activation_distance);
+        if (at_rest < options_.activation_distance)
+            throw Error(str("contact: with self-contact, two surface primitives that share no vertex are ", at_rest,
+                            " m apart at rest, closer than d̂ = ", options_.activation_distance,
+                            " m: their barrier would push the body at rest; use a d̂ below ", at_rest, " m"));
+    }
 }
 
 Eigen::Vector3d ContactPotential::position(const Eigen::VectorXd& u, int vertex) const
@@ -112,6 +113,8 @@ double ContactPotential::smallest_distance(const Eigen::VectorXd& u) const
     for (int v : surface_)
         for (const auto& obstacle : obstacles_)
             smallest = std::min(smallest, obstacle->distance(position(u, v), time_));
+    if (self_)
+        smallest = std::min(smallest, self_->smallest_distance(u, options_.activation_distance));
     return smallest;
 }
 
@@ -133,7 +136,11 @@ bool ContactPotential::out_of_contact(const Eigen::VectorXd& u, double time, con
     // The obstacles' edges and corners against the body's edges and triangles, likewise.
     const double near = std::min({features_.smallest_distance(u, time, reach), features_.smallest_distance(u, end_time, reach),
                                   features_.smallest_distance(u_end, end_time, reach)});
-    return near >= reach && features_.relative_time_of_impact(u, time, u_end, end_time) > 1.0;
+    if (!(near >= reach && features_.relative_time_of_impact(u, time, u_end, end_time) > 1.0))
+        return false;
+    // The body's surface against itself, likewise (it moves with neither obstacle).
+    return !self_ || (std::min(self_->smallest_distance(u, reach), self_->smallest_distance(u_end, reach)) >= reach &&
+                      self_->time_of_impact(u, u_end - u) > 1.0);
 }
 
 void ContactPotential::begin_step(dynamics::Body& body, const dynamics::State& state, double time_step)
@@ -249,7 +256,8 @@ double ContactPotential::barrier_energy(const Eigen::VectorXd& u, double time) c
             for (const DistancePiece& piece : pieces)
                 total += stiffness_ * barrier(piece.distance, options_.activation_distance).value;
         }
-    return total + features_.energy(u, time, stiffness_);
+    total += features_.energy(u, time, stiffness_);
+    return self_ && std::isfinite(total) ? total + self_->energy(u, stiffness_) : total;
 }
 
 double ContactPotential::energy(const Eigen::VectorXd& u) const
@@ -292,6 +300,8 @@ Eigen::VectorXd ContactPotential::barrier_forces(const Eigen::VectorXd& u) const
             forces.segment<3>(3 * v) += barrier_force(*obstacle, position(u, v));
     Eigen::VectorXd feature_gradient = Eigen::VectorXd::Zero(u.size());
     features_.add_gradient(u, time_, stiffness_, feature_gradient);
+    if (self_)
+        self_->add_gradient(u, stiffness_, feature_gradient);
     return forces - feature_gradient;
 }
 
@@ -358,6 +368,8 @@ dynamics::SparseMatrix ContactPotential::hessian(const Eigen::VectorXd& u) const
                 triplets.emplace_back(3 * vertex + i, 3 * vertex + j, projected(i, j));
     }
     features_.add_hessian(u, time_, stiffness_, triplets);
+    if (self_)
+        self_->add_hessian(u, stiffness_, triplets);
     dynamics::SparseMatrix H(u.size(), u.size());
     H.setFromTriplets(triplets.begin(), triplets.end());
     return H;
@@ -373,7 +385,8 @@ double ContactPotential::largest_safe_step(const Eigen::VectorXd& u, const Eigen
         for (const auto& obstacle : obstacles_)
             step = std::min(step, options_.safety * obstacle->time_of_impact(position(u, v), change, time_));
     }
-    return std::min(step, options_.safety * features_.time_of_impact(u, du, time_));
+    step = std::min(step, options_.safety * features_.time_of_impact(u, du, time_));
+    return self_ ? std::min(step, options_.safety * self_->time_of_impact(u, du)) : step;
 }
 
 double ContactPotential::obstacle_advance(const Eigen::VectorXd& u, double time, double time_step, double from) const
@@ -438,6 +451,8 @@ Eigen::VectorXd ContactPotential::free_start(const dynamics::Body& body, const d
             }
             if (features_.relative_time_of_impact(state.u, state.time, state.u + time_step * v, obstacle_time) <= 1.0)
                 return "an obstacle's edge or corner meets the body's surface";
+            if (self_ && self_->time_of_impact(state.u, time_step * v) <= 1.0)
+                return "the body's surface meets itself";
             return {};
         }();
         if (reached.empty())

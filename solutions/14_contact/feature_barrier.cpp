@@ -2,9 +2,10 @@
 // docs/14_contact.md#edges-and-corners-of-obstacles
 #include "14_contact/feature_barrier.hpp"
 
-#include "14_contact/barrier.hpp"
+#include "14_contact/broad_phase.hpp"
 #include "14_contact/ccd.hpp"
 #include "14_contact/distances.hpp"
+#include "14_contact/pair_barrier.hpp"
 
 #include "12_hyperelastic_newton/materials.hpp"
 
@@ -13,14 +14,12 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <map>
 #include <utility>
 
 namespace fem::contact {
 namespace {
 
 constexpr double infinity = std::numeric_limits<double>::infinity();
-constexpr long long line_search_ccd_boxes = 4000;
 
 using BoundingBox = Eigen::Matrix<double, 2, 3>;
 
@@ -43,93 +42,6 @@ std::vector<BoundingBox> boxes_of(const Eigen::MatrixX3d& points, const Eigen::M
         for (Eigen::Index e = 0; e < edges.rows(); ++e)
             boxes.push_back(box_of(points.row(edges(e, 0)).transpose(), points.row(edges(e, 1)).transpose()));
     return boxes;
-}
-
-/// κ-free m b(d) of a pair from its squared distance and mollifier (12 coordinates each), its
-/// gradient and Hessian by the chain rule: with ∇d = ∇d²/(2d), ∇²d = ∇²d²/(2d) − ∇d² ∇d²ᵀ/(4d³),
-/// g_b = b' ∇d, H_b = b'' ∇d ∇dᵀ + b' ∇²d:  ∇(m b) = m g_b + b ∇m,
-/// ∇²(m b) = m H_b + g_b ∇mᵀ + ∇m g_bᵀ + b ∇²m.
-PrimitiveFunction mollified_barrier(const PrimitiveFunction& squared, const PrimitiveFunction& mollifier,
-                                    double activation_distance, bool with_derivatives)
-{
-    const double d = std::sqrt(squared.value);
-    const BarrierValue b = barrier(d, activation_distance);
-    PrimitiveFunction result;
-    result.value = mollifier.value * b.value;
-    if (!with_derivatives)
-        return result;
-    const Vector12d distance_gradient = squared.gradient / (2.0 * d);
-    const Matrix12d distance_hessian = squared.hessian / (2.0 * d) -
-                                       squared.gradient * squared.gradient.transpose() / (4.0 * d * d * d);
-    const Vector12d barrier_gradient = b.first * distance_gradient;
-    const Matrix12d barrier_hessian =
-        b.second * distance_gradient * distance_gradient.transpose() + b.first * distance_hessian;
-    result.gradient = mollifier.value * barrier_gradient + b.value * mollifier.gradient;
-    result.hessian = mollifier.value * barrier_hessian + barrier_gradient * mollifier.gradient.transpose() +
-                     mollifier.gradient * barrier_gradient.transpose() + b.value * mollifier.hessian;
-    return result;
-}
-
-/// The squared distance of the primitives of motion at s ∈ [0, 1].
-double squared_distance_at(PrimitivePair kind, const PrimitiveMotion& motion, double s)
-{
-    const Eigen::Matrix<double, 3, 4> x = (1.0 - s) * motion.start + s * motion.end;
-    if (kind == PrimitivePair::point_triangle)
-        return point_triangle_squared_distance(x.col(0), x.col(1), x.col(2), x.col(3),
-                                               point_triangle_type(x.col(0), x.col(1), x.col(2), x.col(3)))
-            .value;
-    return edge_edge_squared_distance(x.col(0), x.col(1), x.col(2), x.col(3),
-                                      edge_edge_type(x.col(0), x.col(1), x.col(2), x.col(3)))
-        .value;
-}
-
-/// Additive conservative advancement (after Li et al. 2021): with the common part of the vertices'
-/// moves taken out (it moves neither primitive relative to the other), M = the largest move of the
-/// first primitive's vertices plus the largest of the second's bounds how fast their distance d
-/// can fall, so from s the distance stays above g for a further (d(s) − g)/M. Advanced until that
-/// step is below 10⁻³ of s (at most 100 times), with g = d(0)/10, it answers an s at which the
-/// distance is still ≥ g > 0: a lower bound of the time of impact, and one that a step can be cut
-/// to without coming nearer than a tenth of the distance it started at; +∞ when s passes 1.
-double additive_time_of_impact(PrimitivePair kind, const PrimitiveMotion& motion)
-{
-    Eigen::Matrix<double, 3, 4> change = motion.end - motion.start;
-    change.colwise() -= change.rowwise().mean();
-    const int first = kind == PrimitivePair::point_triangle ? 1 : 2;  // vertices of the first primitive
-    double first_move = 0.0, second_move = 0.0;
-    for (int i = 0; i < 4; ++i) {
-        double& move = i < first ? first_move : second_move;
-        move = std::max(move, change.col(i).norm());
-    }
-    const double bound = first_move + second_move;
-    const double gap = 0.1 * std::sqrt(squared_distance_at(kind, motion, 0.0));
-    if (bound == 0.0)
-        return infinity;
-    double s = 0.0;
-    for (int advance = 0; advance < 100; ++advance) {
-        const double step = (std::sqrt(squared_distance_at(kind, motion, s)) - gap) / bound;
-        if (step <= 0.0)
-            return s;
-        s += step;
-        if (s > 1.0)
-            return infinity;
-        if (step < 1e-3 * s)
-            break;
-    }
-    return s;
-}
-
-/// A lower bound of the first s ∈ [0, 1] at which the primitives of motion touch (+∞: never): the
-/// larger of the inclusion method's time of impact (ccd.hpp; stopped at line_search_ccd_boxes, so
-/// that edges moving in one plane cost no more than that) and additive_time_of_impact's, which
-/// keeps the answer above 0 while they are apart, where the first may answer 0 within its
-/// tolerance of a contact or at its box limit.
-double impact_time(PrimitivePair kind, const PrimitiveMotion& motion)
-{
-    const double inclusion =
-        inclusion_ccd(kind, motion, {.tolerance = 1e-6, .max_boxes = line_search_ccd_boxes}).time_of_impact;
-    if (!std::isfinite(inclusion))
-        return inclusion;
-    return std::max(inclusion, additive_time_of_impact(kind, motion));
 }
 
 }  // namespace
@@ -156,16 +68,9 @@ FeatureBarrier::FeatureBarrier(const TetMesh& mesh, const std::vector<std::share
     }
     if (obstacles_.empty())
         return;
-    triangles_ = skin::boundary_faces(mesh).faces;
-    std::map<std::pair<int, int>, int> edges;
-    for (Eigen::Index f = 0; f < triangles_.rows(); ++f)
-        for (int i = 0; i < 3; ++i) {
-            const int a = triangles_(f, i), b = triangles_(f, (i + 1) % 3);
-            edges.try_emplace({std::min(a, b), std::max(a, b)}, static_cast<int>(edges.size()));
-        }
-    edges_.resize(static_cast<Eigen::Index>(edges.size()), 2);
-    for (const auto& [edge, row] : edges)
-        edges_.row(row) << edge.first, edge.second;
+    SurfacePrimitives surface = surface_primitives(mesh);
+    triangles_ = std::move(surface.triangles);
+    edges_ = std::move(surface.edges);
 }
 
 template <class Visit>
@@ -229,9 +134,8 @@ bool FeatureBarrier::for_each_pair(const Eigen::VectorXd& u, double time, double
                     continue;
                 if (!(squared.value > 0.0))
                     return false;
-                PrimitiveFunction one;  // the mollifier of a point–triangle pair: 1
-                one.value = 1.0;
-                const PrimitiveFunction f = mollified_barrier(squared, one, activation_distance_, with_derivatives);
+                const PrimitiveFunction f =
+                    mollified_barrier(squared, unit_mollifier(), activation_distance_, with_derivatives);
                 Pair pair;
                 pair.obstacle = o;
                 pair.count = 3;
@@ -336,7 +240,7 @@ double FeatureBarrier::earliest_impact(const MatrixX3d& x0, const MatrixX3d& x1,
                     const Eigen::Vector3d b0 = corner(features.edges(k, 0)), b1 = corner(features.edges(k, 1));
                     motion.start << start(i), start(j), b0, b1;
                     motion.end << end(i), end(j), b0, b1;
-                    earliest = std::min(earliest, impact_time(PrimitivePair::edge_edge, motion));
+                    earliest = std::min(earliest, line_search_time_of_impact(PrimitivePair::edge_edge, motion));
                 }
             }
         for (Eigen::Index t = 0; t < triangles_.rows(); ++t) {
@@ -349,7 +253,7 @@ double FeatureBarrier::earliest_impact(const MatrixX3d& x0, const MatrixX3d& x1,
                 const Eigen::Vector3d p = corner(k);
                 motion.start << p, start(a), start(b), start(c);
                 motion.end << p, end(a), end(b), end(c);
-                earliest = std::min(earliest, impact_time(PrimitivePair::point_triangle, motion));
+                earliest = std::min(earliest, line_search_time_of_impact(PrimitivePair::point_triangle, motion));
             }
         }
     }

@@ -1,0 +1,79 @@
+#pragma once
+// Chapter 14: bodies against bodies and a body against itself — IPC's barrier (Li et al. 2020)
+// between the surface primitives of one tet mesh: every surface vertex against every surface
+// triangle and every surface edge against every other, both sides unknowns. Several bodies in one
+// solve are one mesh with several connected components (their elasticity is block diagonal; this
+// barrier couples them), so the same pairs hold two bodies apart and a body off itself.
+// docs/14_contact.md#bodies-against-bodies-and-self-contact
+//
+// For a pair k whose primitives share no vertex and whose distance d_k (distances.hpp) is below d̂:
+//
+//   P_self(u) = Σ_k κ m_k b(d_k)
+//
+// with b the barrier of barrier.hpp and m_k the edge–edge mollifier (1 for a point–triangle pair;
+// its threshold from the rest positions). A pair that shares a vertex is left out: its distance is
+// 0 at rest (a triangle holds its own corners, two edges of one triangle meet). The pairs within d̂
+// are found by the broad phase (broad_phase.hpp, chapter 13's tree); the time of impact of a motion
+// by the tree over swept boxes and line_search_time_of_impact (pair_barrier.hpp) per candidate.
+
+#include "14_contact/broad_phase.hpp"
+#include "14_contact/distances.hpp"
+
+#include "common/mesh.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/Sparse>
+
+#include <vector>
+
+namespace fem::contact {
+
+/// The barrier of the header between the surface primitives of one mesh.
+class SelfContactBarrier {
+public:
+    /// The surface primitives of mesh (surface_primitives); d̂ > 0 [m]. fem::Error for d̂ not a
+    /// finite number > 0.
+    SelfContactBarrier(const TetMesh& mesh, double activation_distance);
+
+    /// The primitives it pairs.
+    const SurfacePrimitives& surface() const { return surface_; }
+
+    /// Σ_k κ m_k b(d_k) over the pairs within d̂ at u (3n) with κ = stiffness [N/m] [J]; +∞ when a pair
+    /// touches or crosses (d_k = 0). fem::Error for u of a size other than 3n.
+    double energy(const Eigen::VectorXd& u, double stiffness) const;
+    /// Adds its gradient (3n), κ ∇(m_k b(d_k)) scattered to each pair's 4 vertices, to gradient.
+    /// fem::Error where a pair touches (d = 0) or on sizes.
+    void add_gradient(const Eigen::VectorXd& u, double stiffness, Eigen::VectorXd& gradient) const;
+    /// Appends its Hessian's entries to triplets (3n×3n): each pair's 12×12 block κ ∇²(m_k b(d_k))
+    /// projected to PSD on its own (chapter 12's project_to_psd, clamp), so the sum is PSD.
+    /// fem::Error where a pair touches (d = 0) or on u's size.
+    void add_hessian(const Eigen::VectorXd& u, double stiffness, std::vector<Eigen::Triplet<double>>& triplets) const;
+    /// The smallest distance of any pair within reach [m] at u (3n): +∞ when none is, 0 when a pair touches.
+    double smallest_distance(const Eigen::VectorXd& u, double reach) const;
+    /// The earliest time of impact s ∈ [0, 1] of any pair when the surface moves from u to u + du (3n
+    /// each), x + s du: the candidates of tree_candidates over the motion (no inflation), each pair's
+    /// line_search_time_of_impact (a lower bound of its first contact); +∞ when none meets.
+    /// fem::Error on sizes.
+    double time_of_impact(const Eigen::VectorXd& u, const Eigen::VectorXd& du) const;
+
+private:
+    /// One pair within reach: its 4 mesh vertices (p, a, b, c or ea0, ea1, eb0, eb1), its distance,
+    /// and κ-free m b(d) with gradient and Hessian in their 12 coordinates.
+    struct Pair {
+        int vertices[4] = {0, 0, 0, 0};
+        double distance = 0.0;
+        PrimitiveFunction barrier;
+    };
+    /// Calls visit(pair) for every pair within reach at u; with_derivatives: with the barrier's
+    /// gradient and Hessian. Returns false (stopping) at a pair with d = 0.
+    template <class Visit>
+    bool for_each_pair(const Eigen::VectorXd& u, double reach, bool with_derivatives, Visit visit) const;
+    /// x (#V×3) moved by u (3n, vertex-major); fem::Error naming what when u's size is not 3n.
+    MatrixX3d moved(const MatrixX3d& x, const Eigen::VectorXd& u, const char* what) const;
+
+    MatrixX3d rest_;
+    double activation_distance_;
+    SurfacePrimitives surface_;
+};
+
+}  // namespace fem::contact

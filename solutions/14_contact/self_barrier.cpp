@@ -1,0 +1,152 @@
+// Chapter 14: the barrier between the surface primitives of one mesh (bodies against bodies and
+// a body against itself). docs/14_contact.md#bodies-against-bodies-and-self-contact
+#include "14_contact/self_barrier.hpp"
+
+#include "14_contact/ccd.hpp"
+#include "14_contact/distances.hpp"
+#include "14_contact/pair_barrier.hpp"
+
+#include "12_hyperelastic_newton/materials.hpp"
+
+#include "common/error.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace fem::contact {
+namespace {
+
+constexpr double infinity = std::numeric_limits<double>::infinity();
+
+}  // namespace
+
+SelfContactBarrier::SelfContactBarrier(const TetMesh& mesh, double activation_distance)
+    : rest_(mesh.V), activation_distance_(activation_distance), surface_(surface_primitives(mesh))
+{
+    require_positive(activation_distance, "self-contact activation distance d̂ [m]");
+}
+
+MatrixX3d SelfContactBarrier::moved(const MatrixX3d& x, const Eigen::VectorXd& u, const char* what) const
+{
+    if (u.size() != 3 * x.rows())
+        throw Error(str("self-contact: ", what, " needs 3n = ", 3 * x.rows(), " entries, got ", u.size()));
+    MatrixX3d moved = x;
+    for (Eigen::Index v = 0; v < x.rows(); ++v)
+        moved.row(v) += u.segment<3>(3 * v).transpose();
+    return moved;
+}
+
+template <class Visit>
+bool SelfContactBarrier::for_each_pair(const Eigen::VectorXd& u, double reach, bool with_derivatives,
+                                       Visit visit) const
+{
+    const MatrixX3d x = moved(rest_, u, "the displacement u");
+    const auto at = [&](int v) -> Eigen::Vector3d { return x.row(v).transpose(); };
+    const auto rest = [&](int v) -> Eigen::Vector3d { return rest_.row(v).transpose(); };
+    const CandidatePairs candidates = tree_candidates(surface_, x, x, reach);
+    Pair pair;
+    const auto offer = [&](const PrimitiveFunction& squared, const PrimitiveFunction& mollifier) {
+        if (!(squared.value < reach * reach))
+            return true;
+        if (!(squared.value > 0.0))
+            return false;
+        pair.distance = std::sqrt(squared.value);
+        pair.barrier = mollified_barrier(squared, mollifier, activation_distance_, with_derivatives);
+        visit(pair);
+        return true;
+    };
+    for (const auto& [vertex, triangle] : candidates.point_triangle) {
+        pair.vertices[0] = vertex;
+        for (int c = 0; c < 3; ++c)
+            pair.vertices[c + 1] = surface_.triangles(triangle, c);
+        const Eigen::Vector3d p = at(vertex), a = at(pair.vertices[1]), b = at(pair.vertices[2]),
+                              c = at(pair.vertices[3]);
+        if (!offer(point_triangle_squared_distance(p, a, b, c, point_triangle_type(p, a, b, c)), unit_mollifier()))
+            return false;
+    }
+    for (const auto& [first, second] : candidates.edge_edge) {
+        const int v[4] = {surface_.edges(first, 0), surface_.edges(first, 1), surface_.edges(second, 0),
+                          surface_.edges(second, 1)};
+        std::copy(v, v + 4, pair.vertices);
+        const Eigen::Vector3d a0 = at(v[0]), a1 = at(v[1]), b0 = at(v[2]), b1 = at(v[3]);
+        const PrimitiveFunction squared = edge_edge_squared_distance(a0, a1, b0, b1, edge_edge_type(a0, a1, b0, b1));
+        if (!(squared.value < reach * reach))
+            continue;  // the mollifier only for the pairs within reach
+        const double threshold = edge_edge_mollifier_threshold(rest(v[0]), rest(v[1]), rest(v[2]), rest(v[3]));
+        if (!offer(squared, edge_edge_mollifier(a0, a1, b0, b1, threshold)))
+            return false;
+    }
+    return true;
+}
+
+double SelfContactBarrier::energy(const Eigen::VectorXd& u, double stiffness) const
+{
+    double total = 0.0;
+    if (!for_each_pair(u, activation_distance_, false, [&](const Pair& pair) { total += pair.barrier.value; }))
+        return infinity;
+    return stiffness * total;
+}
+
+void SelfContactBarrier::add_gradient(const Eigen::VectorXd& u, double stiffness, Eigen::VectorXd& gradient) const
+{
+    if (gradient.size() != u.size())
+        throw Error(str("self-contact: the gradient needs ", u.size(), " entries, got ", gradient.size()));
+    const bool apart = for_each_pair(u, activation_distance_, true, [&](const Pair& pair) {
+        for (int k = 0; k < 4; ++k)
+            gradient.segment<3>(3 * pair.vertices[k]) += stiffness * pair.barrier.gradient.segment<3>(3 * k);
+    });
+    if (!apart)
+        throw Error("self-contact: the gradient of the barrier was asked where two surface primitives touch (d = 0)");
+}
+
+void SelfContactBarrier::add_hessian(const Eigen::VectorXd& u, double stiffness,
+                                     std::vector<Eigen::Triplet<double>>& triplets) const
+{
+    const bool apart = for_each_pair(u, activation_distance_, true, [&](const Pair& pair) {
+        // Each pair's block is made PSD on its own (a sum of PSD blocks is PSD).
+        const Matrix12d block = stiffness * hyper::project_to_psd<12>(pair.barrier.hessian, hyper::Projection::clamp);
+        for (int a = 0; a < 4; ++a)
+            for (int b = 0; b < 4; ++b)
+                for (int i = 0; i < 3; ++i)
+                    for (int j = 0; j < 3; ++j)
+                        triplets.emplace_back(3 * pair.vertices[a] + i, 3 * pair.vertices[b] + j,
+                                              block(3 * a + i, 3 * b + j));
+    });
+    if (!apart)
+        throw Error("self-contact: the Hessian of the barrier was asked where two surface primitives touch (d = 0)");
+}
+
+double SelfContactBarrier::smallest_distance(const Eigen::VectorXd& u, double reach) const
+{
+    double smallest = infinity;
+    if (!for_each_pair(u, reach, false, [&](const Pair& pair) { smallest = std::min(smallest, pair.distance); }))
+        return 0.0;
+    return smallest;
+}
+
+double SelfContactBarrier::time_of_impact(const Eigen::VectorXd& u, const Eigen::VectorXd& du) const
+{
+    const MatrixX3d x0 = moved(rest_, u, "the displacement u");
+    const MatrixX3d x1 = moved(x0, du, "the step du");
+    const CandidatePairs candidates = tree_candidates(surface_, x0, x1, 0.0);
+    double earliest = infinity;
+    PrimitiveMotion motion;
+    const auto add = [&](PrimitivePair kind, const int (&v)[4]) {
+        for (int k = 0; k < 4; ++k) {
+            motion.start.col(k) = x0.row(v[k]).transpose();
+            motion.end.col(k) = x1.row(v[k]).transpose();
+        }
+        earliest = std::min(earliest, line_search_time_of_impact(kind, motion));
+    };
+    for (const auto& [vertex, triangle] : candidates.point_triangle) {
+        const auto corners = surface_.triangles.row(triangle);
+        add(PrimitivePair::point_triangle, {vertex, corners(0), corners(1), corners(2)});
+    }
+    for (const auto& [first, second] : candidates.edge_edge)
+        add(PrimitivePair::edge_edge, {surface_.edges(first, 0), surface_.edges(first, 1), surface_.edges(second, 0),
+                                       surface_.edges(second, 1)});
+    return earliest;
+}
+
+}  // namespace fem::contact

@@ -1,0 +1,400 @@
+// Chapter 14: bodies against bodies and a body against itself (self_barrier.hpp, broad_phase.hpp):
+// the barrier's derivatives against central differences, the three broad phases against each other
+// and against every pair's distance, two blocks thrown at each other (momentum, symmetry, no edge
+// through a face, and they part), and two bars crossed at right angles, which only their edges hold
+// apart. docs/14_contact.md#bodies-against-bodies-and-self-contact
+#include "14_contact/broad_phase.hpp"
+#include "14_contact/contact.hpp"
+#include "14_contact/distances.hpp"
+#include "14_contact/self_barrier.hpp"
+
+#include "12_hyperelastic_newton/force_models.hpp"
+#include "12_hyperelastic_newton/newton.hpp"
+
+#include "10_linear_dynamics/body.hpp"
+#include "10_linear_dynamics/time_integration.hpp"
+
+#include "common/error.hpp"
+#include "common/mesh.hpp"
+#include "common/random.hpp"
+#include "common/test_support.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <vector>
+
+using namespace fem;
+using namespace fem::contact;
+
+namespace {
+
+/// One mesh of two components: a's vertices first, then b's (b's tets renumbered).
+TetMesh two_bodies(const TetMesh& a, const TetMesh& b)
+{
+    TetMesh both;
+    both.V.resize(a.V.rows() + b.V.rows(), 3);
+    both.V << a.V, b.V;
+    both.T.resize(a.T.rows() + b.T.rows(), 4);
+    both.T << a.T, (b.T.array() + static_cast<int>(a.V.rows())).matrix();
+    return both;
+}
+
+/// A one-cell box of the given size with its lowest corner at corner.
+TetMesh box_at(const Eigen::Vector3d& corner, const Eigen::Vector3d& size, int cells = 1)
+{
+    TetMesh box = box_mesh(cells, cells, cells, size);
+    box.V.rowwise() += corner.transpose();
+    return box;
+}
+
+/// The barrier with a fixed κ as a potential (energy, gradient) for test::central_differences.
+struct SelfPotential {
+    const SelfContactBarrier& barrier;
+    double stiffness;
+    double energy(const Eigen::VectorXd& u) const { return barrier.energy(u, stiffness); }
+    Eigen::VectorXd gradient(const Eigen::VectorXd& u) const
+    {
+        Eigen::VectorXd g = Eigen::VectorXd::Zero(u.size());
+        barrier.add_gradient(u, stiffness, g);
+        return g;
+    }
+};
+
+/// 6 × the signed volume of (a, b, c, d) in long double: > 0 when d is on the side of (a, b, c) its
+/// normal (b − a) × (c − a) points to.
+long double orient(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, const Eigen::Vector3d& d)
+{
+    const auto ld = [](const Eigen::Vector3d& x) { return Eigen::Matrix<long double, 3, 1>(x.cast<long double>()); };
+    return (ld(b) - ld(a)).cross(ld(c) - ld(a)).dot(ld(d) - ld(a));
+}
+
+/// Whether segment (p, q) meets triangle (a, b, c), touching included: p and q not strictly on one
+/// side of the plane, and the segment's line not strictly outside any of the triangle's edges (the
+/// three volumes of (p, q) with each edge of one sign or zero). Degenerate, coplanar cases count as
+/// meeting (conservative: a test that says "apart" means apart).
+bool segment_meets_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eigen::Vector3d& a,
+                            const Eigen::Vector3d& b, const Eigen::Vector3d& c)
+{
+    const long double sp = orient(a, b, c, p), sq = orient(a, b, c, q);
+    if ((sp > 0 && sq > 0) || (sp < 0 && sq < 0))
+        return false;
+    const long double e0 = orient(p, q, a, b), e1 = orient(p, q, b, c), e2 = orient(p, q, c, a);
+    return !((e0 > 0 || e1 > 0 || e2 > 0) && (e0 < 0 || e1 < 0 || e2 < 0));
+}
+
+/// The first surface edge that meets a surface triangle it shares no vertex with, at positions x,
+/// as "edge (i, j) meets triangle (a, b, c)"; empty when none does.
+std::string edge_through_triangle(const SurfacePrimitives& surface, const MatrixX3d& x)
+{
+    for (Eigen::Index e = 0; e < surface.edges.rows(); ++e)
+        for (Eigen::Index t = 0; t < surface.triangles.rows(); ++t) {
+            const auto tri = surface.triangles.row(t);
+            const int i = surface.edges(e, 0), j = surface.edges(e, 1);
+            if ((tri.array() == i).any() || (tri.array() == j).any())
+                continue;
+            if (segment_meets_triangle(x.row(i).transpose(), x.row(j).transpose(), x.row(tri(0)).transpose(),
+                                       x.row(tri(1)).transpose(), x.row(tri(2)).transpose()))
+                return str("edge (", i, ", ", j, ") meets triangle (", tri(0), ", ", tri(1), ", ", tri(2), ")");
+        }
+    return {};
+}
+
+/// Two bodies, one mesh (two_bodies: the first `half` vertices the first body), without gravity, thrown
+/// at each other at ±speed along axis, stepped by chapter 12's Newton backward Euler with
+/// self-contact as its potential (contact_step).
+struct Bodies {
+    std::unique_ptr<dynamics::Body> body;
+    std::unique_ptr<ContactPotential> contact;
+    std::unique_ptr<hyper::NewtonBackwardEuler> newton;
+    dynamics::State state;
+    SurfacePrimitives surface;
+    double time_step = 1.0 / 400.0;
+
+    Bodies(const TetMesh& mesh, Eigen::Index half, int axis, double speed) : surface(surface_primitives(mesh))
+    {
+        dynamics::Scene scene;
+        scene.mesh = mesh;
+        scene.material = {1e5, 0.3, 1000.0};
+        scene.gravity.setZero();
+        scene.time_step = time_step;
+        body = std::make_unique<dynamics::Body>(scene, hyper::make_force_model("stable-neo-hookean", mesh, scene.material));
+        ContactOptions options;
+        options.self_contact = true;
+        contact = std::make_unique<ContactPotential>(*body, std::vector<std::shared_ptr<const Obstacle>>{}, options);
+        hyper::NewtonOptions newton_options;
+        newton_options.relative_tolerance = 1e-9;
+        newton_options.max_iterations = 200;
+        newton = std::make_unique<hyper::NewtonBackwardEuler>(newton_options);
+        newton->set_potential(contact.get());
+        Eigen::VectorXd velocity = Eigen::VectorXd::Zero(3 * mesh.V.rows());
+        for (Eigen::Index v = 0; v < mesh.V.rows(); ++v)
+            velocity[3 * v + axis] = v < half ? speed : -speed;
+        state = dynamics::initial_state(*body, {}, velocity);
+    }
+    /// One step; requires that no surface pair touches and no surface edge meets a surface triangle
+    /// after it, and returns the smallest distance of a pair within d̂ (+∞: none).
+    double step()
+    {
+        contact_step(*newton, *contact, *body, time_step, state);
+        INFO("step " << state.step);
+        const double distance = contact->smallest_distance(state.u);
+        REQUIRE(distance > 0.0);
+        REQUIRE(edge_through_triangle(surface, body->positions(state.u)).empty());
+        return distance;
+    }
+};
+
+/// Σ m_v v_v over vertices first … first + count − 1 (3) [kg m/s].
+Eigen::Vector3d momentum(const dynamics::Body& body, const Eigen::VectorXd& v, Eigen::Index first, Eigen::Index count)
+{
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    for (Eigen::Index i = first; i < first + count; ++i)
+        p += body.dof_masses()[3 * i] * v.segment<3>(3 * i);
+    return p;
+}
+
+}  // namespace
+
+TEST_CASE("self-contact barrier: energy, gradient and Hessian against central differences, PSD", "[self][ex14.7]")
+{
+    // Two one-cell cubes face to face 0.4 mm apart, the second turned 0.3 rad about x (the faces'
+    // normal) and shifted, so that vertices stand over the other's face and edges cross at angles:
+    // point–triangle and edge–edge pairs within d̂ = 1 mm.
+    const TetMesh first = box_at(Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(0.1));
+    TetMesh second = box_at(Eigen::Vector3d(-0.05, -0.05, -0.05), Eigen::Vector3d::Constant(0.1));
+    const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()).toRotationMatrix();
+    second.V = (second.V * turn.transpose()).rowwise() + Eigen::RowVector3d(0.1504, 0.07, 0.04);
+    const TetMesh mesh = two_bodies(first, second);
+    const SelfContactBarrier barrier(mesh, 1e-3);
+    const SelfPotential potential{barrier, 50.0};
+    const Eigen::Index n = 3 * mesh.V.rows();
+    for (unsigned seed : {1u, 2u, 3u}) {
+        const Eigen::VectorXd u = 5e-5 * random_vector(n, seed);
+        const double energy = potential.energy(u);
+        REQUIRE(std::isfinite(energy));
+        REQUIRE(energy > 0.0);
+        const Eigen::VectorXd g = potential.gradient(u);
+        std::vector<Eigen::Triplet<double>> triplets;
+        barrier.add_hessian(u, potential.stiffness, triplets);
+        Eigen::SparseMatrix<double> sparse(n, n);
+        sparse.setFromTriplets(triplets.begin(), triplets.end());
+        const Eigen::MatrixXd H(sparse);
+        const test::CentralDifferences differences = test::central_differences(potential, u, 1e-8);
+        INFO("seed " << seed << ", energy " << energy << ", |g| " << g.norm() << ", |g - g_fd| "
+                     << (g - differences.gradient).norm());
+        CHECK((g - differences.gradient).norm() <= 1e-5 * g.norm());
+        // Both bodies feel the pair: the forces on the two sum to zero (translation invariance).
+        Eigen::Vector3d total = Eigen::Vector3d::Zero();
+        for (Eigen::Index v = 0; v < mesh.V.rows(); ++v)
+            total += g.segment<3>(3 * v);
+        CHECK(total.norm() <= 1e-10 * g.norm());
+        // PSD, and H − H_exact is PSD (the projections only add).
+        const Eigen::MatrixXd symmetric = 0.5 * (differences.hessian + differences.hessian.transpose());
+        INFO("|H| " << H.norm() << ", |H_fd| " << symmetric.norm());
+        CHECK(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(H).eigenvalues().minCoeff() >= -1e-8 * H.norm());
+        CHECK(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(H - symmetric).eigenvalues().minCoeff() >=
+              -1e-4 * H.norm());
+    }
+    // A body alone at rest: its primitives that share a vertex (d = 0) are not pairs.
+    const SelfContactBarrier alone(box_mesh(2, 2, 2, Eigen::Vector3d::Constant(0.1)), 1e-3);
+    const Eigen::VectorXd rest = Eigen::VectorXd::Zero(3 * 27);
+    CHECK(alone.energy(rest, 50.0) == 0.0);
+    CHECK(alone.smallest_distance(rest, 0.2) > 0.0);
+    CHECK_THROWS_AS(SelfContactBarrier(first, 0.0), Error);
+    CHECK_THROWS_AS(alone.energy(Eigen::VectorXd::Zero(5), 1.0), Error);
+}
+
+TEST_CASE("broad phase: brute force, the AABB tree and the spatial hash find the same pairs, every pair within r",
+          "[self][ex14.7]")
+{
+    const TetMesh block = box_mesh(3, 2, 2, Eigen::Vector3d(0.3, 0.2, 0.2));
+    const TetMesh pair_of_blocks = two_bodies(box_at(Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(0.1), 2),
+                                              box_at(Eigen::Vector3d(0.11, 0.02, 0.03), Eigen::Vector3d::Constant(0.1), 2));
+    std::size_t compared = 0;
+    for (const TetMesh* mesh : {&block, &pair_of_blocks}) {
+        const SurfacePrimitives surface = surface_primitives(*mesh);
+        for (unsigned seed = 1; seed <= 4; ++seed)
+            for (double inflation : {0.0, 1e-3, 0.03}) {
+                const Eigen::Index n = mesh->V.rows();
+                const MatrixX3d start = mesh->V + 0.03 * random_matrix(n, 3, seed);
+                const MatrixX3d end = start + 0.05 * random_matrix(n, 3, 100 + seed);
+                const CandidatePairs brute = brute_force_candidates(surface, start, end, inflation);
+                INFO("seed " << seed << ", r = " << inflation << ": " << brute.point_triangle.size()
+                             << " point-triangle, " << brute.edge_edge.size() << " edge-edge");
+                CHECK(tree_candidates(surface, start, end, inflation) == brute);
+                CHECK(hash_candidates(surface, start, end, inflation) == brute);
+                compared += brute.point_triangle.size() + brute.edge_edge.size();
+                // Held still (start = end), every pair that shares no vertex and is within r is a
+                // candidate, and no candidate shares a vertex.
+                const CandidatePairs still = hash_candidates(surface, start, start, inflation);
+                const auto has = [](const auto& list, int i, int j) {
+                    return std::binary_search(list.begin(), list.end(), std::array<int, 2>{i, j});
+                };
+                const auto at = [&](int v) -> Eigen::Vector3d { return start.row(v).transpose(); };
+                for (int v : surface.vertices)
+                    for (int t = 0; t < static_cast<int>(surface.triangles.rows()); ++t) {
+                        const auto tri = surface.triangles.row(t);
+                        const bool shared = (tri.array() == v).any();
+                        CHECK_FALSE((shared && has(still.point_triangle, v, t)));
+                        if (shared)
+                            continue;
+                        const Eigen::Vector3d p = at(v), a = at(tri(0)), b = at(tri(1)), c = at(tri(2));
+                        const double d2 = point_triangle_squared_distance(p, a, b, c, point_triangle_type(p, a, b, c)).value;
+                        if (d2 < inflation * inflation)
+                            CHECK(has(still.point_triangle, v, t));
+                    }
+                for (int a = 0; a < static_cast<int>(surface.edges.rows()); ++a)
+                    for (int b = a + 1; b < static_cast<int>(surface.edges.rows()); ++b) {
+                        const auto ea = surface.edges.row(a), eb = surface.edges.row(b);
+                        const bool shared = ea(0) == eb(0) || ea(0) == eb(1) || ea(1) == eb(0) || ea(1) == eb(1);
+                        CHECK_FALSE((shared && has(still.edge_edge, a, b)));
+                        if (shared)
+                            continue;
+                        const Eigen::Vector3d a0 = at(ea(0)), a1 = at(ea(1)), b0 = at(eb(0)), b1 = at(eb(1));
+                        const double d2 = edge_edge_squared_distance(a0, a1, b0, b1, edge_edge_type(a0, a1, b0, b1)).value;
+                        if (d2 < inflation * inflation)
+                            CHECK(has(still.edge_edge, a, b));
+                    }
+            }
+    }
+    CHECK(compared > 1000);  // the cases hold pairs to compare
+    const SurfacePrimitives surface = surface_primitives(block);
+    CHECK_THROWS_AS(tree_candidates(surface, block.V, block.V, -1.0), Error);
+    CHECK_THROWS_AS(hash_candidates(surface, block.V, block.V.topRows(3), 0.0), Error);
+}
+
+TEST_CASE("two blocks thrown at each other: momentum kept, the motion point-symmetric, no edge through a face, "
+          "and they part", "[self][ex14.7]")
+{
+    // Block one: 2×2×2 cells of 10 cm at the origin, moving +x at 0.5 m/s. Block two: block one
+    // reflected through the point c (x → 2c − x, tets turned back to positive volume), 2 mm away and
+    // shifted 3 cm in y, 2 cm in z, so that they meet off centre (and spin); it moves at −0.5 m/s.
+    // The scene is symmetric under x → 2c − x with v → −v, and so must the motion be.
+    const TetMesh one = box_at(Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(0.1), 2);
+    const Eigen::RowVector3d centre(0.101, 0.065, 0.06);
+    TetMesh two = one;
+    two.V = (-one.V).rowwise() + 2.0 * centre;
+    two.T.col(2).swap(two.T.col(3));
+    const TetMesh mesh = two_bodies(one, two);
+    const Eigen::Index half = one.V.rows(), n = mesh.V.rows();
+    Bodies bodies(mesh, half, 0, 0.5);
+    double scale = 0.0;  // Σ m |v|: the size of the momenta that cancel
+    for (Eigen::Index v = 0; v < n; ++v)
+        scale += bodies.body->dof_masses()[3 * v] * 0.5;
+    double worst_momentum = 0.0, worst_symmetry = 0.0, smallest = 1.0;
+    for (int step = 0; step < 40; ++step) {
+        smallest = std::min(smallest, bodies.step());
+        const MatrixX3d x = bodies.body->positions(bodies.state.u);
+        worst_momentum = std::max(worst_momentum, momentum(*bodies.body, bodies.state.v, 0, n).norm() / scale);
+        const MatrixX3d mirrored = (-x.bottomRows(half)).rowwise() + 2.0 * centre;
+        worst_symmetry = std::max(worst_symmetry, (x.topRows(half) - mirrored).cwiseAbs().maxCoeff());
+    }
+    const Eigen::Vector3d first = momentum(*bodies.body, bodies.state.v, 0, half);
+    INFO("smallest distance " << smallest << " m, worst relative momentum " << worst_momentum
+                              << ", worst asymmetry " << worst_symmetry << " m, block one's momentum at the end "
+                              << first.transpose());
+    CHECK(smallest < 1e-3);           // they met, within d̂
+    CHECK(worst_momentum <= 1e-9);    // Σ m v = 0 throughout
+    CHECK(worst_symmetry <= 1e-9);    // x_one = 2c − x_two throughout (0.1 m blocks)
+    CHECK(first.x() < 0.0);           // block one now moves back, away from block two
+    CHECK(bodies.contact->smallest_distance(bodies.state.u) >= 1e-3);  // and they parted: no pair within d̂
+}
+
+TEST_CASE("two bars crossed at right angles, pushed together: only their edges meet, and hold", "[self][ex14.7]")
+{
+    // Bar one along x (30 × 10 × 5 cm, one cell: vertices only at its ends), bar two along y above it,
+    // 2 mm higher; where they cross, no vertex of either stands over the other's faces: the contact
+    // is edge against edge, which a vertex-only barrier would let through.
+    const double gap = 2e-3;
+    const TetMesh one = box_at(Eigen::Vector3d(0.0, 0.1, 0.0), Eigen::Vector3d(0.3, 0.1, 0.05));
+    const TetMesh two = box_at(Eigen::Vector3d(0.1, 0.0, 0.05 + gap), Eigen::Vector3d(0.1, 0.3, 0.05));
+    const TetMesh mesh = two_bodies(one, two);
+    const Eigen::Index half = one.V.rows();
+    Bodies bodies(mesh, half, 2, 0.5);
+    const SurfacePrimitives& surface = bodies.surface;
+    // The vertices' distance to the other bar's surface triangles (what a vertex-only barrier sees).
+    const auto vertex_distance = [&](const MatrixX3d& x) {
+        double nearest = 1.0;
+        for (int v : surface.vertices)
+            for (Eigen::Index t = 0; t < surface.triangles.rows(); ++t) {
+                const auto tri = surface.triangles.row(t);
+                if ((v < half) == (tri(0) < half))
+                    continue;  // the same bar
+                const Eigen::Vector3d p = x.row(v).transpose(), a = x.row(tri(0)).transpose(),
+                                      b = x.row(tri(1)).transpose(), c = x.row(tri(2)).transpose();
+                nearest = std::min(nearest, std::sqrt(point_triangle_squared_distance(
+                                                          p, a, b, c, point_triangle_type(p, a, b, c)).value));
+            }
+        return nearest;
+    };
+    double smallest = 1.0, vertices_at_smallest = 0.0;
+    for (int step = 0; step < 40; ++step) {
+        const double distance = bodies.step();
+        if (distance < smallest) {
+            smallest = distance;
+            vertices_at_smallest = vertex_distance(bodies.body->positions(bodies.state.u));
+        }
+    }
+    INFO("smallest distance " << smallest << " m; then the nearest vertex was " << vertices_at_smallest
+                              << " m from the other bar");
+    CHECK(smallest < 1e-3);                 // they met within d̂ …
+    CHECK(vertices_at_smallest > 1e-2);     // … where no vertex was near the other bar
+    const Eigen::Vector3d lower = momentum(*bodies.body, bodies.state.v, 0, half);
+    CHECK(lower.z() < 0.0);                 // the lower bar moves down again: they bounced
+}
+
+TEST_CASE("self-contact's refusals: no obstacle without it, and primitives closer than d-hat at rest", "[self][ex14.7]")
+{
+    dynamics::Scene scene;
+    scene.mesh = box_mesh(2, 2, 2, Eigen::Vector3d::Constant(0.1));  // cells of 5 cm
+    const dynamics::Body body(scene);
+    const std::vector<std::shared_ptr<const Obstacle>> none;
+    CHECK_THROWS_AS(ContactPotential(body, none, ContactOptions{}), Error);
+    ContactOptions options;
+    options.self_contact = true;
+    CHECK_NOTHROW(ContactPotential(body, none, options));
+    // d̂ = 6 cm reaches from a surface vertex to the triangles of the neighbouring cell's far side.
+    options.activation_distance = 0.06;
+    CHECK_THROWS_WITH(ContactPotential(body, none, options), Catch::Contains("closer than d̂"));
+}
+
+TEST_CASE("self-contact's time of impact: never after the first contact, never far before it", "[self][ex14.7]")
+{
+    // Two cubes 1 cm apart closing by 4 cm (first contact at s = 1/4, face on face: point–triangle
+    // pairs), and two crossed one-cell bars 2 mm apart closing by 4 mm (first contact at s = 1/2,
+    // where only edges meet: edge–edge pairs). Moving apart instead, no impact.
+    struct Case {
+        const char* name;
+        TetMesh mesh;
+        Eigen::Index half;
+        int axis;
+        double closing, first_contact;
+    };
+    const TetMesh cube = box_at(Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(0.1));
+    const TetMesh bar_one = box_at(Eigen::Vector3d(0.0, 0.1, 0.0), Eigen::Vector3d(0.3, 0.1, 0.05));
+    const std::vector<Case> cases{
+        {"cubes", two_bodies(cube, box_at(Eigen::Vector3d(0.11, 0.03, 0.02), Eigen::Vector3d::Constant(0.1))),
+         cube.V.rows(), 0, 0.04, 0.25},
+        {"crossed bars",
+         two_bodies(bar_one, box_at(Eigen::Vector3d(0.1, 0.0, 0.052), Eigen::Vector3d(0.1, 0.3, 0.05))),
+         bar_one.V.rows(), 2, 0.004, 0.5}};
+    for (const Case& c : cases) {
+        const SelfContactBarrier barrier(c.mesh, 1e-3);
+        const Eigen::Index n = c.mesh.V.rows();
+        Eigen::VectorXd du = Eigen::VectorXd::Zero(3 * n);
+        for (Eigen::Index v = 0; v < n; ++v)
+            du[3 * v + c.axis] = (v < c.half ? 0.5 : -0.5) * c.closing;
+        const Eigen::VectorXd u = Eigen::VectorXd::Zero(3 * n);
+        const double s = barrier.time_of_impact(u, du);
+        INFO(c.name << ": time of impact " << s << ", first contact at " << c.first_contact);
+        CHECK(s <= c.first_contact);
+        CHECK(s >= 0.9 * c.first_contact);
+        CHECK(barrier.time_of_impact(u, -du) > 1.0);
+    }
+}
