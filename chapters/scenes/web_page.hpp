@@ -71,7 +71,9 @@ void check_web_page_library();
 /// Collects a run's frames and writes its page (docs/scenes.md#the-web-page). Each frame keeps the
 /// surface of the merged frame (the boundary triangles of every body's tets, chapter 13's
 /// boundary_faces of the first frame) at X + warp·u, the colour field on it (a cell field per
-/// triangle, its tet's value; a point field per vertex; a vector's magnitude) and the caption.
+/// triangle, its tet's value; a point field per vertex; a vector's magnitude) and the caption. With
+/// the motion drawn exaggerated (warp ≠ 1) the page also draws the rest surface, faint grey, as the
+/// PNG frames do.
 class WebPage {
 public:
     explicit WebPage(const SceneSpec& scene);
@@ -92,6 +94,7 @@ private:
     MatrixX3i triangles_;                 // into surface_points_
     std::vector<int> triangle_cells_;     // the tet of each triangle (for a cell field)
     bool cell_field_ = false;
+    MatrixX3d rest_;                      // surface vertices at X (drawn faint grey when warp ≠ 1)
     std::vector<MatrixX3d> positions_;    // per frame: surface vertices at X + warp·u
     std::vector<Eigen::VectorXd> values_; // per frame: the field per triangle or surface vertex
     std::vector<double> times_;

@@ -273,6 +273,9 @@ void WebPage::add_frame(const io::MeshData& frame, double time, const std::strin
                 triangles_(f, c) = i;
             }
         triangle_cells_ = boundary.tet;
+        rest_.resize(static_cast<Eigen::Index>(surface_points_.size()), 3);
+        for (std::size_t i = 0; i < surface_points_.size(); ++i)
+            rest_.row(static_cast<Eigen::Index>(i)) = frame.points.row(surface_points_[i]);
         cell_field_ = std::any_of(frame.cell_data.begin(), frame.cell_data.end(),
                                   [&](const io::Field& f) { return f.name == scene_.output.colour; });
     }
@@ -325,6 +328,9 @@ Eigen::Vector3d WebPage::write(const std::filesystem::path& path, const std::vec
     // The obstacles at t = 0 (each moves by t·w), drawn under the motion's box as the PNGs draw them;
     // the camera frames the motion and the obstacles at every frame, or the scene's frame_box.
     std::array<double, 6> box{q.low.x(), q.high.x(), q.low.y(), q.high.y(), q.low.z(), q.high.z()};
+    const bool outline = scene_.output.warp != 1.0;  // the rest shape under an exaggerated motion
+    if (outline)
+        fig::grow_bounds(box, rest_);
     const std::array<double, 6> motion_box = box;
     for (const double t : times_)
         for (const fig::Prop& prop : obstacle_props(scene_, motion_box, t))
@@ -389,6 +395,7 @@ Eigen::Vector3d WebPage::write(const std::filesystem::path& path, const std::vec
         ",\"view_direction\":", json_numbers(scene_.output.view_direction),
         ",\"view_up\":", json_numbers(scene_.output.view_up),
         ",\"obstacles\":", obstacles,
+        ",\"rest\":\"", outline ? base64_encode(float32_bytes(rest_)) : std::string(), "\"",
         ",\"energy\":{\"times\":", json_numbers(energy_times), ",\"series\":", series, "}}");
     std::string page = player_template;
     std::string title = scene_.title;
@@ -506,6 +513,16 @@ html, body { margin: 0; height: 100%; overflow: hidden; background: #fff; color:
   body.setAttribute("position", new THREE.BufferAttribute(position, 3));
   body.setAttribute("color", new THREE.BufferAttribute(colour, 3));
   scene.add(new THREE.Mesh(body, new THREE.MeshLambertMaterial({ vertexColors: THREE.VertexColors, side: THREE.DoubleSide })));
+
+  // under an exaggerated motion (output.warp), the body at rest: faint grey, as in the PNG frames
+  if (D.rest) {
+    const rest = new THREE.BufferGeometry();
+    rest.setAttribute("position", new THREE.BufferAttribute(new Float32Array(buffer(D.rest)), 3));
+    rest.setIndex(new THREE.BufferAttribute(tri, 1));
+    rest.computeVertexNormals();
+    scene.add(new THREE.Mesh(rest, new THREE.MeshLambertMaterial({ color: 0x999999, transparent: true, opacity: 0.25,
+                                                                   depthWrite: false, side: THREE.DoubleSide })));
+  }
 
   // the obstacles, grey, each moved by t·w
   const obstacles = D.obstacles.map((o) => {
