@@ -521,7 +521,8 @@ html, body { margin: 0; height: 100%; overflow: hidden; background: #fff; color:
     rest.setIndex(new THREE.BufferAttribute(tri, 1));
     rest.computeVertexNormals();
     scene.add(new THREE.Mesh(rest, new THREE.MeshLambertMaterial({ color: 0x999999, transparent: true, opacity: 0.25,
-                                                                   depthWrite: false, side: THREE.DoubleSide })));
+                                                                   depthWrite: false, side: THREE.DoubleSide,
+                                                                   polygonOffset: true, polygonOffsetFactor: 2, polygonOffsetUnits: 4 })));
   }
 
   // the obstacles, grey, each moved by t·w
