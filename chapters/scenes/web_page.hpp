@@ -76,6 +76,7 @@ void check_web_page_library();
 /// PNG frames do.
 class WebPage {
 public:
+    /// The page of a run of scene (which must outlive it), no frames yet.
     explicit WebPage(const SceneSpec& scene);
     /// Adds a frame: the merged frame of every body (runner.hpp), its time and the models the
     /// bodies use at it (the caption's, frame_title).
