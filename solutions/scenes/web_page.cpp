@@ -495,70 +495,90 @@ html, body { margin: 0; height: 100%; overflow: hidden; background: #fff; color:
     d.style.top = (100 - 25 * i) + "%"; d.textContent = fmt(D.range[0] + (D.range[1] - D.range[0]) * i / 4); ticks.appendChild(d); }
   document.getElementById("bar-text").textContent = D.field + (D.unit ? " [" + D.unit + "]" : "") + (D.range_note ? "\n" + D.range_note : "");
 
+  // the 3D view: { draw(k), resize() }, or null without WebGL (the page then says so, and plays the
+  // caption and the energy plot alone)
   const view = document.getElementById("view");
-  let renderer;
-  try { renderer = new THREE.WebGLRenderer({ antialias: true }); }
-  catch (e) { document.getElementById("nogl").style.display = "block"; return; }
-  renderer.setPixelRatio(window.devicePixelRatio || 1);
-  renderer.setClearColor(0xffffff);
-  view.appendChild(renderer.domElement);
-  const scene = new THREE.Scene();
-  const camera = new THREE.PerspectiveCamera(30, 1, 1e-3, 1e3);
-  const light = new THREE.DirectionalLight(0xffffff, 0.75);
-  scene.add(new THREE.AmbientLight(0xffffff, 0.35), light, light.target);
+  const view3d = (function () {
+    let renderer;
+    try { renderer = new THREE.WebGLRenderer({ antialias: true }); }
+    catch (e) { document.getElementById("nogl").style.display = "block"; return null; }
+    renderer.setPixelRatio(window.devicePixelRatio || 1);
+    renderer.setClearColor(0xffffff);
+    view.appendChild(renderer.domElement);
+    const scene = new THREE.Scene();
+    const camera = new THREE.PerspectiveCamera(30, 1, 1e-3, 1e3);
+    const light = new THREE.DirectionalLight(0xffffff, 0.75);
+    scene.add(new THREE.AmbientLight(0xffffff, 0.35), light, light.target);
 
-  // the bodies' surface: one vertex per triangle corner (flat facets, a colour per triangle)
-  const position = new Float32Array(9 * F), colour = new Float32Array(9 * F);
-  const body = new THREE.BufferGeometry();
-  body.setAttribute("position", new THREE.BufferAttribute(position, 3));
-  body.setAttribute("color", new THREE.BufferAttribute(colour, 3));
-  scene.add(new THREE.Mesh(body, new THREE.MeshLambertMaterial({ vertexColors: THREE.VertexColors, side: THREE.DoubleSide })));
+    // the bodies' surface: one vertex per triangle corner (flat facets, a colour per triangle)
+    const position = new Float32Array(9 * F), colour = new Float32Array(9 * F);
+    const body = new THREE.BufferGeometry();
+    body.setAttribute("position", new THREE.BufferAttribute(position, 3));
+    body.setAttribute("color", new THREE.BufferAttribute(colour, 3));
+    scene.add(new THREE.Mesh(body, new THREE.MeshLambertMaterial({ vertexColors: THREE.VertexColors, side: THREE.DoubleSide })));
 
-  // under an exaggerated motion (output.warp), the body at rest: faint grey, as in the PNG frames
-  if (D.rest) {
-    const rest = new THREE.BufferGeometry();
-    rest.setAttribute("position", new THREE.BufferAttribute(new Float32Array(buffer(D.rest)), 3));
-    rest.setIndex(new THREE.BufferAttribute(tri, 1));
-    rest.computeVertexNormals();
-    scene.add(new THREE.Mesh(rest, new THREE.MeshLambertMaterial({ color: 0x999999, transparent: true, opacity: 0.25,
-                                                                   depthWrite: false, side: THREE.DoubleSide,
-                                                                   polygonOffset: true, polygonOffsetFactor: 2, polygonOffsetUnits: 4 })));
-  }
+    // under an exaggerated motion (output.warp), the body at rest: faint grey, as in the PNG frames
+    if (D.rest) {
+      const rest = new THREE.BufferGeometry();
+      rest.setAttribute("position", new THREE.BufferAttribute(new Float32Array(buffer(D.rest)), 3));
+      rest.setIndex(new THREE.BufferAttribute(tri, 1));
+      rest.computeVertexNormals();
+      scene.add(new THREE.Mesh(rest, new THREE.MeshLambertMaterial({ color: 0x999999, transparent: true, opacity: 0.25,
+                                                                     depthWrite: false, side: THREE.DoubleSide,
+                                                                     polygonOffset: true, polygonOffsetFactor: 2, polygonOffsetUnits: 4 })));
+    }
 
-  // the obstacles, grey, each moved by t·w
-  const obstacles = D.obstacles.map((o) => {
-    const geometry = new THREE.BufferGeometry();
-    geometry.setAttribute("position", new THREE.BufferAttribute(new Float32Array(buffer(o.positions)), 3));
-    geometry.setIndex(new THREE.BufferAttribute(new Uint32Array(buffer(o.triangles)), 1));
-    geometry.computeVertexNormals();
-    const mesh = new THREE.Mesh(geometry, new THREE.MeshLambertMaterial({ color: new THREE.Color(o.colour[0], o.colour[1], o.colour[2]), side: THREE.DoubleSide }));
-    scene.add(mesh);
-    return { mesh: mesh, velocity: o.velocity };
-  });
+    // the obstacles, grey, each moved by t·w
+    const obstacles = D.obstacles.map((o) => {
+      const geometry = new THREE.BufferGeometry();
+      geometry.setAttribute("position", new THREE.BufferAttribute(new Float32Array(buffer(o.positions)), 3));
+      geometry.setIndex(new THREE.BufferAttribute(new Uint32Array(buffer(o.triangles)), 1));
+      geometry.computeVertexNormals();
+      const mesh = new THREE.Mesh(geometry, new THREE.MeshLambertMaterial({ color: new THREE.Color(o.colour[0], o.colour[1], o.colour[2]), side: THREE.DoubleSide }));
+      scene.add(mesh);
+      return { mesh: mesh, velocity: o.velocity };
+    });
 
-  // the camera looks along view_direction with view_up, framing view_box
-  const b = D.view_box, center = new THREE.Vector3((b[0] + b[1]) / 2, (b[2] + b[3]) / 2, (b[4] + b[5]) / 2);
-  const radius = Math.max(0.5 * Math.hypot(b[1] - b[0], b[3] - b[2], b[5] - b[4]), 1e-9);
-  const direction = new THREE.Vector3().fromArray(D.view_direction).normalize();
-  const distance = radius / Math.sin(Math.PI / 12);  // the box's sphere in the field of view of 30°
-  camera.up.fromArray(D.view_up).normalize();
-  camera.position.copy(center).addScaledVector(direction, -distance);
-  camera.near = distance / 100; camera.far = distance * 100;
-  const controls = new THREE.OrbitControls(camera, renderer.domElement);
-  controls.target.copy(center);
-  controls.update();
+    // the camera looks along view_direction with view_up, framing view_box
+    const b = D.view_box, center = new THREE.Vector3((b[0] + b[1]) / 2, (b[2] + b[3]) / 2, (b[4] + b[5]) / 2);
+    const radius = Math.max(0.5 * Math.hypot(b[1] - b[0], b[3] - b[2], b[5] - b[4]), 1e-9);
+    const direction = new THREE.Vector3().fromArray(D.view_direction).normalize();
+    const distance = radius / Math.sin(Math.PI / 12);  // the box's sphere in the field of view of 30°
+    camera.up.fromArray(D.view_up).normalize();
+    camera.position.copy(center).addScaledVector(direction, -distance);
+    camera.near = distance / 100; camera.far = distance * 100;
+    const controls = new THREE.OrbitControls(camera, renderer.domElement);
+    controls.target.copy(center);
+    controls.update();
 
-  function render() {
-    light.position.copy(camera.position).addScaledVector(camera.up, 0.5 * distance);  // a headlight, a little above
-    light.target.position.copy(controls.target);
-    renderer.render(scene, camera);
-  }
-  function resize() {
-    const w = view.clientWidth, h = view.clientHeight;
-    renderer.setSize(w, h); camera.aspect = w / Math.max(h, 1); camera.updateProjectionMatrix(); render();
-  }
-  controls.addEventListener("change", render);
-  window.addEventListener("resize", () => { resize(); plot(); });
+    function render() {
+      light.position.copy(camera.position).addScaledVector(camera.up, 0.5 * distance);  // a headlight, a little above
+      light.target.position.copy(controls.target);
+      renderer.render(scene, camera);
+    }
+    function resize() {
+      const w = view.clientWidth, h = view.clientHeight;
+      renderer.setSize(w, h); camera.aspect = w / Math.max(h, 1); camera.updateProjectionMatrix(); render();
+    }
+    // frame k: positions decoded, colours looked up, obstacles moved
+    function draw(k) {
+      const base = 3 * P * k;
+      for (let f = 0; f < F; ++f) for (let c = 0; c < 3; ++c) {
+        const p = tri[3 * f + c], o = 9 * f + 3 * c;
+        for (let a = 0; a < 3; ++a) position[o + a] = D.low[a] + codes[base + 3 * p + a] * step[a];
+        const rgb = lut[perTriangle ? colours[F * k + f] : colours[P * k + p]];
+        colour[o] = rgb[0]; colour[o + 1] = rgb[1]; colour[o + 2] = rgb[2];
+      }
+      body.attributes.position.needsUpdate = true; body.attributes.color.needsUpdate = true;
+      body.computeVertexNormals(); body.computeBoundingSphere();
+      const time = D.times[k];
+      for (const o of obstacles) o.mesh.position.set(time * o.velocity[0], time * o.velocity[1], time * o.velocity[2]);
+      render();
+    }
+    controls.addEventListener("change", render);
+    return { draw: draw, resize: resize };
+  })();
+  window.addEventListener("resize", () => { if (view3d) view3d.resize(); plot(); });
 
   // the energy plot: an SVG of each series over time, a cursor at the frame's time
   const svg = document.getElementById("energy"), NS = "http://www.w3.org/2000/svg";
@@ -592,29 +612,19 @@ html, body { margin: 0; height: 100%; overflow: hidden; background: #fff; color:
     show(frame);
   }
 
-  // one frame: positions decoded, colours looked up, obstacles moved, caption, slider, cursor
+  // one frame: the 3D view's, the caption, the slider, the energy plot's cursor
   const slider = document.getElementById("slider"), label = document.getElementById("frame-label");
   const caption = document.getElementById("caption"), playButton = document.getElementById("play");
   slider.max = N - 1;
   let frame = 0, playing = false, clock = 0;
   function show(k) {
     frame = Math.min(Math.max(k, 0), N - 1);
-    const base = 3 * P * frame;
-    for (let f = 0; f < F; ++f) for (let c = 0; c < 3; ++c) {
-      const p = tri[3 * f + c], o = 9 * f + 3 * c;
-      for (let a = 0; a < 3; ++a) position[o + a] = D.low[a] + codes[base + 3 * p + a] * step[a];
-      const rgb = lut[perTriangle ? colours[F * frame + f] : colours[P * frame + p]];
-      colour[o] = rgb[0]; colour[o + 1] = rgb[1]; colour[o + 2] = rgb[2];
-    }
-    body.attributes.position.needsUpdate = true; body.attributes.color.needsUpdate = true;
-    body.computeVertexNormals(); body.computeBoundingSphere();
+    if (view3d) view3d.draw(frame);
     const time = D.times[frame];
-    for (const o of obstacles) o.mesh.position.set(time * o.velocity[0], time * o.velocity[1], time * o.velocity[2]);
     caption.textContent = D.captions[frame];
     slider.value = frame;
     label.textContent = "frame " + frame + " / " + (N - 1) + " · t = " + fmt(time) + " s";
     if (cursor && xOf) { const x = xOf(time); cursor.setAttribute("x1", x); cursor.setAttribute("x2", x); }
-    render();
   }
   function play(on) { playing = on && N > 1; playButton.textContent = playing ? "❚❚" : "▶"; clock = performance.now(); }
   function tick(now) {
@@ -637,7 +647,7 @@ html, body { margin: 0; height: 100%; overflow: hidden; background: #fff; color:
   // #frame=N: open at frame N, paused (a link to one moment, and the browser test's two frames);
   // otherwise play from the first frame
   const asked = /frame=(\d+)/.exec(location.hash);
-  resize();
+  if (view3d) view3d.resize();
   plot();
   show(asked ? Number(asked[1]) : 0);
   play(!asked);
