@@ -515,18 +515,32 @@ html, body { margin: 0; height: 100%; overflow: hidden; background: #fff; color:
     const body = new THREE.BufferGeometry();
     body.setAttribute("position", new THREE.BufferAttribute(position, 3));
     body.setAttribute("color", new THREE.BufferAttribute(colour, 3));
-    scene.add(new THREE.Mesh(body, new THREE.MeshLambertMaterial({ vertexColors: THREE.VertexColors, side: THREE.DoubleSide })));
+    scene.add(new THREE.Mesh(body, new THREE.MeshLambertMaterial({ vertexColors: THREE.VertexColors, side: THREE.DoubleSide,
+                                                                   polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1 })));
 
-    // under an exaggerated motion (output.warp), the body at rest: faint grey, as in the PNG frames
+    // the surface's edges, dark grey, as the PNG frames draw them (each edge once)
+    const edgeEnds = [], seen = new Set();
+    for (let f = 0; f < F; ++f) for (let c = 0; c < 3; ++c) {
+      const a = tri[3 * f + c], b = tri[3 * f + (c + 1) % 3], key = Math.min(a, b) * P + Math.max(a, b);
+      if (!seen.has(key)) { seen.add(key); edgeEnds.push(a, b); }
+    }
+    const edgePosition = new Float32Array(3 * edgeEnds.length), vertex = new Float32Array(3 * P);
+    const edges = new THREE.BufferGeometry();
+    edges.setAttribute("position", new THREE.BufferAttribute(edgePosition, 3));
+    scene.add(new THREE.LineSegments(edges, new THREE.LineBasicMaterial({ color: 0x404040 })));
+
+    // under an exaggerated motion (output.warp), the body at rest, faint grey behind the body as in the
+    // PNG frames: a scene of its own, drawn first, its depth cleared before the body is drawn over it
+    const restScene = new THREE.Scene(), restLight = new THREE.DirectionalLight(0xffffff, 0.75);
+    restScene.add(new THREE.AmbientLight(0xffffff, 0.35), restLight, restLight.target);
     if (D.rest) {
       const rest = new THREE.BufferGeometry();
       rest.setAttribute("position", new THREE.BufferAttribute(new Float32Array(buffer(D.rest)), 3));
       rest.setIndex(new THREE.BufferAttribute(tri, 1));
       rest.computeVertexNormals();
-      scene.add(new THREE.Mesh(rest, new THREE.MeshLambertMaterial({ color: 0x999999, transparent: true, opacity: 0.25,
-                                                                     depthWrite: false, side: THREE.DoubleSide,
-                                                                     polygonOffset: true, polygonOffsetFactor: 2, polygonOffsetUnits: 4 })));
+      restScene.add(new THREE.Mesh(rest, new THREE.MeshLambertMaterial({ color: 0xe0e0e0, side: THREE.DoubleSide })));
     }
+    renderer.autoClear = false;
 
     // the obstacles, grey, each moved by t·w
     const obstacles = D.obstacles.map((o) => {
@@ -554,6 +568,11 @@ html, body { margin: 0; height: 100%; overflow: hidden; background: #fff; color:
     function render() {
       light.position.copy(camera.position).addScaledVector(camera.up, 0.5 * distance);  // a headlight, a little above
       light.target.position.copy(controls.target);
+      restLight.position.copy(light.position);
+      restLight.target.position.copy(light.target.position);
+      renderer.clear();
+      renderer.render(restScene, camera);
+      renderer.clearDepth();
       renderer.render(scene, camera);
     }
     function resize() {
@@ -563,13 +582,16 @@ html, body { margin: 0; height: 100%; overflow: hidden; background: #fff; color:
     // frame k: positions decoded, colours looked up, obstacles moved
     function draw(k) {
       const base = 3 * P * k;
+      for (let i = 0; i < 3 * P; ++i) vertex[i] = D.low[i % 3] + codes[base + i] * step[i % 3];
       for (let f = 0; f < F; ++f) for (let c = 0; c < 3; ++c) {
         const p = tri[3 * f + c], o = 9 * f + 3 * c;
-        for (let a = 0; a < 3; ++a) position[o + a] = D.low[a] + codes[base + 3 * p + a] * step[a];
+        for (let a = 0; a < 3; ++a) position[o + a] = vertex[3 * p + a];
         const rgb = lut[perTriangle ? colours[F * k + f] : colours[P * k + p]];
         colour[o] = rgb[0]; colour[o + 1] = rgb[1]; colour[o + 2] = rgb[2];
       }
+      for (let e = 0; e < edgeEnds.length; ++e) for (let a = 0; a < 3; ++a) edgePosition[3 * e + a] = vertex[3 * edgeEnds[e] + a];
       body.attributes.position.needsUpdate = true; body.attributes.color.needsUpdate = true;
+      edges.attributes.position.needsUpdate = true; edges.computeBoundingSphere();
       body.computeVertexNormals(); body.computeBoundingSphere();
       const time = D.times[k];
       for (const o of obstacles) o.mesh.position.set(time * o.velocity[0], time * o.velocity[1], time * o.velocity[2]);
