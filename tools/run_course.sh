@@ -2,7 +2,8 @@
 # Runs the course: builds the reference solutions and runs every chapter executable (or the
 # chapters given, e.g. `tools/run_course.sh 01 05`), writing VTK files, CSV tables and PNG figures
 # under out/NN_name/; then the scenes gallery (or only it: `tools/run_course.sh scenes`): every
-# scenes/*.toml with fem_scene into out/scenes/<scene>/ (.pvd, PNG frames, video, energies) and the
+# scenes/*.toml with fem_scene into out/scenes/<scene>/ (.pvd, PNG frames, video, energies, and the
+# web page <scene>.html beside the video) and the
 # model comparison of all of them into out/scenes/compare/ (docs/scenes.md). Provides a virtual
 # display when none is set, so the PNGs are drawn.
 set -euo pipefail
@@ -36,7 +37,7 @@ if [ "$gallery" -eq 1 ]; then
     for scene in scenes/*.toml; do
         name=$(basename "$scene" .toml)
         step "fem_scene $scene  ->  out/scenes/$name"
-        with_display build/release/bin/fem_scene "$scene" --out "out/scenes/$name"
+        with_display build/release/bin/fem_scene "$scene" --html --out "out/scenes/$name"
     done
     step "fem_scene scenes/*.toml --compare  ->  out/scenes/compare"
     with_display build/release/bin/fem_scene scenes/*.toml --compare --out out/scenes/compare

@@ -15,6 +15,8 @@ packages=(
   libspectra-dev                          # sparse eigenvalues (chapter 10: modes)
   libtomlplusplus-dev                     # scene files (scenes/*.toml, docs/scenes.md)
   ffmpeg                                  # the scenes' videos from their PNG frames (optional)
+  libjs-three                             # three.js r111, inlined into the scenes' web pages (--html)
+  chromium                                # the web page's browser test (headless; optional)
   time                                    # GNU time: the course's peak memory (docs/engineering.md)
   clang-14 libclang-rt-14-dev             # the readers' fuzz targets (libFuzzer; tools/fuzz.sh)
 )

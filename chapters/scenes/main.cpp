@@ -11,9 +11,11 @@
 //
 // Writes (under out/scenes/<scene>): <scene>.pvd with <scene>/<scene>_NNNN.vtu frames, PNG frames
 // <scene>_NNNN.png and <scene>.mp4 (ffmpeg), steps.csv with the charts energies, step_time and
-// newton_iterations; with --compare, models.csv. docs/scenes.md
+// newton_iterations; with --html, <scene>.html (a web page that plays the run); with --compare,
+// models.csv. docs/scenes.md
 #include "scenes/compare.hpp"
 #include "scenes/runner.hpp"
+#include "scenes/web_page.hpp"
 
 #include "09_conjugate_gradient/linear_solver.hpp"
 
@@ -51,7 +53,7 @@ int main(int argc, char** argv)
                    "Runs a scene file with the cheapest model that is accurate enough (docs/scenes.md)");
     std::vector<std::string> files;
     std::vector<std::string> settings;
-    bool compare = false, no_progress = false;
+    bool compare = false, no_progress = false, html = false;
     cli.app.add_option("scene", files, "The scene file (TOML), e.g. scenes/cantilever.toml; several with --compare")
         ->required();
     cli.app.add_option("--set", settings,
@@ -61,6 +63,8 @@ int main(int argc, char** argv)
         ->take_all();              // and every --set kept
     cli.app.add_flag("--compare", compare,
                      "Run every model and auto against the stable neo-Hookean reference and print the table (models_<scene>.csv)");
+    cli.app.add_flag("--html", html,
+                     "Also write <scene>.html: one self-contained web page that plays the run (as output.html = true)");
     cli.app.add_flag("--no-progress", no_progress, "No progress bar on stderr (it shows only on a terminal anyway)");
     bool view = false;
     int screenshot = -1;
@@ -99,8 +103,17 @@ int main(int argc, char** argv)
             throw Error("--screenshot: writes a file, and --forever writes none");
         if (cli.app.count("--pull-stiffness") > 0 && !view)
             throw Error("--pull-stiffness: needs --view (the mouse pulls in the live view)");
+        if (html && compare)
+            throw Error("--html: writes the page of one run; --compare runs many without frames");
+        if (html && forever)
+            throw Error("--html: writes a file, and --forever writes none");
         for (const std::string& file : files) {
             scenes.push_back(read_scene(file, settings, quick));
+            scenes.back().output.html = scenes.back().output.html || html;
+            if (scenes.back().output.html && !compare) {
+                check_web_page_library();
+                cli.writes_entry(scenes.back().file.stem().string() + ".html");
+            }
             cli.protect_inputs(input_files(scenes.back()));  // --out must not overlap what is read
             if (!compare)  // the frames folder <scene>/ must not replace a folder of someone else's
                 cli.writes_entry(scenes.back().file.stem().string());

@@ -87,7 +87,8 @@ struct RunOptions {
 
 /// Runs a scene (header comment), writing (when options.run is set) the outputs the scene asks for:
 /// <name>.pvd with its .vtu frames, PNG frames <name>_NNNN.png, a video <name>.mp4/.gif (ffmpeg; a
-/// one-line notice without it), steps.csv and the charts energies, step_time and newton_iterations.
+/// one-line notice without it), steps.csv and the charts energies, step_time and newton_iterations,
+/// and with output.html the web page <name>.html (web_page.hpp).
 /// A stop signal (fem::stop_requested, common/interrupt.hpp) stops after the current step with every
 /// file so far valid. fem::Error when a step fails or the run diverges (naming body, step, time and
 /// model). docs/scenes.md#the-runner

@@ -129,6 +129,7 @@ struct OutputSpec {
     std::string video = "mp4";          ///< "mp4", "gif" or "none" (ffmpeg, from the PNG frames)
     bool csv = true;                    ///< steps.csv: energies, Newton iterations and time per step
     bool charts = true;                 ///< the charts of steps.csv (PNG + CSV: energies, step_time, newton_iterations)
+    bool html = false;                  ///< the web page <scene>.html that plays the run (web_page.hpp)
     std::vector<std::string> fields{"displacement", "velocity", "von Mises stress"};  ///< in the frames
     std::string colour = "von Mises stress";  ///< the field the PNGs are coloured by
     Eigen::Vector3d view_direction{0.3, 1.0, -0.3};   ///< the camera looks along this

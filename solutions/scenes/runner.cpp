@@ -4,6 +4,7 @@
 #include "scenes/run_outputs.hpp"
 #include "scenes/scene_contact.hpp"
 #include "scenes/scene_conditions.hpp"
+#include "scenes/web_page.hpp"
 
 #include "12_hyperelastic_newton/force_models.hpp"
 
@@ -217,6 +218,9 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
     std::optional<io::MotionRecorder> skin_recorder;  // the skin's .vtp frames beside the tets' .vtu
     if (run != nullptr && scene.output.pvd && skin)
         skin_recorder.emplace(run->file(stem + "_skin.pvd"), png ? 1 : 0, io::FrameFile::surface);
+    std::optional<WebPage> page;  // the web page <stem>.html (web_page.hpp)
+    if (run != nullptr && scene.output.html)
+        page.emplace(scene);
     StepHistory history;
     RunResult result;
     result.frames.resize(bodies.size());
@@ -224,10 +228,12 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
     const auto frame = [&] {
         const dynamics::State& first = bodies.front().state();
         models.push_back(frame_models(bodies));
-        if (recorder || options.on_frame) {
+        if (recorder || options.on_frame || page) {
             const io::MeshData data = scene_frame(bodies, scene.output);
             if (recorder)
                 recorder->add(first.time, data);
+            if (page)
+                page->add_frame(data, first.time, models.back());
             if (skin_recorder)
                 skin_recorder->add(first.time, skin->frame(bodies[skinned].state().u));
             if (options.on_frame)
@@ -293,6 +299,13 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
         history.write_csv(run->file("steps.csv"));
     if (scene.output.charts)
         history.save_charts(scene, bodies.size(), *run);
+    if (page) {
+        const std::filesystem::path file = run->file(stem + ".html");
+        const Eigen::Vector3d bound = page->write(file, result.records);
+        std::cout << "web page: " << file.filename().string() << " (" << result.frame_count << " frames, "
+                  << std::lround(std::filesystem::file_size(file) / 1e4) / 100.0 << " MB; positions to within "
+                  << bound.maxCoeff() << " m)\n";
+    }
     if (recorder && png && !result.interrupted) {
         // Every frame captioned with the models of its moment; the obstacles drawn at its time under
         // the box the camera frames (the scene's, as the live view takes it, or the motion's).

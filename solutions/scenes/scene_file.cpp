@@ -133,7 +133,7 @@ void read_output(const Fields& top, SceneSpec& scene)
     if (output_table == nullptr)
         return;
     const Fields o(*output_table, "output", top.source(),
-                   {"frame_rate", "pvd", "png", "video", "csv", "charts", "frame_box", "colour_range", "fields", "colour", "view_direction", "view_up",
+                   {"frame_rate", "pvd", "png", "video", "csv", "charts", "html", "frame_box", "colour_range", "fields", "colour", "view_direction", "view_up",
                     "warp", "width", "height"});
     OutputSpec& out = scene.output;
     out.frame_rate = o.number("frame_rate", out.frame_rate, [](double f) { return f > 0.0 && f <= 1000.0; },
@@ -143,6 +143,7 @@ void read_output(const Fields& top, SceneSpec& scene)
     out.video = o.text("video", out.video, {"mp4", "gif", "none"});
     out.csv = o.flag("csv", out.csv);
     out.charts = o.flag("charts", out.charts);
+    out.html = o.flag("html", out.html);
     if (out.charts && !out.csv)
         o.fail(*o.get(o.has("charts") ? "charts" : "csv"), "charts", "are drawn from steps.csv: set csv = true or charts = false");
     if (out.png && !out.pvd)
