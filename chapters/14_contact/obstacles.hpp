@@ -53,7 +53,7 @@ public:
     /// ∇²d₀(p) (3×3, symmetric) [1/m]: 0 for a plane or a box face, (I − n nᵀ)/|p − c| for a sphere.
     virtual Eigen::Matrix3d local_hessian(const Eigen::Vector3d& p) const = 0;
     /// The first s ≥ 0 at which the path p + s·dp (p outside, d₀(p) > 0) reaches d₀ = 0, or +∞ when
-    /// it never does. Exact for a half-space and a sphere; a box answers a conservative s (never
+    /// it never does. Exact for a half-space, a sphere and a capsule; a box answers a conservative s (never
     /// beyond the true one).
     virtual double local_time_of_impact(const Eigen::Vector3d& p, const Eigen::Vector3d& dp) const = 0;
 
@@ -181,6 +181,32 @@ public:
 private:
     Eigen::Vector3d centre_, half_;
     Eigen::Matrix3d rotation_;
+};
+
+/// A solid capsule: the points within r of the segment from a to b (a rod, a rail, a pipe). With
+/// e = (b − a)/|b − a| and c(x) = a + clamp((x − a)·e, 0, |b − a|) e the segment's closest point:
+/// d = |x − c| − r, ∇d = n = (x − c)/|x − c|; ∇²d = (I − e eᵀ − n nᵀ)/|x − c| beside the segment (a
+/// cylinder's) and (I − n nᵀ)/|x − c| beyond an end (a sphere's). The time of impact is exact: the
+/// earliest of the side's root (the infinite cylinder's, where it lies between the ends) and each
+/// end ball's (Sphere's). Smooth: no features. docs/14_contact.md#obstacles
+class Capsule final : public Obstacle {
+public:
+    /// fem::Error for r ≤ 0 (or not finite), a non-finite end, or a <= 0 segment length |b − a|.
+    Capsule(const Eigen::Vector3d& start, const Eigen::Vector3d& end, double radius, double friction = 0.0,
+            const Eigen::Vector3d& velocity = Eigen::Vector3d::Zero());
+    std::string name() const override { return "capsule"; }
+    double local_distance(const Eigen::Vector3d& p) const override;
+    Eigen::Vector3d local_gradient(const Eigen::Vector3d& p) const override;
+    Eigen::Matrix3d local_hessian(const Eigen::Vector3d& p) const override;
+    double local_time_of_impact(const Eigen::Vector3d& p, const Eigen::Vector3d& dp) const override;
+    /// A triangulated tube with a half ball at each end (swept_ball_surface(a, b, r)).
+    TriMesh local_surface(const std::array<double, 6>& around) const override;
+
+private:
+    /// The closest point of the segment to p.
+    Eigen::Vector3d closest(const Eigen::Vector3d& p) const;
+    Eigen::Vector3d start_, end_, axis_;  // axis_: the unit e
+    double length_, radius_;
 };
 
 /// The surface swept by a ball of radius r from a to b, drawn with 48 points a ring: 13 rings of a

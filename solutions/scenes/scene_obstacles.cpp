@@ -86,6 +86,24 @@ Build read_mesh(const Fields& fields, const std::filesystem::path& scene_file, s
     };
 }
 
+/// A capsule: start and end (its segment's ends, required, apart) and radius > 0 (required).
+Build read_capsule(const Fields& fields, const std::filesystem::path&, std::filesystem::path&)
+{
+    for (const char* end : {"start", "end"})
+        if (!fields.has(end))
+            fields.missing(end, "a capsule needs start = [x, y, z] and end = [x, y, z] (its segment's ends, m)");
+    const Eigen::Vector3d start = fields.vector("start", Eigen::Vector3d::Zero());
+    const Eigen::Vector3d end = fields.vector("end", Eigen::Vector3d::Zero());
+    if (!((end - start).norm() > 0.0))
+        fields.fail(*fields.get("end"), "end", "must differ from start: a capsule's segment has a length > 0 (m)");
+    if (!fields.has("radius"))
+        fields.missing("radius", "a capsule needs radius = r (m)");
+    const double radius = fields.positive("radius", 1.0);
+    return [=](double friction, const Eigen::Vector3d& velocity) {
+        return std::make_shared<contact::Capsule>(start, end, radius, friction, velocity);
+    };
+}
+
 /// One [[obstacle]] type: its name, its own fields, and its reader (the fields read and checked;
 /// a mesh's file returned in the last argument).
 struct ObstacleType {
@@ -103,6 +121,7 @@ const std::vector<ObstacleType>& registry()
         {"sphere", {"center", "radius"}, read_sphere},
         {"box", {"center", "size", "axis", "angle"}, read_box},
         {"mesh", {"file", "scale", "translate"}, read_mesh},
+        {"capsule", {"start", "end", "radius"}, read_capsule},
     };
     return types;
 }

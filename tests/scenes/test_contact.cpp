@@ -1,5 +1,6 @@
 // Obstacles in a scene (chapter 14): the reader's fields, chapter 14's obstacles made from them, and
 // the rule that steps a body with contact only when it needs it. docs/scenes.md#obstacles
+#include "scenes/live_view.hpp"
 #include "scenes/runner.hpp"
 #include "scenes/scene_contact.hpp"
 
@@ -79,6 +80,38 @@ TEST_CASE("obstacles in the scene file: each type's fields, and chapter 14's obs
     CHECK(scene.obstacles[2].obstacle->distance(Eigen::Vector3d(3.0, 1.0, 0.25), 0.0) == Approx(0.75).epsilon(1e-15));
     // A scene without obstacles has none, and its runs meet none.
     CHECK(read_scene(gallery / "cantilever.toml").obstacles.empty());
+}
+
+TEST_CASE("a capsule obstacle: read from its type's fields, made, drawn, and its foreign fields refused", "[scenes][contact]")
+{
+    const std::filesystem::path file = drop_scene(
+        "obstacle_capsule", "type = \"capsule\"\nstart = [-1.0, 0.05, -0.5]\nend = [1.0, 0.05, -0.5]\nradius = 0.25\n"
+                            "friction = 0.4\nvelocity = [0.0, 0.0, -0.1]\n");
+    const SceneSpec scene = read_scene(file);
+    REQUIRE(scene.obstacles.size() == 1);
+    const ObstacleSpec& capsule = scene.obstacles[0];
+    CHECK(capsule.type == "capsule");
+    CHECK(capsule.file.empty());
+    const auto& made = capsule.obstacle;
+    CHECK(made->name() == "capsule");
+    CHECK(made->friction() == 0.4);
+    CHECK(made->velocity() == Eigen::Vector3d(0.0, 0.0, -0.1));
+    // 0.75 m above the axis: 0.5 m from its surface; 2 m beyond its end b along the axis: 1.75 m.
+    CHECK(made->distance(Eigen::Vector3d(0.3, 0.05, 0.25), 0.0) == Approx(0.5).epsilon(1e-15));
+    CHECK(made->distance(Eigen::Vector3d(3.0, 0.05, -0.5), 0.0) == Approx(1.75).epsilon(1e-15));
+    // Drawn where it stands at t = 1: moved 0.1 m down.
+    const std::vector<fig::Prop> props = obstacle_props(scene, {0.0, 0.1, 0.0, 0.1, 0.0, 0.1}, 1.0);
+    REQUIRE(props.size() == 1);
+    for (Eigen::Index v = 0; v < props[0].shape.points.rows(); ++v)
+        CHECK(std::abs(made->distance(props[0].shape.points.row(v).transpose(), 1.0)) < 1e-14);
+    // A sphere's or a box's field is not a capsule's: refused at the field, naming its type.
+    const std::filesystem::path foreign = drop_scene(
+        "obstacle_capsule_foreign", "type = \"capsule\"\nstart = [-1.0, 0.05, -0.5]\nend = [1.0, 0.05, -0.5]\n"
+                                    "radius = 0.25\ncenter = [0.0, 0.0, -0.5]\n");
+    CHECK_THROWS_WITH(read_scene(foreign), Catch::Contains("obstacle[0].center") &&
+                                               Catch::Contains("belongs to type = \"sphere\", not to type = \"capsule\""));
+    const std::filesystem::path missing = drop_scene("obstacle_capsule_missing", "type = \"capsule\"\nradius = 0.25\n");
+    CHECK_THROWS_WITH(read_scene(missing), Catch::Contains("obstacle[0].start: missing"));
 }
 
 TEST_CASE("a mesh obstacle: its file found in data/, placed by scale then translate, and read by the runner's input list",
