@@ -187,6 +187,18 @@ std::unique_ptr<Material> make_material(std::string_view name, double youngs_mod
 /// "stable-neo-hookean" (the course's variant), "stable-neo-hookean-paper".
 std::vector<std::string> material_names();
 
+/// What a material is called, beside make_material's name: in words, as the figures' legends write
+/// it (e.g. "St. Venant-Kirchhoff"); its label, as a frame's caption writes it (short, e.g. "StVK");
+/// and whether the scenes' model comparison runs it (false for a variant of one it runs already).
+/// docs/12_hyperelastic_newton.md#adding-a-material
+struct MaterialNames {
+    std::string name, in_words, label;
+    bool compared = true;
+};
+
+/// Every registered material's names (MaterialNames), in the registry's order (material_names()).
+std::vector<MaterialNames> material_descriptions();
+
 /// The cofactor matrix C = ∂(det F)/∂F (3×3): its rows are cross products of F's rows, so it is
 /// defined for every F and equals det F · F⁻ᵀ when F is invertible.
 Eigen::Matrix3d cofactor(const Eigen::Matrix3d& F);

@@ -26,8 +26,9 @@ struct Settings {
     double seconds = 0.2;                          ///< measuring time per timed kernel [s]
 };
 
-/// A force model's name (force_model_names()) as the figures' legends write it, e.g.
-/// "stable-neo-hookean" -> "stable neo-Hookean (course)"; an unknown name is returned as it is.
+/// A force model's name (force_model_names()) as the figures' legends write it: a material's
+/// in_words (material_descriptions(), e.g. "stable-neo-hookean" -> "stable neo-Hookean (course)");
+/// any other name ("linear", "corotational") as it is.
 std::string model_in_words(const std::string& name);
 
 void materials_study(const RunContext& run, const Settings& settings);

@@ -56,11 +56,10 @@ double lateral_stretch(const Material& material, double stretch)
 
 std::string model_in_words(const std::string& name)
 {
-    return name == "stvk"                       ? std::string("St. Venant-Kirchhoff")
-           : name == "neo-hookean"              ? std::string("neo-Hookean")
-           : name == "stable-neo-hookean"       ? std::string("stable neo-Hookean (course)")
-           : name == "stable-neo-hookean-paper" ? std::string("stable neo-Hookean (Smith et al.)")
-                                                : name;
+    for (const MaterialNames& material : material_descriptions())
+        if (material.name == name)
+            return material.in_words;
+    return name;
 }
 
 void materials_study(const RunContext& run, const Settings& settings)

@@ -103,10 +103,14 @@ public:
     /// passes through the triangle (the three volumes (x0, x1, edge) agree in sign). The triangles
     /// whose boxes meet the segment's box are found with the tree. What a scene reader uses to
     /// refuse a body that starts through a sheet, where every vertex may be far from it.
-    bool crosses(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1) const;
+    bool crosses(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1) const override;
+    /// False: its distance is unsigned (a sheet).
+    bool has_inside() const override { return false; }
 
-    /// The triangles at the rest placement [m] (at time t the obstacle stands at V + t·velocity()):
-    /// what a frame writer draws.
+    /// Its triangles, as surface() (around is not needed).
+    TriMesh local_surface(const std::array<double, 6>& /*around*/) const override { return surface_; }
+
+    /// The triangles at the rest placement [m] (at time t the obstacle stands at V + t·velocity()).
     const TriMesh& surface() const { return surface_; }
     /// The nodes of its AABB tree.
     int tree_nodes() const { return static_cast<int>(tree_.nodes.size()); }

@@ -8,8 +8,11 @@
 // so d(x, t) = d₀(x − t w), where d₀ is the distance to the rest placement. Every function taking a
 // point in the obstacle's rest frame is named local_*; the public ones take the time.
 
+#include "common/mesh.hpp"
+
 #include <Eigen/Core>
 
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -50,7 +53,7 @@ public:
     /// ∇²d₀(p) (3×3, symmetric) [1/m]: 0 for a plane or a box face, (I − n nᵀ)/|p − c| for a sphere.
     virtual Eigen::Matrix3d local_hessian(const Eigen::Vector3d& p) const = 0;
     /// The first s ≥ 0 at which the path p + s·dp (p outside, d₀(p) > 0) reaches d₀ = 0, or +∞ when
-    /// it never does. Exact for a half-space and a sphere; a box answers a conservative s (never
+    /// it never does. Exact for a half-space, a sphere and a capsule; a box answers a conservative s (never
     /// beyond the true one).
     virtual double local_time_of_impact(const Eigen::Vector3d& p, const Eigen::Vector3d& dp) const = 0;
 
@@ -62,6 +65,21 @@ public:
 
     /// Its corners and edges at the rest placement (ObstacleFeatures; default: none, a smooth shape).
     virtual ObstacleFeatures local_features() const { return {}; }
+
+    /// The triangles it is drawn as at the rest placement (V #V×3 [m], F #F×3): a solid's surface, a
+    /// mesh's own triangles. A half-space has no edge: it is drawn as the square of its plane under
+    /// `around` = (xmin, xmax, ymin, ymax, zmin, zmax) [m] (the box's corners projected on the plane,
+    /// grown by a fifth of the box's diagonal each way); the others ignore around.
+    /// docs/14_contact.md#obstacles
+    virtual TriMesh local_surface(const std::array<double, 6>& around) const = 0;
+
+    /// Whether d₀ has an inside (< 0): true for a solid (the default); false for a sheet of triangles,
+    /// whose distance is unsigned, so that a body must start beyond d̂ of it, and an edge of a body
+    /// may pass through it with both ends clear (crosses).
+    virtual bool has_inside() const { return true; }
+    /// Whether the segment from x0 to x1 (rest frame) passes through a sheet of the obstacle (see
+    /// MeshObstacle::crosses); false for a solid (the default), whose start is checked at the vertices.
+    virtual bool crosses(const Eigen::Vector3d& /*x0*/, const Eigen::Vector3d& /*x1*/) const { return false; }
 
     /// d(x, t) = d₀(x − t w) [m].
     double distance(const Eigen::Vector3d& x, double time) const { return local_distance(x - time * velocity_); }
@@ -79,6 +97,8 @@ public:
     {
         return local_time_of_impact(x - time * velocity_, dx);
     }
+    /// Its drawn triangles at time t: local_surface(around − t w) moved by t w (around: as there, at t).
+    TriMesh surface_at(const std::array<double, 6>& around, double time) const;
 
     const Eigen::Vector3d& velocity() const { return velocity_; }
     double friction() const { return friction_; }
@@ -108,6 +128,8 @@ public:
     Eigen::Vector3d local_gradient(const Eigen::Vector3d& p) const override;
     Eigen::Matrix3d local_hessian(const Eigen::Vector3d& p) const override;
     double local_time_of_impact(const Eigen::Vector3d& p, const Eigen::Vector3d& dp) const override;
+    /// The square of its plane under around (two triangles).
+    TriMesh local_surface(const std::array<double, 6>& around) const override;
     const Eigen::Vector3d& normal() const { return normal_; }
 
 private:
@@ -126,6 +148,8 @@ public:
     Eigen::Vector3d local_gradient(const Eigen::Vector3d& p) const override;
     Eigen::Matrix3d local_hessian(const Eigen::Vector3d& p) const override;
     double local_time_of_impact(const Eigen::Vector3d& p, const Eigen::Vector3d& dp) const override;
+    /// A triangulated ball (swept_ball_surface(c, c, r)).
+    TriMesh local_surface(const std::array<double, 6>& around) const override;
 
 private:
     Eigen::Vector3d centre_;
@@ -151,10 +175,43 @@ public:
     double local_time_of_impact(const Eigen::Vector3d& p, const Eigen::Vector3d& dp) const override;
     /// Its 8 corners c + R (±h₀, ±h₁, ±h₂) and 12 edges.
     ObstacleFeatures local_features() const override;
+    /// Its 6 faces (12 triangles, outward).
+    TriMesh local_surface(const std::array<double, 6>& around) const override;
 
 private:
     Eigen::Vector3d centre_, half_;
     Eigen::Matrix3d rotation_;
 };
+
+/// A solid capsule: the points within r of the segment from a to b (a rod, a rail, a pipe). With
+/// e = (b − a)/|b − a| and c(x) = a + clamp((x − a)·e, 0, |b − a|) e the segment's closest point:
+/// d = |x − c| − r, ∇d = n = (x − c)/|x − c|; ∇²d = (I − e eᵀ − n nᵀ)/|x − c| beside the segment (a
+/// cylinder's) and (I − n nᵀ)/|x − c| beyond an end (a sphere's). The time of impact is exact: the
+/// earliest of the side's root (the infinite cylinder's, where it lies between the ends) and each
+/// end ball's (Sphere's). Smooth: no features. docs/14_contact.md#obstacles
+class Capsule final : public Obstacle {
+public:
+    /// fem::Error for r ≤ 0 (or not finite), a non-finite end, or a <= 0 segment length |b − a|.
+    Capsule(const Eigen::Vector3d& start, const Eigen::Vector3d& end, double radius, double friction = 0.0,
+            const Eigen::Vector3d& velocity = Eigen::Vector3d::Zero());
+    std::string name() const override { return "capsule"; }
+    double local_distance(const Eigen::Vector3d& p) const override;
+    Eigen::Vector3d local_gradient(const Eigen::Vector3d& p) const override;
+    Eigen::Matrix3d local_hessian(const Eigen::Vector3d& p) const override;
+    double local_time_of_impact(const Eigen::Vector3d& p, const Eigen::Vector3d& dp) const override;
+    /// A triangulated tube with a half ball at each end (swept_ball_surface(a, b, r)).
+    TriMesh local_surface(const std::array<double, 6>& around) const override;
+
+private:
+    /// The closest point of the segment to p.
+    Eigen::Vector3d closest(const Eigen::Vector3d& p) const;
+    Eigen::Vector3d start_, end_, axis_;  // axis_: the unit e
+    double length_, radius_;
+};
+
+/// The surface swept by a ball of radius r from a to b, drawn with 48 points a ring: 13 rings of a
+/// half ball around b (polar angles 0 … π/2 from e = (b − a)/|b − a|), 13 of a half ball around a
+/// (π/2 … π), joined by a tube; one ball when a = b (e = z then). V ((26 or 25)·48 × 3) [m], F outward.
+TriMesh swept_ball_surface(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double radius);
 
 }  // namespace fem::contact

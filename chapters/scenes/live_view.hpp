@@ -21,8 +21,8 @@ namespace fem::scenes {
 /// range when the scene fixes them. The PNG frames and the live view use it alike.
 fig::RenderOptions frame_view(const SceneSpec& scene);
 
-/// How a model is named on a frame: "linear", "corotational", "StVK", "neo-Hookean", "stable
-/// neo-Hookean" (chapter 12's names, as the docs write them); any other name as it is.
+/// How a model is named on a frame: a material's label (chapter 12's material_descriptions(), e.g.
+/// "StVK", "stable neo-Hookean"); any other name ("linear", "corotational") as it is.
 std::string model_label(const std::string& model);
 
 /// How many times slower than real time the run's frames play: the video's (make_video) frames per
@@ -39,11 +39,11 @@ std::string frame_caption(const SceneSpec& scene, const std::string& models, dou
 /// title, frame_caption under it, and when the displacement is drawn exaggerated a line saying so.
 std::string frame_title(const SceneSpec& scene, const std::string& models, double time);
 
-/// The shapes the scene's obstacles are drawn as at time t (fig::Prop, grey), each moved by t·w:
-/// a half-space as the square of its plane under body_box (the box's corners projected on the plane,
-/// grown by a fifth of the box's diagonal each way: the floor or slope where the body moves), a sphere as
-/// a fine triangulated ball, a box as its 12 triangles, a mesh as its triangles. body_box: (xmin, xmax, ymin, ymax, zmin,
-/// zmax) of the body's motion [m]. docs/scenes.md#outputs
+/// The shapes the scene's obstacles are drawn as at time t (fig::Prop, grey): each one's own
+/// triangles (chapter 14's Obstacle::surface_at), moved by t·w; a solid whole, a mesh as its
+/// triangles, a half-space as the square of its plane under body_box (the floor or slope where the
+/// body moves). body_box: (xmin, xmax, ymin, ymax, zmin, zmax) of the body's motion [m].
+/// docs/scenes.md#outputs
 std::vector<fig::Prop> obstacle_props(const SceneSpec& scene, const std::array<double, 6>& body_box, double time);
 
 /// The live view of --view: a window that plays the run's frames as they come, one frame interval of

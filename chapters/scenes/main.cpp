@@ -96,6 +96,8 @@ int main(int argc, char** argv)
             throw Error("--view: plays one run; --compare runs many without frames");
         if (forever && !view)
             throw Error("--forever: needs --view (it runs until the window's q)");
+        if (html && forever)
+            throw Error("--html: writes a file, and --forever writes none");
         if (forever && !fig::display_available())
             throw Error("--forever: needs a display for --view (set DISPLAY, or run under xvfb-run -a): it runs "
                         "until the window's q");
@@ -105,8 +107,6 @@ int main(int argc, char** argv)
             throw Error("--pull-stiffness: needs --view (the mouse pulls in the live view)");
         if (html && compare)
             throw Error("--html: writes the page of one run; --compare runs many without frames");
-        if (html && forever)
-            throw Error("--html: writes a file, and --forever writes none");
         for (const std::string& file : files) {
             scenes.push_back(read_scene(file, settings, quick));
             scenes.back().output.html = scenes.back().output.html || html;

@@ -36,7 +36,7 @@ namespace fem::scenes {
 /// iteration at the slowest step. docs/scenes.md#obstacles
 inline constexpr int contact_newton_iterations = 200;
 
-/// Chapter 14's obstacles of a scene (make_obstacle of each spec).
+/// Chapter 14's obstacles of a scene (each spec's obstacle).
 std::vector<std::shared_ptr<const contact::Obstacle>> scene_obstacles(const SceneSpec& scene);
 
 /// A body's integrator in a scene with obstacles (header comment): its own integrator while out of

@@ -149,25 +149,13 @@ struct SkinSpec {
     std::string body;                   ///< the body that carries it
 };
 
-/// A rigid obstacle every body must stay out of (chapter 14): a half-space (a floor, a slope), a
-/// sphere, a box or a triangle mesh (a bowl, stairs: any surface file), fixed or moving with a
-/// constant velocity, with Coulomb friction μ against every body. docs/scenes.md#obstacles
+/// A rigid obstacle every body must stay out of (chapter 14): one of obstacle_types() (a
+/// half-space, a sphere, a box, a triangle mesh, …), fixed or moving with a constant velocity, with
+/// Coulomb friction μ against every body. docs/scenes.md#obstacles
 struct ObstacleSpec {
-    enum class Kind { half_space, sphere, box, mesh };
-    Kind kind = Kind::half_space;
-    Eigen::Vector3d point = Eigen::Vector3d::Zero();    ///< half-space: a point on its plane [m]
-    Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< half-space: its outward normal (unit)
-    Eigen::Vector3d center = Eigen::Vector3d::Zero();   ///< sphere, box: the centre [m]
-    double radius = 1.0;                                ///< sphere [m]
-    Eigen::Vector3d size = Eigen::Vector3d::Ones();     ///< box: edge lengths along its own axes [m]
-    Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();    ///< box: its axes are the world's turned about this (unit)
-    double angle = 0.0;                                 ///< box: … by this angle [rad]
-    std::filesystem::path file;                         ///< mesh: its surface file (.obj, .stl, .ply, .vtu)
-    double scale = 1.0;                                 ///< mesh: the file's coordinates × scale …
-    Eigen::Vector3d translate = Eigen::Vector3d::Zero(); ///< mesh: … + translate [m]
-    TriMesh surface;                                    ///< mesh: the triangles, placed (scaled, translated)
-    Eigen::Vector3d velocity = Eigen::Vector3d::Zero(); ///< w [m/s]; zero: fixed
-    double friction = 0.0;                              ///< Coulomb's μ ≥ 0
+    std::string type;                                   ///< its [[obstacle]] type, e.g. "sphere"
+    std::shared_ptr<const contact::Obstacle> obstacle;  ///< chapter 14's obstacle, placed, with its μ and w
+    std::filesystem::path file;                         ///< the file it was read from (a mesh's), else empty
 };
 
 /// The constants of contact a scene may set (chapter 14's ContactOptions). docs/scenes.md#obstacles
@@ -253,10 +241,10 @@ std::vector<std::filesystem::path> input_files(const SceneSpec& scene);
 /// the scene's gravity, Δt and duration.
 dynamics::Scene dynamics_scene(const SceneSpec& scene, const BodySpec& body);
 
-/// Chapter 14's obstacle of a spec: HalfSpace(point, normal), Sphere(center, radius),
-/// Box(center, size/2, R) with R the rotation by angle about axis, or MeshObstacle(surface); each with
-/// the spec's μ and velocity.
-std::shared_ptr<const contact::Obstacle> make_obstacle(const ObstacleSpec& spec);
+/// The type names of [[obstacle]], in the order the scene reader lists them ("half-space",
+/// "sphere", "box", "mesh", …): the registry in solutions/scenes/scene_obstacles.cpp, one entry a
+/// type, its own fields and how they are read, checked and built. docs/scenes.md#obstacles
+std::vector<std::string> obstacle_types();
 
 /// The vertices of mesh a selector selects, ascending. fem::Error (naming selector.where) if none.
 std::vector<int> select_vertices(const TetMesh& mesh, const Selector& selector);

@@ -2,10 +2,14 @@
 
 #include "common/error.hpp"
 
+#include <Eigen/Geometry>
 #include <Eigen/LU>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
+#include <vector>
 
 namespace fem::contact {
 namespace {
@@ -25,6 +29,19 @@ Obstacle::Obstacle(const Eigen::Vector3d& velocity, double friction) : velocity_
     require_finite_point(velocity, "velocity [m/s]");
     if (!(std::isfinite(friction) && friction >= 0.0))
         throw Error(str("obstacle: the friction coefficient mu must be a finite number >= 0, got ", friction));
+}
+
+TriMesh Obstacle::surface_at(const std::array<double, 6>& around, double time) const
+{
+    const Eigen::Vector3d shift = time * velocity_;
+    std::array<double, 6> local = around;
+    for (int axis = 0; axis < 3; ++axis) {
+        local[2 * axis] -= shift[axis];
+        local[2 * axis + 1] -= shift[axis];
+    }
+    TriMesh drawn = local_surface(local);
+    drawn.V.rowwise() += shift.transpose();
+    return drawn;
 }
 
 void Obstacle::local_pieces(const Eigen::Vector3d& p, double reach, std::vector<DistancePiece>& pieces) const
@@ -75,6 +92,31 @@ double HalfSpace::local_time_of_impact(const Eigen::Vector3d& p, const Eigen::Ve
     return s;
 }
 
+TriMesh HalfSpace::local_surface(const std::array<double, 6>& around) const
+{
+    const Eigen::Vector3d other = std::abs(normal_.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+    const Eigen::Vector3d u = normal_.cross(other).normalized(), v = normal_.cross(u);
+    double lo_u = infinity, hi_u = -infinity, lo_v = infinity, hi_v = -infinity;
+    for (int corner = 0; corner < 8; ++corner) {
+        const Eigen::Vector3d c(around[(corner & 1) ? 1 : 0], around[(corner & 2) ? 3 : 2], around[(corner & 4) ? 5 : 4]);
+        lo_u = std::min(lo_u, u.dot(c - point_));
+        hi_u = std::max(hi_u, u.dot(c - point_));
+        lo_v = std::min(lo_v, v.dot(c - point_));
+        hi_v = std::max(hi_v, v.dot(c - point_));
+    }
+    const double margin =
+        0.2 * Eigen::Vector3d(around[1] - around[0], around[3] - around[2], around[5] - around[4]).norm();
+    TriMesh patch;
+    patch.V.resize(4, 3);
+    int row = 0;
+    for (double a : {lo_u - margin, hi_u + margin})
+        for (double b : {lo_v - margin, hi_v + margin})
+            patch.V.row(row++) = (point_ + a * u + b * v).transpose();
+    patch.F.resize(2, 3);
+    patch.F << 0, 1, 3, 0, 3, 2;
+    return patch;
+}
+
 // --- Sphere ----------------------------------------------------------------------------------------
 
 Sphere::Sphere(const Eigen::Vector3d& centre, double radius, double friction, const Eigen::Vector3d& velocity)
@@ -119,6 +161,11 @@ double Sphere::local_time_of_impact(const Eigen::Vector3d& p, const Eigen::Vecto
         s = 2.0 * k / (-b + std::sqrt(discriminant));
     // END EXERCISE
     return s;
+}
+
+TriMesh Sphere::local_surface(const std::array<double, 6>&) const
+{
+    return swept_ball_surface(centre_, centre_, radius_);
 }
 
 // --- Box -------------------------------------------------------------------------------------------
@@ -215,6 +262,128 @@ ObstacleFeatures Box::local_features() const
             if ((k & bit) == 0)
                 features.edges.row(e++) << k, k | bit;
     return features;
+}
+
+TriMesh Box::local_surface(const std::array<double, 6>&) const
+{
+    TriMesh box;
+    box.V = local_features().corners;
+    box.F.resize(12, 3);
+    box.F << 0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6, 0, 1, 5, 0, 5, 4, 2, 6, 7, 2, 7, 3, 0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5;
+    return box;
+}
+
+// --- Capsule ---------------------------------------------------------------------------------------
+
+Capsule::Capsule(const Eigen::Vector3d& start, const Eigen::Vector3d& end, double radius, double friction,
+                 const Eigen::Vector3d& velocity)
+    : Obstacle(velocity, friction), start_(start), end_(end), length_((end - start).norm()), radius_(radius)
+{
+    require_finite_point(start, "start of the capsule's segment");
+    require_finite_point(end, "end of the capsule's segment");
+    require_positive(radius, "capsule radius [m]");
+    if (!(length_ > 0.0))
+        throw Error("capsule: the segment's start and end must differ (a capsule around a point is a sphere)");
+    axis_ = (end - start) / length_;
+}
+
+Eigen::Vector3d Capsule::closest(const Eigen::Vector3d& p) const
+{
+    return start_ + std::clamp(axis_.dot(p - start_), 0.0, length_) * axis_;
+}
+
+double Capsule::local_distance(const Eigen::Vector3d& p) const
+{
+    return (p - closest(p)).norm() - radius_;
+}
+
+Eigen::Vector3d Capsule::local_gradient(const Eigen::Vector3d& p) const
+{
+    const Eigen::Vector3d r = p - closest(p);
+    const double length = r.norm();
+    if (length > 0.0)
+        return r / length;
+    // On the segment itself, where the barrier never looks: any direction across it.
+    const Eigen::Vector3d other = std::abs(axis_.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+    return axis_.cross(other).normalized();
+}
+
+Eigen::Matrix3d Capsule::local_hessian(const Eigen::Vector3d& p) const
+{
+    const double along = axis_.dot(p - start_);
+    const double length = (p - closest(p)).norm();
+    if (!(length > 0.0))
+        return Eigen::Matrix3d::Zero();
+    const Eigen::Vector3d n = local_gradient(p);
+    Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - n * n.transpose();
+    if (along > 0.0 && along < length_)  // beside the segment: no curvature along the axis
+        across -= axis_ * axis_.transpose();
+    return across / length;
+}
+
+double Capsule::local_time_of_impact(const Eigen::Vector3d& p, const Eigen::Vector3d& dp) const
+{
+    // The first s where |p + s dp − c|² = r² (c a ball's centre): 2k/(−b + √(b² − 4ak)), as Sphere's.
+    const auto ball = [&](const Eigen::Vector3d& centre) {
+        const Eigen::Vector3d r = p - centre;
+        const double a = dp.squaredNorm(), b = 2.0 * dp.dot(r), k = r.squaredNorm() - radius_ * radius_;
+        const double discriminant = b * b - 4.0 * a * k;
+        return b < 0.0 && discriminant >= 0.0 ? 2.0 * k / (-b + std::sqrt(discriminant)) : infinity;
+    };
+    double s = std::min(ball(start_), ball(end_));
+    // The side: the same quadratic across the axis (the components of p − a and dp normal to e),
+    // from outside the infinite cylinder, counted where its root lies between the ends.
+    const Eigen::Vector3d w = (p - start_) - axis_.dot(p - start_) * axis_, v = dp - axis_.dot(dp) * axis_;
+    const double a = v.squaredNorm(), b = 2.0 * v.dot(w), k = w.squaredNorm() - radius_ * radius_;
+    const double discriminant = b * b - 4.0 * a * k;
+    if (k > 0.0 && b < 0.0 && discriminant >= 0.0) {
+        const double side = 2.0 * k / (-b + std::sqrt(discriminant));
+        const double along = axis_.dot(p + side * dp - start_);
+        if (along >= 0.0 && along <= length_)
+            s = std::min(s, side);
+    }
+    return s;
+}
+
+TriMesh Capsule::local_surface(const std::array<double, 6>&) const
+{
+    return swept_ball_surface(start_, end_, radius_);
+}
+
+TriMesh swept_ball_surface(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double radius)
+{
+    constexpr int rings = 24, segments = 48;  // polar steps over π, points a ring
+    const bool tube = (b - a).norm() > 0.0;
+    const Eigen::Vector3d e = tube ? Eigen::Vector3d((b - a).normalized()) : Eigen::Vector3d::UnitZ();
+    const Eigen::Vector3d other = std::abs(e.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+    const Eigen::Vector3d u = tube ? Eigen::Vector3d(e.cross(other).normalized()) : Eigen::Vector3d::UnitX();
+    const Eigen::Vector3d w = e.cross(u);
+    // Ring j's polar angle and centre: 0 … π/2 around b, then (a tube's second equator) π/2 … π around a.
+    std::vector<std::pair<double, Eigen::Vector3d>> ring;
+    for (int i = 0; i <= rings; ++i) {
+        if (tube && 2 * i == rings)
+            ring.emplace_back(M_PI * i / rings, b);
+        ring.emplace_back(M_PI * i / rings, 2 * i < rings ? b : a);
+    }
+    const int count = static_cast<int>(ring.size());
+    TriMesh surface;
+    surface.V.resize(count * segments, 3);
+    for (int i = 0; i < count; ++i)
+        for (int j = 0; j < segments; ++j) {
+            const double polar = ring[i].first, around = 2.0 * M_PI * j / segments;
+            surface.V.row(i * segments + j) =
+                (ring[i].second + radius * (std::sin(polar) * std::cos(around) * u +
+                                            std::sin(polar) * std::sin(around) * w + std::cos(polar) * e)).transpose();
+        }
+    surface.F.resize(2 * (count - 1) * segments, 3);
+    int row = 0;
+    for (int i = 0; i + 1 < count; ++i)
+        for (int j = 0; j < segments; ++j) {
+            const int p = i * segments + j, q = i * segments + (j + 1) % segments;
+            surface.F.row(row++) << p, p + segments, q + segments;
+            surface.F.row(row++) << p, q + segments, q;
+        }
+    return surface;
 }
 
 }  // namespace fem::contact

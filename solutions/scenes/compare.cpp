@@ -3,6 +3,8 @@
 
 #include "13_skinning/skinning.hpp"
 
+#include "12_hyperelastic_newton/materials.hpp"
+
 #include "common/error.hpp"
 #include "common/table.hpp"
 
@@ -70,7 +72,13 @@ ModelComparison compare_models(const SceneSpec& scene, const RunContext* run)
             largest_displacement = std::max(largest_displacement, (x - scene.bodies[b].mesh.V).rowwise().norm().maxCoeff());
     }
 
-    for (const std::string model : {"stable-neo-hookean", "linear", "corotational", "stvk", "neo-hookean", "auto"}) {
+    // The reference's model at the scene's Δt, then every other model the comparison runs, then auto.
+    std::vector<std::string> models{reference_model, "linear", "corotational"};
+    for (const hyper::MaterialNames& material : hyper::material_descriptions())
+        if (material.compared && material.name != reference_model)
+            models.push_back(material.name);
+    models.push_back("auto");
+    for (const std::string& model : models) {
         ModelError row;
         row.model = model;
         RunResult result;

@@ -4,16 +4,15 @@
 #include "scenes/run_outputs.hpp"
 #include "scenes/runner.hpp"
 
+#include "12_hyperelastic_newton/materials.hpp"
+
 #include "common/error.hpp"
 #include "common/interrupt.hpp"
 #include "common/motion.hpp"
 
-#include <Eigen/Geometry>
-
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <limits>
 #include <iostream>
 #include <thread>
 
@@ -59,7 +58,10 @@ fig::RenderOptions frame_view(const SceneSpec& scene)
 
 std::string model_label(const std::string& model)
 {
-    return model == "stvk" ? "StVK" : model == "neo-hookean" ? "neo-Hookean" : model == "stable-neo-hookean" ? "stable neo-Hookean" : model;
+    for (const hyper::MaterialNames& material : hyper::material_descriptions())
+        if (material.name == model)
+            return material.label;
+    return model;
 }
 
 double slow_motion(const SceneSpec& scene)
@@ -84,103 +86,14 @@ std::string frame_title(const SceneSpec& scene, const std::string& models, doubl
     return title;
 }
 
-namespace {
-
-/// Two unit vectors spanning the plane of unit normal n.
-std::pair<Eigen::Vector3d, Eigen::Vector3d> plane_axes(const Eigen::Vector3d& n)
-{
-    const Eigen::Vector3d other = std::abs(n.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
-    const Eigen::Vector3d u = n.cross(other).normalized();
-    return {u, n.cross(u)};
-}
-
-/// The square of the plane through p with unit normal n under box: its corners projected, grown by
-/// a fifth of its diagonal each way (two triangles).
-io::MeshData plane_patch(const Eigen::Vector3d& p, const Eigen::Vector3d& n, const std::array<double, 6>& box)
-{
-    const auto [u, v] = plane_axes(n);
-    double lo_u = std::numeric_limits<double>::infinity(), hi_u = -lo_u, lo_v = lo_u, hi_v = -lo_u;
-    for (int corner = 0; corner < 8; ++corner) {
-        const Eigen::Vector3d c(box[(corner & 1) ? 1 : 0], box[(corner & 2) ? 3 : 2], box[(corner & 4) ? 5 : 4]);
-        lo_u = std::min(lo_u, u.dot(c - p));
-        hi_u = std::max(hi_u, u.dot(c - p));
-        lo_v = std::min(lo_v, v.dot(c - p));
-        hi_v = std::max(hi_v, v.dot(c - p));
-    }
-    const double margin = 0.2 * Eigen::Vector3d(box[1] - box[0], box[3] - box[2], box[5] - box[4]).norm();
-    io::MeshData patch;
-    patch.points.resize(4, 3);
-    int row = 0;
-    for (double a : {lo_u - margin, hi_u + margin})
-        for (double b : {lo_v - margin, hi_v + margin})
-            patch.points.row(row++) = (p + a * u + b * v).transpose();
-    patch.cells.resize(2, 3);
-    patch.cells << 0, 1, 3, 0, 3, 2;
-    return patch;
-}
-
-/// A ball of centre c and radius r: 24 rings of 48 triangles' quads.
-io::MeshData ball(const Eigen::Vector3d& c, double r)
-{
-    const int rings = 24, segments = 48;
-    io::MeshData sphere;
-    sphere.points.resize((rings + 1) * segments, 3);
-    for (int i = 0; i <= rings; ++i)
-        for (int j = 0; j < segments; ++j) {
-            const double polar = M_PI * i / rings, around = 2.0 * M_PI * j / segments;
-            sphere.points.row(i * segments + j) =
-                (c + r * Eigen::Vector3d(std::sin(polar) * std::cos(around), std::sin(polar) * std::sin(around),
-                                         std::cos(polar))).transpose();
-        }
-    sphere.cells.resize(2 * rings * segments, 3);
-    int row = 0;
-    for (int i = 0; i < rings; ++i)
-        for (int j = 0; j < segments; ++j) {
-            const int a = i * segments + j, b = i * segments + (j + 1) % segments;
-            sphere.cells.row(row++) << a, a + segments, b + segments;
-            sphere.cells.row(row++) << a, b + segments, b;
-        }
-    return sphere;
-}
-
-/// A box: centre c, edge lengths size along the columns of R (12 triangles).
-io::MeshData box_surface(const Eigen::Vector3d& c, const Eigen::Vector3d& size, const Eigen::Matrix3d& R)
-{
-    io::MeshData box;
-    box.points.resize(8, 3);
-    for (int corner = 0; corner < 8; ++corner) {
-        const Eigen::Vector3d sign((corner & 1) ? 0.5 : -0.5, (corner & 2) ? 0.5 : -0.5, (corner & 4) ? 0.5 : -0.5);
-        box.points.row(corner) = (c + R * sign.cwiseProduct(size)).transpose();
-    }
-    box.cells.resize(12, 3);
-    box.cells << 0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6, 0, 1, 5, 0, 5, 4, 2, 6, 7, 2, 7, 3, 0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5;
-    return box;
-}
-
-}  // namespace
-
 std::vector<fig::Prop> obstacle_props(const SceneSpec& scene, const std::array<double, 6>& body_box, double time)
 {
     std::vector<fig::Prop> props;
-    for (const ObstacleSpec& obstacle : scene.obstacles) {
-        const Eigen::Vector3d shift = time * obstacle.velocity;
+    for (const ObstacleSpec& spec : scene.obstacles) {
+        const TriMesh drawn = spec.obstacle->surface_at(body_box, time);
         fig::Prop prop;
-        switch (obstacle.kind) {  // one case per kind of obstacle
-        case ObstacleSpec::Kind::half_space:
-            prop.shape = plane_patch(obstacle.point + shift, obstacle.normal.normalized(), body_box);
-            break;
-        case ObstacleSpec::Kind::sphere:
-            prop.shape = ball(obstacle.center + shift, obstacle.radius);
-            break;
-        case ObstacleSpec::Kind::box:
-            prop.shape = box_surface(obstacle.center + shift, obstacle.size,
-                                     Eigen::AngleAxisd(obstacle.angle, obstacle.axis.normalized()).toRotationMatrix());
-            break;
-        case ObstacleSpec::Kind::mesh:  // its triangles, placed already
-            prop.shape.points = obstacle.surface.V.rowwise() + shift.transpose();
-            prop.shape.cells = obstacle.surface.F;
-            break;
-        }
+        prop.shape.points = drawn.V;
+        prop.shape.cells = drawn.F;
         props.push_back(std::move(prop));
     }
     return props;

@@ -9,7 +9,7 @@ std::vector<std::shared_ptr<const contact::Obstacle>> scene_obstacles(const Scen
 {
     std::vector<std::shared_ptr<const contact::Obstacle>> obstacles;
     for (const ObstacleSpec& spec : scene.obstacles)
-        obstacles.push_back(make_obstacle(spec));
+        obstacles.push_back(spec.obstacle);
     return obstacles;
 }
 

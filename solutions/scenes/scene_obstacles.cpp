@@ -1,5 +1,6 @@
-// The scene file's obstacles: read and checked ([[obstacle]]), the bodies' start clear of them, and
-// chapter 14's obstacle of each. docs/scenes.md#obstacles
+// The scene file's obstacles: the registry of [[obstacle]] types (one entry a type: its name, its
+// own fields, and how they are read, checked and built into chapter 14's obstacle), the bodies'
+// start clear of them. docs/scenes.md#obstacles
 #include "scenes/scene_parts.hpp"
 
 #include "14_contact/mesh_obstacle.hpp"
@@ -10,91 +11,186 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <memory>
 
 namespace fem::scenes {
+namespace detail {
+namespace {
+
+/// What a type's own fields build, once μ and w are read: chapter 14's obstacle.
+using Build = std::function<std::shared_ptr<const contact::Obstacle>(double friction, const Eigen::Vector3d& velocity)>;
+
+/// A half-space: point (default the origin) and normal (not 0, normalised; default +z).
+Build read_half_space(const Fields& fields, const std::filesystem::path&, std::filesystem::path&)
+{
+    const Eigen::Vector3d point = fields.vector("point", Eigen::Vector3d::Zero());
+    const Eigen::Vector3d normal = fields.vector("normal", Eigen::Vector3d::UnitZ(), true).normalized();
+    return [=](double friction, const Eigen::Vector3d& velocity) {
+        return std::make_shared<contact::HalfSpace>(point, normal, friction, velocity);
+    };
+}
+
+/// A sphere: center (default the origin) and radius > 0 (required).
+Build read_sphere(const Fields& fields, const std::filesystem::path&, std::filesystem::path&)
+{
+    const Eigen::Vector3d center = fields.vector("center", Eigen::Vector3d::Zero());
+    if (!fields.has("radius"))
+        fields.missing("radius", "a sphere needs radius = r (m)");
+    const double radius = fields.positive("radius", 1.0);
+    return [=](double friction, const Eigen::Vector3d& velocity) {
+        return std::make_shared<contact::Sphere>(center, radius, friction, velocity);
+    };
+}
+
+/// A box: center, size (three edge lengths > 0, required), its axes the world's turned by angle
+/// (degrees in the file) about axis (not 0; default +z): Box(center, size/2, R).
+Build read_box(const Fields& fields, const std::filesystem::path&, std::filesystem::path&)
+{
+    const Eigen::Vector3d center = fields.vector("center", Eigen::Vector3d::Zero());
+    if (!fields.has("size"))
+        fields.missing("size", "a box needs size = [x, y, z] (its edge lengths, m)");
+    const Eigen::Vector3d size = fields.vector("size", Eigen::Vector3d::Ones());
+    if ((size.array() <= 0.0).any())
+        fields.fail(*fields.get("size"), "size", "must be three edge lengths > 0 (m)");
+    const Eigen::Vector3d axis = fields.vector("axis", Eigen::Vector3d::UnitZ(), true).normalized();
+    const double angle = fields.finite("angle", 0.0) * std::acos(-1.0) / 180.0;
+    const Eigen::Matrix3d rotation = Eigen::AngleAxisd(angle, axis).toRotationMatrix();
+    return [=](double friction, const Eigen::Vector3d& velocity) {
+        return std::make_shared<contact::Box>(center, 0.5 * size, rotation, friction, velocity);
+    };
+}
+
+/// A mesh: file (required; beside the scene file, then in data/), its coordinates × scale (> 0) +
+/// translate. file is set to the surface file read.
+Build read_mesh(const Fields& fields, const std::filesystem::path& scene_file, std::filesystem::path& file)
+{
+    if (!fields.has("file"))
+        fields.missing("file", "a mesh needs file = \"….obj\" (a triangle surface: .obj, .stl, .ply or .vtu)");
+    const toml::node& node = *fields.get("file");
+    file = existing_file(fields, "file", scene_file);
+    const std::string extension = file.extension().string();
+    if (extension != ".obj" && extension != ".stl" && extension != ".ply" && extension != ".vtu")
+        fields.fail(node, "file", str("has the extension '", extension, "'; a mesh obstacle is a triangle surface: .obj, .stl, .ply or .vtu"));
+    TriMesh surface;
+    try {
+        surface = io::read_tri_mesh(file);
+    } catch (const Error& e) {
+        fields.fail(node, "file", str("must be a surface of triangles, none degenerate: ", e.what()));
+    }
+    const double scale = fields.positive("scale", 1.0);
+    const Eigen::Vector3d translate = fields.vector("translate", Eigen::Vector3d::Zero());
+    surface.V = ((surface.V * scale).rowwise() + translate.transpose()).eval();
+    return [surface, what = file.string()](double friction, const Eigen::Vector3d& velocity) {
+        return std::make_shared<contact::MeshObstacle>(surface, friction, velocity, what);
+    };
+}
+
+/// A capsule: start and end (its segment's ends, required, apart) and radius > 0 (required).
+Build read_capsule(const Fields& fields, const std::filesystem::path&, std::filesystem::path&)
+{
+    for (const char* end : {"start", "end"})
+        if (!fields.has(end))
+            fields.missing(end, "a capsule needs start = [x, y, z] and end = [x, y, z] (its segment's ends, m)");
+    const Eigen::Vector3d start = fields.vector("start", Eigen::Vector3d::Zero());
+    const Eigen::Vector3d end = fields.vector("end", Eigen::Vector3d::Zero());
+    if (!((end - start).norm() > 0.0))
+        fields.fail(*fields.get("end"), "end", "must differ from start: a capsule's segment has a length > 0 (m)");
+    if (!fields.has("radius"))
+        fields.missing("radius", "a capsule needs radius = r (m)");
+    const double radius = fields.positive("radius", 1.0);
+    return [=](double friction, const Eigen::Vector3d& velocity) {
+        return std::make_shared<contact::Capsule>(start, end, radius, friction, velocity);
+    };
+}
+
+/// One [[obstacle]] type: its name, its own fields, and its reader (the fields read and checked;
+/// a mesh's file returned in the last argument).
+struct ObstacleType {
+    std::string name;
+    std::vector<std::string> fields;
+    Build (*read)(const Fields& fields, const std::filesystem::path& scene_file, std::filesystem::path& file);
+};
+
+/// Every type a scene file may name: adding an obstacle type is one entry here (and its class in
+/// chapter 14, which also draws it). docs/scenes.md#obstacles
+const std::vector<ObstacleType>& registry()
+{
+    static const std::vector<ObstacleType> types{
+        {"half-space", {"point", "normal"}, read_half_space},
+        {"sphere", {"center", "radius"}, read_sphere},
+        {"box", {"center", "size", "axis", "angle"}, read_box},
+        {"mesh", {"file", "scale", "translate"}, read_mesh},
+        {"capsule", {"start", "end", "radius"}, read_capsule},
+    };
+    return types;
+}
+
+}  // namespace
+}  // namespace detail
+
+std::vector<std::string> obstacle_types()
+{
+    std::vector<std::string> names;
+    for (const detail::ObstacleType& type : detail::registry())
+        names.push_back(type.name);
+    return names;
+}
+
 namespace detail {
 
 ObstacleSpec read_obstacle(const toml::table& table, const std::string& name, const Source& source,
                            const std::filesystem::path& scene_file)
 {
-    const std::vector<std::string> types{"half-space", "sphere", "box", "mesh"};
-    const std::vector<std::vector<std::string>> own{
-        {"point", "normal"}, {"center", "radius"}, {"center", "size", "axis", "angle"}, {"file", "scale", "translate"}};
-    const Fields fields(table, name, source, {"type", "point", "normal", "center", "radius", "size", "axis", "angle",
-                                              "file", "scale", "translate", "velocity", "friction"});
+    const std::vector<std::string> types = obstacle_types();
+    std::vector<std::string> allowed{"type"};
+    for (const ObstacleType& type : registry())
+        for (const std::string& key : type.fields)
+            if (std::find(allowed.begin(), allowed.end(), key) == allowed.end())
+                allowed.push_back(key);
+    allowed.insert(allowed.end(), {"velocity", "friction"});
+    const Fields fields(table, name, source, allowed);
     if (!fields.has("type"))
-        fields.missing("type", "one of half-space, sphere, box, mesh");
-    const std::string type = fields.text("type", "", types);
-    const std::size_t index = static_cast<std::size_t>(std::find(types.begin(), types.end(), type) - types.begin());
-    for (std::size_t other = 0; other < types.size(); ++other)
-        for (const std::string& key : own[other])
-            if (fields.has(key) && std::find(own[index].begin(), own[index].end(), key) == own[index].end())
-                fields.fail(*fields.get(key), key, str("belongs to type = \"", types[other], "\", not to type = \"", type, "\""));
+        fields.missing("type", str("one of ", joined(types)));
     ObstacleSpec o;
-    o.kind = static_cast<ObstacleSpec::Kind>(index);
-    if (o.kind == ObstacleSpec::Kind::half_space) {
-        o.point = fields.vector("point", o.point);
-        o.normal = fields.vector("normal", o.normal, true).normalized();
-    } else if (o.kind != ObstacleSpec::Kind::mesh) {
-        o.center = fields.vector("center", o.center);
-    }
-    if (o.kind == ObstacleSpec::Kind::sphere) {
-        if (!fields.has("radius"))
-            fields.missing("radius", "a sphere needs radius = r (m)");
-        o.radius = fields.positive("radius", o.radius);
-    }
-    if (o.kind == ObstacleSpec::Kind::box) {
-        if (!fields.has("size"))
-            fields.missing("size", "a box needs size = [x, y, z] (its edge lengths, m)");
-        o.size = fields.vector("size", o.size);
-        if ((o.size.array() <= 0.0).any())
-            fields.fail(*fields.get("size"), "size", "must be three edge lengths > 0 (m)");
-        o.axis = fields.vector("axis", o.axis, true).normalized();
-        o.angle = fields.finite("angle", 0.0) * std::acos(-1.0) / 180.0;
-    }
-    if (o.kind == ObstacleSpec::Kind::mesh) {
-        if (!fields.has("file"))
-            fields.missing("file", "a mesh needs file = \"….obj\" (a triangle surface: .obj, .stl, .ply or .vtu)");
-        const toml::node& node = *fields.get("file");
-        o.file = existing_file(fields, "file", scene_file);
-        const std::string extension = o.file.extension().string();
-        if (extension != ".obj" && extension != ".stl" && extension != ".ply" && extension != ".vtu")
-            fields.fail(node, "file", str("has the extension '", extension, "'; a mesh obstacle is a triangle surface: .obj, .stl, .ply or .vtu"));
-        try {
-            o.surface = io::read_tri_mesh(o.file);
-        } catch (const Error& e) {
-            fields.fail(node, "file", str("must be a surface of triangles, none degenerate: ", e.what()));
+    o.type = fields.text("type", "", types);
+    const ObstacleType& own = *std::find_if(registry().begin(), registry().end(),
+                                            [&](const ObstacleType& type) { return type.name == o.type; });
+    for (const std::string& key : allowed)
+        if (fields.has(key) && key != "type" && key != "velocity" && key != "friction" &&
+            std::find(own.fields.begin(), own.fields.end(), key) == own.fields.end()) {
+            const ObstacleType& other = *std::find_if(registry().begin(), registry().end(), [&](const ObstacleType& type) {
+                return std::find(type.fields.begin(), type.fields.end(), key) != type.fields.end();
+            });
+            fields.fail(*fields.get(key), key, str("belongs to type = \"", other.name, "\", not to type = \"", o.type, "\""));
         }
-        o.scale = fields.positive("scale", o.scale);
-        o.translate = fields.vector("translate", o.translate);
-        o.surface.V = ((o.surface.V * o.scale).rowwise() + o.translate.transpose()).eval();
-    }
-    o.friction = fields.number("friction", 0.0, [](double mu) { return mu >= 0.0 && mu <= 10.0; }, "a number in [0, 10]");
-    o.velocity = fields.vector("velocity", o.velocity);
+    const Build build = own.read(fields, scene_file, o.file);
+    const double friction = fields.number("friction", 0.0, [](double mu) { return mu >= 0.0 && mu <= 10.0; }, "a number in [0, 10]");
+    const Eigen::Vector3d velocity = fields.vector("velocity", Eigen::Vector3d::Zero());
+    o.obstacle = build(friction, velocity);
     return o;
 }
 
 void check_bodies_clear(const Fields& top, const toml::node& node, const std::string& name, const SceneSpec& scene)
 {
-    const auto obstacle = make_obstacle(scene.obstacles.back());
-    const auto* mesh = dynamic_cast<const contact::MeshObstacle*>(obstacle.get());
-    const double clearance = mesh ? scene.contact.activation_distance : 0.0;
+    const contact::Obstacle& obstacle = *scene.obstacles.back().obstacle;
+    const bool sheet = !obstacle.has_inside();
+    const double clearance = sheet ? scene.contact.activation_distance : 0.0;
     for (const BodySpec& body : scene.bodies) {
         for (Eigen::Index v = 0; v < body.mesh.V.rows(); ++v) {
-            const double d = obstacle->distance(body.mesh.V.row(v).transpose(), 0.0);
+            const double d = obstacle.distance(body.mesh.V.row(v).transpose(), 0.0);
             if (!(d > clearance))
                 top.fail(node, name,
-                         mesh ? str("body '", body.name, "' starts within contact.activation_distance = ", clearance,
+                         sheet ? str("body '", body.name, "' starts within contact.activation_distance = ", clearance,
                                     " m of it (vertex ", v, " at ", d, " m from its triangles; a mesh's distance ",
                                     "is unsigned, so a body must start clear of it): move the body or the obstacle")
                               : str("body '", body.name, "' starts inside it (vertex ", v, " at ", d,
                                     " m from its surface): move the body or the obstacle"));
         }
-        for (Eigen::Index t = 0; mesh && t < body.mesh.T.rows(); ++t)
+        for (Eigen::Index t = 0; sheet && t < body.mesh.T.rows(); ++t)
             for (int j = 0; j < 4; ++j)
                 for (int k = j + 1; k < 4; ++k)
-                    if (mesh->crosses(body.mesh.V.row(body.mesh.T(t, j)).transpose(),
+                    if (obstacle.crosses(body.mesh.V.row(body.mesh.T(t, j)).transpose(),
                                       body.mesh.V.row(body.mesh.T(t, k)).transpose()))
                         top.fail(node, name,
                                  str("body '", body.name, "' starts through it (the edge of tet ", t, " from vertex ",
@@ -104,21 +200,5 @@ void check_bodies_clear(const Fields& top, const toml::node& node, const std::st
 }
 
 }  // namespace detail
-
-std::shared_ptr<const contact::Obstacle> make_obstacle(const ObstacleSpec& spec)
-{
-    switch (spec.kind) {
-    case ObstacleSpec::Kind::half_space:
-        return std::make_shared<contact::HalfSpace>(spec.point, spec.normal, spec.friction, spec.velocity);
-    case ObstacleSpec::Kind::sphere:
-        return std::make_shared<contact::Sphere>(spec.center, spec.radius, spec.friction, spec.velocity);
-    case ObstacleSpec::Kind::mesh:
-        return std::make_shared<contact::MeshObstacle>(spec.surface, spec.friction, spec.velocity, spec.file.string());
-    case ObstacleSpec::Kind::box:
-        break;
-    }
-    const Eigen::Matrix3d rotation = Eigen::AngleAxisd(spec.angle, spec.axis).toRotationMatrix();
-    return std::make_shared<contact::Box>(spec.center, 0.5 * spec.size, rotation, spec.friction, spec.velocity);
-}
 
 }  // namespace fem::scenes

@@ -44,6 +44,24 @@ TEST_CASE("the model names: linear, corotational, then every registered material
     CHECK(make_integrator_for("corotational", {.integrator = "implicit-midpoint"})->order() == 2);
 }
 
+TEST_CASE("the material registry's names: each material's own, in words and as a label, in the registry's order", "[ch12]")
+{
+    const std::vector<MaterialNames> descriptions = material_descriptions();
+    const std::vector<std::string> names = material_names();
+    REQUIRE(descriptions.size() == names.size());
+    for (std::size_t i = 0; i < names.size(); ++i) {
+        CAPTURE(names[i]);
+        CHECK(descriptions[i].name == names[i]);
+        CHECK_FALSE(descriptions[i].in_words.empty());
+        CHECK_FALSE(descriptions[i].label.empty());
+    }
+    CHECK(descriptions[0].in_words == "St. Venant-Kirchhoff");
+    CHECK(descriptions[0].label == "StVK");
+    // The course's stable neo-Hookean is compared; the paper's form of it is not (a variant).
+    CHECK(descriptions[2].compared);
+    CHECK_FALSE(descriptions[3].compared);
+}
+
 TEST_CASE("the model names: unknown names and a hyperelastic model with another integrator are refused", "[ch12]")
 {
     const TetMesh mesh = box_mesh(1, 1, 1, Eigen::Vector3d(0.1, 0.1, 0.1));

@@ -6,6 +6,7 @@
 #include "14_contact/contact_scenes.hpp"
 #include "14_contact/mesh_obstacle.hpp"
 #include "14_contact/obstacles.hpp"
+#include "rest_weight.hpp"
 
 #include "12_hyperelastic_newton/newton.hpp"
 
@@ -77,23 +78,9 @@ TEST_CASE("a cube at rest on the floor: its contact forces sum to its weight at 
         block.step();
         REQUIRE(lowest_height(*block.body, block.state.u) > 0.0);
     }
-    const dynamics::State start = block.state;
-    const double scale = hyper::momentum_scale(*block.body, start, settings.time_step);
-    block.step();
-    const Eigen::VectorXd forces = block.contact->barrier_forces(block.state.u);
-    const Eigen::VectorXd& m = block.body->dof_masses();
-    Eigen::Vector3d total = Eigen::Vector3d::Zero(), momentum_change = Eigen::Vector3d::Zero();
-    for (Eigen::Index v = 0; v < forces.size() / 3; ++v) {
-        total += forces.segment<3>(3 * v);
-        momentum_change += m[3 * v] * (block.state.v - start.v).segment<3>(3 * v);
-    }
-    const double weight = m.sum() / 3.0 * settings.gravity;
-    // The step's gradient r = M(v − vᵗ) − Δt (f + f_ext + F_contact) has ‖r‖ ≤ tol · scale, and the
-    // internal forces f sum to 0 (a translation stores no energy), so summed over the vertices
-    // Σ F_contact − W = (Σ m Δv − Σ r)/Δt, with |Σ r_z| ≤ √#V ‖r‖ (Cauchy–Schwarz). At rest Σ m Δv ≈ 0.
-    const double vertices = double(forces.size() / 3);
-    const double bound = (std::abs(momentum_change.z()) + std::sqrt(vertices) * settings.newton.relative_tolerance * scale) /
-                         settings.time_step + 1e-12 * weight;
+    const test::RestWeight rest = test::rest_weight(block, settings);
+    const Eigen::Vector3d& total = rest.barrier;  // no friction: the barrier's forces are all of them
+    const double weight = rest.weight, bound = rest.bound;
     INFO("sum of contact forces " << total.transpose() << " N, weight " << weight << " N, bound " << bound << " N");
     CHECK(std::abs(total.z() - weight) <= bound);
     CHECK(bound <= 1e-6 * weight);  // equilibrium: the momentum no longer changes

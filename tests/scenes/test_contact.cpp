@@ -1,5 +1,6 @@
 // Obstacles in a scene (chapter 14): the reader's fields, chapter 14's obstacles made from them, and
 // the rule that steps a body with contact only when it needs it. docs/scenes.md#obstacles
+#include "scenes/live_view.hpp"
 #include "scenes/runner.hpp"
 #include "scenes/scene_contact.hpp"
 
@@ -62,24 +63,55 @@ TEST_CASE("obstacles in the scene file: each type's fields, and chapter 14's obs
     CHECK(scene.contact.activation_distance == 0.002);
     CHECK(scene.contact.friction_velocity == 0.01);
     const ObstacleSpec& box = scene.obstacles[0];
-    CHECK(box.kind == ObstacleSpec::Kind::box);
-    CHECK(box.angle == Approx(std::acos(-1.0) / 2.0).epsilon(1e-15));  // degrees in the file, radians read
-    CHECK(box.friction == 0.25);
-    // The box turned by 90° about z: its 4 m edge lies along y, its 2 m edge along x.
-    const auto made = make_obstacle(box);
+    CHECK(box.type == "box");
+    CHECK(box.obstacle->name() == "box");
+    // The box turned by 90° about z (degrees in the file): its 4 m edge lies along y, its 2 m edge along x.
+    const auto& made = box.obstacle;
     CHECK(made->friction() == 0.25);
     CHECK(made->velocity() == Eigen::Vector3d(0.01, 0.0, 0.0));
     const Eigen::Vector3d centre(0.05, 0.05, -1.0);
     CHECK(made->distance(centre + Eigen::Vector3d(1.5, 0.0, 0.0), 0.0) == Approx(0.5).epsilon(1e-14));
     CHECK(made->distance(centre + Eigen::Vector3d(0.0, 1.5, 0.0), 0.0) == Approx(-0.5).epsilon(1e-14));
     CHECK(made->distance(centre + Eigen::Vector3d(1.5, 0.0, 0.0), 10.0) == Approx(0.4).epsilon(1e-13));  // moved by 10 w
-    const auto sphere = make_obstacle(scene.obstacles[1]);
+    const auto& sphere = scene.obstacles[1].obstacle;
     CHECK(sphere->distance(Eigen::Vector3d(0.0, 0.0, 0.0), 0.0) == Approx(2.5).epsilon(1e-15));
     // The half-space's normal is normalised: d = n·(x − p) in metres.
-    CHECK(scene.obstacles[2].normal == Eigen::Vector3d::UnitZ());
-    CHECK(make_obstacle(scene.obstacles[2])->distance(Eigen::Vector3d(3.0, 1.0, 0.25), 0.0) == Approx(0.75).epsilon(1e-15));
+    CHECK(scene.obstacles[2].obstacle->gradient(Eigen::Vector3d::Zero(), 0.0) == Eigen::Vector3d::UnitZ());
+    CHECK(scene.obstacles[2].obstacle->distance(Eigen::Vector3d(3.0, 1.0, 0.25), 0.0) == Approx(0.75).epsilon(1e-15));
     // A scene without obstacles has none, and its runs meet none.
     CHECK(read_scene(gallery / "cantilever.toml").obstacles.empty());
+}
+
+TEST_CASE("a capsule obstacle: read from its type's fields, made, drawn, and its foreign fields refused", "[scenes][contact]")
+{
+    const std::filesystem::path file = drop_scene(
+        "obstacle_capsule", "type = \"capsule\"\nstart = [-1.0, 0.05, -0.5]\nend = [1.0, 0.05, -0.5]\nradius = 0.25\n"
+                            "friction = 0.4\nvelocity = [0.0, 0.0, -0.1]\n");
+    const SceneSpec scene = read_scene(file);
+    REQUIRE(scene.obstacles.size() == 1);
+    const ObstacleSpec& capsule = scene.obstacles[0];
+    CHECK(capsule.type == "capsule");
+    CHECK(capsule.file.empty());
+    const auto& made = capsule.obstacle;
+    CHECK(made->name() == "capsule");
+    CHECK(made->friction() == 0.4);
+    CHECK(made->velocity() == Eigen::Vector3d(0.0, 0.0, -0.1));
+    // 0.75 m above the axis: 0.5 m from its surface; 2 m beyond its end b along the axis: 1.75 m.
+    CHECK(made->distance(Eigen::Vector3d(0.3, 0.05, 0.25), 0.0) == Approx(0.5).epsilon(1e-15));
+    CHECK(made->distance(Eigen::Vector3d(3.0, 0.05, -0.5), 0.0) == Approx(1.75).epsilon(1e-15));
+    // Drawn where it stands at t = 1: moved 0.1 m down.
+    const std::vector<fig::Prop> props = obstacle_props(scene, {0.0, 0.1, 0.0, 0.1, 0.0, 0.1}, 1.0);
+    REQUIRE(props.size() == 1);
+    for (Eigen::Index v = 0; v < props[0].shape.points.rows(); ++v)
+        CHECK(std::abs(made->distance(props[0].shape.points.row(v).transpose(), 1.0)) < 1e-14);
+    // A sphere's or a box's field is not a capsule's: refused at the field, naming its type.
+    const std::filesystem::path foreign = drop_scene(
+        "obstacle_capsule_foreign", "type = \"capsule\"\nstart = [-1.0, 0.05, -0.5]\nend = [1.0, 0.05, -0.5]\n"
+                                    "radius = 0.25\ncenter = [0.0, 0.0, -0.5]\n");
+    CHECK_THROWS_WITH(read_scene(foreign), Catch::Contains("obstacle[0].center") &&
+                                               Catch::Contains("belongs to type = \"sphere\", not to type = \"capsule\""));
+    const std::filesystem::path missing = drop_scene("obstacle_capsule_missing", "type = \"capsule\"\nradius = 0.25\n");
+    CHECK_THROWS_WITH(read_scene(missing), Catch::Contains("obstacle[0].start: missing"));
 }
 
 TEST_CASE("a mesh obstacle: its file found in data/, placed by scale then translate, and read by the runner's input list",
@@ -91,12 +123,12 @@ TEST_CASE("a mesh obstacle: its file found in data/, placed by scale then transl
     const SceneSpec scene = read_scene(file);
     REQUIRE(scene.obstacles.size() == 1);
     const ObstacleSpec& bowl = scene.obstacles[0];
-    CHECK(bowl.kind == ObstacleSpec::Kind::mesh);
+    CHECK(bowl.type == "mesh");
     CHECK(bowl.file.filename() == "bowl.obj");
-    CHECK(bowl.scale == 2.0);
-    CHECK(bowl.surface.V.row(0) == Eigen::RowVector3d(0.05, 0.05, -0.5));  // the lowest vertex, placed
-    CHECK(bowl.surface.V.col(0).maxCoeff() - bowl.surface.V.col(0).minCoeff() == Approx(2.0 * 2.0 * 0.15 * std::sin(70.0 * std::acos(-1.0) / 180.0)).epsilon(1e-12));
-    const auto made = make_obstacle(bowl);
+    const auto& made = bowl.obstacle;
+    const TriMesh surface = made->local_surface({});
+    CHECK(surface.V.row(0) == Eigen::RowVector3d(0.05, 0.05, -0.5));  // the lowest vertex, placed
+    CHECK(surface.V.col(0).maxCoeff() - surface.V.col(0).minCoeff() == Approx(2.0 * 2.0 * 0.15 * std::sin(70.0 * std::acos(-1.0) / 180.0)).epsilon(1e-12));
     CHECK(made->friction() == 0.3);
     // 0.1 m straight below the lowest vertex: that vertex is the nearest point (the bowl curves up).
     CHECK(made->distance(Eigen::Vector3d(0.05, 0.05, -0.6), 0.0) == Approx(0.1).epsilon(1e-12));
@@ -181,7 +213,7 @@ TEST_CASE("the gallery's slopes: the block slides with g (sin - mu cos) when tan
     {
         const SceneSpec scene = read_scene(gallery / "slope_slide.toml", small);
         REQUIRE(scene.obstacles.size() == 1);
-        const double mu = scene.obstacles[0].friction;
+        const double mu = scene.obstacles[0].obstacle->friction();
         REQUIRE(std::tan(theta) > mu);
         const RunResult run = run_positions(scene);
         const std::vector<MatrixX3d>& x = run.frames[0];
@@ -195,7 +227,7 @@ TEST_CASE("the gallery's slopes: the block slides with g (sin - mu cos) when tan
     }
     {
         const SceneSpec scene = read_scene(gallery / "slope_stick.toml", small);
-        REQUIRE(std::tan(theta) < scene.obstacles[0].friction);
+        REQUIRE(std::tan(theta) < scene.obstacles[0].obstacle->friction());
         const RunResult run = run_positions(scene);
         const std::vector<MatrixX3d>& x = run.frames[0];
         // Sticking with the smoothed friction: slower than eps_v, a creep of at most eps_v dt per step.

@@ -5,6 +5,8 @@
 #include "scenes/runner.hpp"
 #include "scenes/scene_text.hpp"
 
+#include "14_contact/mesh_obstacle.hpp"
+
 #include "common/figures.hpp"
 #include "common/motion.hpp"
 
@@ -147,19 +149,18 @@ TEST_CASE("obstacle_props: a floor patch under the body's box, a ball where it i
 TEST_CASE("obstacle_props: a mesh obstacle is its own triangles where it stands at the frame's time", "[scenes]")
 {
     SceneSpec scene;
-    ObstacleSpec mesh;
-    mesh.kind = ObstacleSpec::Kind::mesh;
-    mesh.surface.V.resize(3, 3);
-    mesh.surface.V << 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0;
-    mesh.surface.F.resize(1, 3);
-    mesh.surface.F << 0, 1, 2;
-    mesh.velocity = Eigen::Vector3d(0.0, 0.0, -0.5);
-    scene.obstacles.push_back(mesh);
+    TriMesh triangle;
+    triangle.V.resize(3, 3);
+    triangle.V << 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0;
+    triangle.F.resize(1, 3);
+    triangle.F << 0, 1, 2;
+    scene.obstacles.push_back(
+        {"mesh", std::make_shared<contact::MeshObstacle>(triangle, 0.0, Eigen::Vector3d(0.0, 0.0, -0.5)), {}});
     const std::vector<fig::Prop> props = obstacle_props(scene, {0.0, 1.0, 0.0, 1.0, 0.0, 1.0}, 2.0);
     REQUIRE(props.size() == 1);
-    CHECK(props[0].shape.cells == MatrixXiR(mesh.surface.F));
+    CHECK(props[0].shape.cells == MatrixXiR(triangle.F));
     CHECK(props[0].shape.points.col(2).isConstant(-1.0));  // moved by t w = (0, 0, -1)
-    CHECK(props[0].shape.points.leftCols(2) == mesh.surface.V.leftCols(2));
+    CHECK(props[0].shape.points.leftCols(2) == triangle.V.leftCols(2));
 }
 
 TEST_CASE("the caption: scene, the model in use, the time and the slow motion the video plays at", "[scenes]")
