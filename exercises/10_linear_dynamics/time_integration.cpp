@@ -424,6 +424,9 @@ Simulation::Simulation(Body& body, Integrator& integrator, State initial)
     : body_(body), integrator_(integrator), state_(std::move(initial))
 {
     require_fits(body, state_);
+    const Material& material = body.scene().material;
+    const double volume = body.dof_masses().sum() / 3.0 / material.density;
+    roundoff_energy_ = material.youngs_modulus * volume * divergence_roundoff_strain * divergence_roundoff_strain;
 }
 
 void Simulation::run(int steps, const Observer& observer)
@@ -481,7 +484,7 @@ void Simulation::run(int steps, const Observer& observer)
                             " J); ", cause()));
         largest_magnitude_ = std::max(largest_magnitude_, record.energies.magnitude());
         const double rise = total - record.work_in - initial_total_;
-        if (rise > divergence_energy_fraction * largest_magnitude_)
+        if (rise > divergence_energy_fraction * largest_magnitude_ && rise > roundoff_energy_)
             throw Error(str("the run diverged at ", where(), ": H - W_in (the total energy less the ", record.work_in,
                             " J the scene put in) rose from ", initial_total_, " J to ", total - record.work_in,
                             " J, by ", rise / std::max(largest_magnitude_, 1e-300),

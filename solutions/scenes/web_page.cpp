@@ -341,7 +341,7 @@ Eigen::Vector3d WebPage::write(const std::filesystem::path& path, const std::vec
     for (std::size_t i = 0; i < props.size(); ++i)
         obstacles += str(i > 0 ? "," : "", "{\"positions\":\"", base64_encode(float32_bytes(props[i].shape.points)),
                          "\",\"triangles\":\"", base64_encode(triangle_bytes(props[i].shape.cells)),
-                         "\",\"velocity\":", json_numbers(scene_.obstacles[i].velocity), ",\"colour\":",
+                         "\",\"velocity\":", json_numbers(scene_.obstacles[i].obstacle->velocity()), ",\"colour\":",
                          json_numbers(props[i].colour, 4), "}");
     obstacles += "]";
     // The energy plot: each body's kinetic and elastic energy and H − W_in (the chart energies's
