@@ -10,10 +10,11 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <cctype>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <regex>
 #include <sstream>
 
 using namespace fem;
@@ -87,6 +88,56 @@ std::string page_data(const std::string& page)
 }
 
 /// Whether the library three.js is installed; a test that needs it is skipped without.
+/// text in lower case (ASCII).
+std::string lower(std::string text)
+{
+    std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return std::tolower(c); });
+    return text;
+}
+
+/// The first "src=" or "href=" value (any case, spaces and a quote allowed around '=') that starts
+/// with "http:", "https:" or "//": an address the browser would fetch; empty when there is none.
+/// (Scanned by hand: std::regex draws a false -Wmaybe-uninitialized from g++ 12 under the sanitizers.)
+std::string fetched_address(const std::string& page)
+{
+    const std::string text = lower(page);
+    for (const std::string attribute : {"src", "href"})
+        for (std::size_t at = text.find(attribute); at != std::string::npos; at = text.find(attribute, at + 1)) {
+            std::size_t i = at + attribute.size();
+            while (i < text.size() && std::isspace(static_cast<unsigned char>(text[i])))
+                ++i;
+            if (i >= text.size() || text[i] != '=')
+                continue;
+            ++i;
+            while (i < text.size() && (std::isspace(static_cast<unsigned char>(text[i])) || text[i] == '"' || text[i] == '\''))
+                ++i;
+            const std::string value = text.substr(i, 8);
+            if (value.rfind("http:", 0) == 0 || value.rfind("https:", 0) == 0 || value.rfind("//", 0) == 0)
+                return page.substr(at, 60);
+        }
+    return "";
+}
+
+/// Whether some tag opened by `open` (e.g. "<script", any case) has the attribute (" src=", spaces
+/// allowed before '=') before its '>'.
+bool tag_has_attribute(const std::string& page, const std::string& open, const std::string& attribute)
+{
+    const std::string text = lower(page);
+    for (std::size_t at = text.find(open); at != std::string::npos; at = text.find(open, at + 1)) {
+        const std::string tag = text.substr(at, text.find('>', at) - at);
+        for (std::size_t a = tag.find(attribute); a != std::string::npos; a = tag.find(attribute, a + 1)) {
+            if (a == 0 || !std::isspace(static_cast<unsigned char>(tag[a - 1])))
+                continue;
+            std::size_t i = a + attribute.size();
+            while (i < tag.size() && std::isspace(static_cast<unsigned char>(tag[i])))
+                ++i;
+            if (i < tag.size() && tag[i] == '=')
+                return true;
+        }
+    }
+    return false;
+}
+
 bool have_three_js()
 {
     try {
@@ -159,9 +210,15 @@ TEST_CASE("the web page's frames are the .vtu frames to the quantisation bound, 
     const auto [out, page] = cantilever_page("positions", "--set output.warp=3");
 
     // self-contained: no script, style or link fetched from anywhere
-    CHECK(!std::regex_search(page, std::regex(R"((src|href)\s*=\s*["']?\s*(https?:)?//)", std::regex::icase)));
-    CHECK(!std::regex_search(page, std::regex(R"(<script[^>]*\ssrc\s*=)", std::regex::icase)));
-    CHECK(!std::regex_search(page, std::regex(R"(<link[^>]*\shref\s*=)", std::regex::icase)));
+    // (the scanners themselves: they find what they look for)
+    REQUIRE(!fetched_address("<img SRC = 'https://example.org/a.png'>").empty());
+    REQUIRE(!fetched_address("<a href=//example.org>").empty());
+    REQUIRE(fetched_address("<a href=\"#frame=3\">").empty());
+    REQUIRE(tag_has_attribute("<SCRIPT type=x  src = 'a.js'>", "<script", "src"));
+    REQUIRE(!tag_has_attribute("<script>var src = 1;</script>", "<script", "src"));
+    CHECK(fetched_address(page).empty());
+    CHECK(!tag_has_attribute(page, "<script", "src"));
+    CHECK(!tag_has_attribute(page, "<link", "href"));
     CHECK(page.find("THREE.OrbitControls") != std::string::npos);  // the library is in the page
 
     const std::string data = page_data(page);
