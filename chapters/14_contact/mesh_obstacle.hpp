@@ -41,10 +41,10 @@ struct TrianglePoint {
     int corner = 0;
 };
 
-/// The point q of the triangle (a, b, c) closest to p, and its feature: p's projection onto the
-/// triangle's plane when it lies inside the triangle (face); otherwise the nearest of the three
-/// edges' points xᵢ + t (xⱼ − xᵢ), t = clamp((p − xᵢ)·(xⱼ − xᵢ)/|xⱼ − xᵢ|², 0, 1), an edge for
-/// 0 < t < 1 and a corner at t = 0 or 1. The triangle must not be degenerate (MeshObstacle checks).
+/// The point q of the triangle (a, b, c) closest to p, and its feature, by the feature that
+/// point_triangle_type (distances.hpp, exercise 14.5) names: a corner; an edge's point
+/// xᵢ + t (xⱼ − xᵢ), t = (p − xᵢ)·(xⱼ − xᵢ)/|xⱼ − xᵢ|²; or p's projection onto the triangle's plane
+/// (face). fem::Error as point_triangle_type (a non-finite coordinate, a zero-area triangle).
 /// docs/14_contact.md#distance-to-a-triangle
 TrianglePoint closest_triangle_point(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                      const Eigen::Vector3d& c);

@@ -162,14 +162,14 @@ CandidatePairs tree_candidates(const SurfacePrimitives& surface, const MatrixX3d
 {
     const SweptBoxes boxes = checked_boxes(surface, start, end, inflation);
     CandidatePairs pairs;
-    // EXERCISE 14.7 (tree_candidates): see docs/14_contact.md#bodies-against-bodies-and-self-contact
+    // EXERCISE 14.9 (tree_candidates): see docs/14_contact.md#bodies-against-bodies-and-self-contact
     // HINT: Build chapter 13's box tree (skin::box_hierarchy(boxes, 4)) over boxes.triangles and one
     // HINT: over boxes.edges. Then pairs = collect(surface, boxes, found): collect calls found(point, k)
     // HINT: for each surface vertex k (point = true) and each edge k (point = false), and wants the
     // HINT: triangles (edges) whose boxes meet that primitive's grown box, boxes.grown_vertices[k]
     // HINT: (boxes.grown_edges[k]): ask the tree with skin::boxes_meeting(tree, boxes, low, high).
     // HINT: collect itself applies the box test, leaves out pairs that share a vertex, and sorts.
-    throw fem::NotImplemented("14.7", "tree_candidates", "docs/14_contact.md#bodies-against-bodies-and-self-contact");
+    throw fem::NotImplemented("14.9", "tree_candidates", "docs/14_contact.md#bodies-against-bodies-and-self-contact");
     return pairs;
 }
 

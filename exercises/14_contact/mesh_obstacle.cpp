@@ -4,6 +4,8 @@
 // AABB tree, and the same distance sampled on a grid. docs/14_contact.md#mesh-obstacles
 #include "14_contact/mesh_obstacle.hpp"
 
+#include "14_contact/distances.hpp"
+
 #include "common/error.hpp"
 
 #include <Eigen/Geometry>
@@ -30,15 +32,23 @@ double box_distance(const Eigen::Vector3d& low, const Eigen::Vector3d& high, con
 TrianglePoint closest_triangle_point(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                      const Eigen::Vector3d& c)
 {
+    const std::array<Eigen::Vector3d, 3> x{a, b, c};
+    const int type = static_cast<int>(point_triangle_type(p, a, b, c));
     TrianglePoint closest;
-    // EXERCISE 14.5 (closest_triangle_point): see docs/14_contact.md#distance-to-a-triangle
-    // HINT: The point of triangle abc nearest to p, and which feature holds it (the face, an edge or a
-    // HINT: corner: `closest.feature`, and for an edge or corner its first corner in `closest.corner`),
-    // HINT: docs/14_contact.md#distance-to-a-triangle. The face answers when p's projection onto the
-    // HINT: plane lies inside; otherwise the nearest point lies on the border, on one of the three edges
-    // HINT: with its ends. The triangle may be sliver-thin but not degenerate (the reader refuses those).
-    // HINT: The tests compare with chapter 13's closest_point_on_triangle and place p in every region.
-    throw fem::NotImplemented("14.5", "closest_triangle_point", "docs/14_contact.md#distance-to-a-triangle");
+    if (type <= static_cast<int>(PointTriangleType::corner_c)) {  // corner_a, corner_b, corner_c: 0, 1, 2
+        closest.feature = TriangleFeature::vertex;
+        closest.corner = type;
+        closest.point = x[type];
+    } else if (type <= static_cast<int>(PointTriangleType::edge_ca)) {  // edge_ab, edge_bc, edge_ca: 3, 4, 5
+        const int i = type - static_cast<int>(PointTriangleType::edge_ab);
+        const Eigen::Vector3d edge = x[(i + 1) % 3] - x[i];
+        closest.feature = TriangleFeature::edge;
+        closest.corner = i;
+        closest.point = x[i] + ((p - x[i]).dot(edge) / edge.squaredNorm()) * edge;
+    } else {
+        const Eigen::Vector3d n = (b - a).cross(c - a);
+        closest.point = p - ((p - a).dot(n) / n.squaredNorm()) * n;
+    }
     return closest;
 }
 
@@ -228,7 +238,7 @@ double MeshObstacle::local_time_of_impact(const Eigen::Vector3d& p, const Eigen:
     if (!(local_distance(p) > 0.0))
         return 0.0;
     double first = infinity;
-    // EXERCISE 14.6 (mesh_time_of_impact): see docs/14_contact.md#continuous-collision-detection
+    // EXERCISE 14.8 (mesh_time_of_impact): see docs/14_contact.md#continuous-collision-detection
     // HINT: The smallest s in [0, 2] at which p + s dp meets one of the triangles whose boxes meet the
     // HINT: path's box (triangles_meeting), in `first` (docs/14_contact.md#continuous-collision-detection):
     // HINT: solve for where the path crosses each triangle's plane and whether that point lies in the
@@ -236,7 +246,7 @@ double MeshObstacle::local_time_of_impact(const Eigen::Vector3d& p, const Eigen:
     // HINT: margin of 1e-9 of the barycentric range, so a path through a shared edge cannot slip between
     // HINT: two triangles by round-off. A path parallel to a plane misses it unless it lies in it; then
     // HINT: there is no root to solve for: answer conservative_time_of_impact.
-    throw fem::NotImplemented("14.6", "mesh_time_of_impact", "docs/14_contact.md#continuous-collision-detection");
+    throw fem::NotImplemented("14.8", "mesh_time_of_impact", "docs/14_contact.md#continuous-collision-detection");
     return first;
 }
 

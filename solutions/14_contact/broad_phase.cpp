@@ -160,7 +160,7 @@ CandidatePairs tree_candidates(const SurfacePrimitives& surface, const MatrixX3d
 {
     const SweptBoxes boxes = checked_boxes(surface, start, end, inflation);
     CandidatePairs pairs;
-    // BEGIN EXERCISE 14.7 tree_candidates #bodies-against-bodies-and-self-contact
+    // BEGIN EXERCISE 14.9 tree_candidates #bodies-against-bodies-and-self-contact
     // HINT: Build chapter 13's box tree (skin::box_hierarchy(boxes, 4)) over boxes.triangles and one
     // HINT: over boxes.edges. Then pairs = collect(surface, boxes, found): collect calls found(point, k)
     // HINT: for each surface vertex k (point = true) and each edge k (point = false), and wants the

@@ -185,6 +185,14 @@ std::array<std::array<double, 8>, 3> corner_values(PrimitivePair pair, const Pri
 bool excludes_contact(PrimitivePair pair, const PrimitiveMotion& motion, const Box& box,
                       const Eigen::Vector3d& epsilon)
 {
+    // BEGIN EXERCISE 14.7 excludes_contact #primitive-ccd
+    // HINT: Whether box (its t, u, v ranges: box.lo, box.hi) can hold no time and place of contact
+    // HINT: (docs/14_contact.md#primitive-ccd). For a point and a triangle, a box entirely where u + v > 1
+    // HINT: is outside the triangle. Otherwise F's coordinates are multilinear in (t, u, v), so each one's
+    // HINT: range over the box is spanned by its 8 corner values (corner_values(pair, motion, box)[k]): the
+    // HINT: box is excluded when, for some coordinate k, all 8 lie above +epsilon[k] or all below
+    // HINT: −epsilon[k] (the round-off bound of a computed corner value). A value that is not finite (an
+    // HINT: overflow) never excludes: a false "no contact" is the one answer CCD must never give.
     if (pair == PrimitivePair::point_triangle && box.lo[1] + box.lo[2] > 1.0)
         return true;
     const auto values = corner_values(pair, motion, box);
@@ -198,6 +206,7 @@ bool excludes_contact(PrimitivePair pair, const PrimitiveMotion& motion, const B
             return true;
     }
     return false;
+    // END EXERCISE
 }
 
 /// ε_k = 4 γ₆ M_k + 2⁻¹⁰⁷⁰: the round-off bound of one corner value of F_k (docs: #primitive-ccd).

@@ -163,6 +163,13 @@ PointTriangleType point_triangle_type(const Eigen::Vector3d& p, const Eigen::Vec
                                       const Eigen::Vector3d& c)
 {
     check_point_triangle({p, a, b, c}, "point_triangle_type");
+    // BEGIN EXERCISE 14.5 point_triangle_type #distances-between-primitives
+    // HINT: Which features of triangle abc hold the point nearest to p (docs/14_contact.md#distances-between-primitives):
+    // HINT: with t_i = (p − x_i)·(x_{i+1} − x_i)/|x_{i+1} − x_i|², p's parameter along edge i (from corner i to
+    // HINT: corner i + 1; corners a, b, c are 0, 1, 2), corner i when t_i ≤ 0 and t_{i−1} ≥ 1 (before edge i's
+    // HINT: start and past edge i − 1's end); else edge i (edge_ab, edge_bc, edge_ca) when p lies across the
+    // HINT: edge's line from the opposite corner, ((x_{i+1} − x_i) × (p − x_i))·n < 0 with n = (b − a) × (c − a),
+    // HINT: and 0 < t_i < 1; else the face. Only signs are tested: no square root, no division but the t_i.
     const std::array<Eigen::Vector3d, 3> x{a, b, c};
     const Eigen::Vector3d n = (b - a).cross(c - a);
     std::array<double, 3> t;  // p's parameter along edge i, from corner i to corner i + 1
@@ -181,6 +188,7 @@ PointTriangleType point_triangle_type(const Eigen::Vector3d& p, const Eigen::Vec
         if ((x[(i + 1) % 3] - x[i]).cross(p - x[i]).dot(n) < 0.0 && t[i] > 0.0 && t[i] < 1.0)
             return edges[i];
     return PointTriangleType::face;
+    // END EXERCISE
 }
 
 PrimitiveFunction point_triangle_squared_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
@@ -206,6 +214,16 @@ EdgeEdgeType edge_edge_type(const Eigen::Vector3d& ea0, const Eigen::Vector3d& e
                             const Eigen::Vector3d& eb1)
 {
     check_edges({ea0, ea1, eb0, eb1}, "edge_edge_type");
+    // BEGIN EXERCISE 14.6 edge_edge_type #distances-between-primitives
+    // HINT: Which features of edges a = (ea0, ea1) and b = (eb0, eb1) hold their closest points
+    // HINT: (docs/14_contact.md#distances-between-primitives). Not parallel (|e_a × e_b|² above
+    // HINT: parallel_edges_sin2 |e_a|²|e_b|²): solve the 2×2 normal equations of |r + s e_a − t e_b|²
+    // HINT: (r = ea0 − eb0) for the lines' closest points; both 0 < s, t < 1 gives edge_edge (compare the
+    // HINT: numerators with the determinant |e_a × e_b|² instead of dividing). Otherwise the minimum is on the
+    // HINT: border of the square: for each endpoint y (ea0, ea1, eb0, eb1) its closest point q on the other
+    // HINT: edge (closest_on_segment: a clamped projection, and which feature of the edge q is) — the first
+    // HINT: where (y − q)·(y' − y) ≥ 0 (y' the other end of y's edge) names the type; if round-off leaves
+    // HINT: none, the nearest. Parallel edges always end on the border.
     const Eigen::Vector3d ea = ea1 - ea0, eb = eb1 - eb0, r = ea0 - eb0;
     const double cross2 = ea.cross(eb).squaredNorm();
     if (cross2 > parallel_edges_sin2 * ea.squaredNorm() * eb.squaredNorm()) {
@@ -241,6 +259,7 @@ EdgeEdgeType edge_edge_type(const Eigen::Vector3d& ea0, const Eigen::Vector3d& e
             return (l.end - l.closest.point).squaredNorm() < (r.end - r.closest.point).squaredNorm();
         });
     return nearest.types[nearest.closest.feature];
+    // END EXERCISE
 }
 
 PrimitiveFunction edge_edge_squared_distance(const Eigen::Vector3d& ea0, const Eigen::Vector3d& ea1,

@@ -181,7 +181,7 @@ TEST_CASE("sphere time of impact where the textbook root cancels: close to the s
     }
 }
 
-TEST_CASE("continuous collision: no point of a randomised safe step is inside any obstacle (fuzzed)", "[ex14.3]")
+TEST_CASE("continuous collision: no point of a randomised safe step is inside any obstacle (fuzzed)", "[ex14.8]")
 {
     BlockSettings settings;
     settings.height = 0.0;
@@ -294,7 +294,7 @@ TEST_CASE("contact potential: gradient and Hessian of barrier and friction again
 }
 
 TEST_CASE("contact potential on a mesh: the barriers summed over the triangles within dhat, against central "
-          "differences", "[ex14.5]")
+          "differences", "[ex14.6]")
 {
     check_contact_derivatives("mesh");
 }

@@ -80,7 +80,7 @@ CcdResult cubic(PrimitivePair pair, const PrimitiveMotion& m) { return cubic_ccd
 
 }  // namespace
 
-TEST_CASE("inclusion CCD: no false negative on the benchmark's 250 vertex-face and 74 edge-edge queries")
+TEST_CASE("inclusion CCD: no false negative on the benchmark's 250 vertex-face and 74 edge-edge queries", "[ex14.7]")
 {
     const Counts vertex_face = count_errors("vertex-face", inclusion);
     CHECK(vertex_face.queries == 250);
@@ -92,7 +92,7 @@ TEST_CASE("inclusion CCD: no false negative on the benchmark's 250 vertex-face a
     CHECK(edge_edge.false_negatives == 0);
 }
 
-TEST_CASE("inclusion CCD: its time of impact is never later than a root the cubic confirms")
+TEST_CASE("inclusion CCD: its time of impact is never later than a root the cubic confirms", "[ex14.7]")
 {
     // Where the cubic finds a contact, its root t_c is a true contact time up to the cubic's
     // round-off; the inclusion method's time must come no later (conservative), and in [0, 1].
@@ -119,7 +119,7 @@ TEST_CASE("inclusion CCD: its time of impact is never later than a root the cubi
     CHECK(compared > 50);
 }
 
-TEST_CASE("primitive CCD: a point falling straight onto a triangle's face at t = 0.5")
+TEST_CASE("primitive CCD: a point falling straight onto a triangle's face at t = 0.5", "[ex14.7]")
 {
     const PrimitiveMotion m = point_over_unit_triangle({0.2, 0.3, 1.0}, {0.2, 0.3, -1.0});
     const CcdResult naive = cubic_ccd(PrimitivePair::point_triangle, m);
@@ -139,7 +139,7 @@ TEST_CASE("primitive CCD: a point falling straight onto a triangle's face at t =
     CHECK(coarse.work < safe.work);
 }
 
-TEST_CASE("primitive CCD: a touch exactly at t = 1, and misses by a small margin")
+TEST_CASE("primitive CCD: a touch exactly at t = 1, and misses by a small margin", "[ex14.7]")
 {
     const PrimitiveMotion landing = point_over_unit_triangle({0.2, 0.3, 1.0}, {0.2, 0.3, 0.0});
     const CcdResult touch = inclusion_ccd(PrimitivePair::point_triangle, landing);
@@ -172,7 +172,7 @@ TEST_CASE("primitive CCD: a touch exactly at t = 1, and misses by a small margin
     CHECK(cross.time_of_impact >= 0.5 - delta - 1e-15);
 }
 
-TEST_CASE("primitive CCD: parallel edges — the cubic vanishes, the inclusion method still decides")
+TEST_CASE("primitive CCD: parallel edges — the cubic vanishes, the inclusion method still decides", "[ex14.7]")
 {
     // Two parallel lines always lie in one plane: the coplanarity cubic is 0 for every t, no root
     // is isolated, and the naive method cannot see the edges land on each other at t = 0.5.
@@ -193,7 +193,7 @@ TEST_CASE("primitive CCD: parallel edges — the cubic vanishes, the inclusion m
 }
 
 TEST_CASE("primitive CCD: the naive cubic's false negatives are real: on the benchmark, at a graze, "
-          "in coplanar motion")
+          "in coplanar motion", "[ex14.7]")
 {
     const Counts vertex_face = count_errors("vertex-face", cubic);
     const Counts edge_edge = count_errors("edge-edge", cubic);
@@ -234,7 +234,7 @@ TEST_CASE("primitive CCD: the naive cubic's false negatives are real: on the ben
 }
 
 TEST_CASE("inclusion CCD: the bound eps is needed: a point landing on an edge where F's computed value is "
-          "round-off")
+          "round-off", "[ex14.7]")
 {
     // The triangle (a, b, c) fixed in the plane z = 0 and the point falling straight down onto
     // q = (3/4) a + (1/4) b, on the edge ab, at t = 1: b = 4q − 3a exactly (checked below in long
@@ -263,7 +263,7 @@ TEST_CASE("inclusion CCD: the bound eps is needed: a point landing on an edge wh
     CHECK(safe.time_of_impact >= 1.0 - delta - 1e-15);
 }
 
-TEST_CASE("inclusion CCD: stopped at its box limit it still answers conservatively")
+TEST_CASE("inclusion CCD: stopped at its box limit it still answers conservatively", "[ex14.7]")
 {
     const PrimitiveMotion m = point_over_unit_triangle({0.2, 0.3, 1.0}, {0.2, 0.3, -1.0});
     const CcdResult capped = inclusion_ccd(PrimitivePair::point_triangle, m, {1e-6, 10});

@@ -211,37 +211,52 @@ bool same_type_around(const Pair& pair, const Points& x, double h)
 
 }  // namespace
 
-TEST_CASE("primitive distances: d^2 equals the constrained least-squares minimum and no sample of the "
-          "domain is nearer, in every region")
+namespace {
+
+/// d² of random pairs of one kind against the constrained least-squares minimum and a sampled one,
+/// and the type against the minimum's, every type met.
+void check_least_squares_minimum(const Pair& pair)
 {
-    for (const Pair& pair : {point_triangle, edge_edge}) {
-        std::map<int, int> seen;
-        int types_compared = 0;
-        for (unsigned seed = 1; seed <= 3000; ++seed) {
-            const Points x = random_points(pair, seed);
-            const int type = pair.type(x);
-            const Minimum minimum = constrained_minimum(pair, x);
-            const double d2 = pair.classified(x).value;
-            INFO(pair.describe(x) << "\ntype " << pair.type_name(type) << ", the least squares' "
-                                  << pair.type_name(minimum.type));
-            CHECK(std::abs(d2 - minimum.value) <= 1e-13);
-            CHECK(d2 <= sampled_minimum(pair, x) + 1e-13);
-            if (minimum.runner_up - minimum.value > 1e-9) {  // clear of the border between two types
-                CHECK(type == minimum.type);
-                ++types_compared;
-            }
-            ++seen[type];
+    std::map<int, int> seen;
+    int types_compared = 0;
+    for (unsigned seed = 1; seed <= 3000; ++seed) {
+        const Points x = random_points(pair, seed);
+        const int type = pair.type(x);
+        const Minimum minimum = constrained_minimum(pair, x);
+        const double d2 = pair.classified(x).value;
+        INFO(pair.describe(x) << "\ntype " << pair.type_name(type) << ", the least squares' "
+                              << pair.type_name(minimum.type));
+        CHECK(std::abs(d2 - minimum.value) <= 1e-13);
+        CHECK(d2 <= sampled_minimum(pair, x) + 1e-13);
+        if (minimum.runner_up - minimum.value > 1e-9) {  // clear of the border between two types
+            CHECK(type == minimum.type);
+            ++types_compared;
         }
-        INFO((pair.triangle ? "point–triangle" : "edge–edge"));
-        CHECK(types_compared > 2900);
-        for (int type = 0; type < pair.types(); ++type) {
-            INFO("type " << pair.type_name(type));
-            CHECK(seen[type] >= 20);
-        }
+        ++seen[type];
+    }
+    INFO((pair.triangle ? "point–triangle" : "edge–edge"));
+    CHECK(types_compared > 2900);
+    for (int type = 0; type < pair.types(); ++type) {
+        INFO("type " << pair.type_name(type));
+        CHECK(seen[type] >= 20);
     }
 }
 
-TEST_CASE("primitive distances: gradient and Hessian of d^2 against central differences in every region")
+}  // namespace
+
+TEST_CASE("point-triangle distance: d^2 equals the constrained least-squares minimum and no sample of the "
+          "triangle is nearer, its type that of the minimum, in every region", "[ex14.5]")
+{
+    check_least_squares_minimum(point_triangle);
+}
+
+TEST_CASE("edge-edge distance: d^2 equals the constrained least-squares minimum and no sample of the "
+          "square is nearer, its type that of the minimum, in every region", "[ex14.6]")
+{
+    check_least_squares_minimum(edge_edge);
+}
+
+TEST_CASE("primitive distances: gradient and Hessian of d^2 against central differences in every region", "[ex14.6]")
 {
     for (const Pair& pair : {point_triangle, edge_edge}) {
         std::map<int, int> checked;
@@ -268,7 +283,7 @@ TEST_CASE("primitive distances: gradient and Hessian of d^2 against central diff
 }
 
 TEST_CASE("primitive distances: where two types meet, both give the same d^2 and gradient, and central "
-          "differences hold just beside the border")
+          "differences hold just beside the border", "[ex14.6]")
 {
     for (const Pair& pair : {point_triangle, edge_edge}) {
         std::set<std::pair<int, int>> borders;
@@ -321,7 +336,7 @@ TEST_CASE("primitive distances: where two types meet, both give the same d^2 and
 }
 
 TEST_CASE("primitive distances: relabelling the triangle's corners or the edges gives the same d^2 and the "
-          "relabelled gradient")
+          "relabelled gradient", "[ex14.6]")
 {
     // Each relabelling: where the stacked point i goes.
     const std::vector<std::array<int, 4>> triangle_relabellings{{0, 1, 3, 2}, {0, 2, 1, 3}, {0, 2, 3, 1},
@@ -414,7 +429,7 @@ TEST_CASE("edge-edge mollifier: m(c) of c = |e_a x e_b|^2, its gradient and Hess
     }
 }
 
-TEST_CASE("primitive distances: non-finite coordinates, zero-length edges and zero-area triangles are refused")
+TEST_CASE("primitive distances: non-finite coordinates, zero-length edges and zero-area triangles are refused", "[ex14.6]")
 {
     const Eigen::Vector3d o(0, 0, 0), x(1, 0, 0), y(0, 1, 0), z(0, 0, 1), p(0.2, 0.3, 0.5);
     const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
@@ -463,7 +478,7 @@ TEST_CASE("primitive distances: non-finite coordinates, zero-length edges and ze
 }
 
 TEST_CASE("edge-edge distance of parallel and nearly parallel edges: an endpoint type at sin^2 <= 1e-10, "
-          "within 3e-10 min(|ea|^2, |eb|^2) of the least-squares minimum")
+          "within 3e-10 min(|ea|^2, |eb|^2) of the least-squares minimum", "[ex14.6]")
 {
     const Eigen::Vector3d ea0(-0.4, 0.1, 0.2), ea(1.0, 0.2, -0.1);
     const Eigen::Vector3d across = ea.cross(Eigen::Vector3d(0.3, 1.0, 0.2)).normalized(), side = across.cross(ea).normalized();

@@ -75,7 +75,7 @@ bool edge_inside_body(const dynamics::Body& body, const Eigen::VectorXd& u, cons
 
 }  // namespace
 
-TEST_CASE("edge and corner barrier: energy, gradient and Hessian against central differences", "[ex14.1]")
+TEST_CASE("edge and corner barrier: energy, gradient and Hessian against central differences", "[ex14.6]")
 {
     // A one-cube block over a box turned so that its top corner and two top edges come within d̂ of
     // the block's lower face and edges, not at its vertices.
@@ -123,7 +123,7 @@ TEST_CASE("edge and corner barrier: energy, gradient and Hessian against central
     }
 }
 
-TEST_CASE("the knife: a wedge's ridge and a box's edge pressed into a one-cell block never enter it", "[ex14.6][slow]")
+TEST_CASE("the knife: a wedge's ridge and a box's edge pressed into a one-cell block never enter it", "[ex14.8][slow]")
 {
     // The block (10 cm, one cell: its top face two triangles) on the floor; a ridge along y over the
     // middle of its top face, between its vertices, 0.5 mm above it, comes down at 2 cm/s for

@@ -150,7 +150,7 @@ TEST_CASE("mesh obstacle: distance, gradient and Hessian, and the barrier on the
 }
 
 TEST_CASE("mesh obstacle: the time of impact is the first crossing of the path, nothing earlier, none missed",
-          "[ex14.6]")
+          "[ex14.8]")
 {
     const MeshObstacle mesh(bowl());
     int hits = 0, misses = 0;
@@ -204,7 +204,7 @@ TEST_CASE("mesh obstacle: the time of impact is the first crossing of the path, 
 }
 
 TEST_CASE("mesh obstacle: a path through a shared edge of two random triangles is caught there, whatever the round-off",
-          "[ex14.6]")
+          "[ex14.8]")
 {
     // Two triangles (a, b, c) and (b, a, d) sharing the edge ab, all corners random (not representable
     // in binary); a path from above through a random point q of ab, reaching it at s = 1/2. Without

@@ -245,7 +245,7 @@ TEST_CASE("fired at a ball at 100 times a drop's speed, no vertex gets inside or
 }
 
 TEST_CASE("fired at a triangle mesh at 30 times a drop's speed, no vertex gets through its sheet or onto it",
-          "[ex14.6][slow]")
+          "[ex14.8][slow]")
 {
     // A tent: the square [-1, 1]² at z = 0 cut into four triangles at a raised apex (0.05, 0.05, 0.02)
     // under the block's centre; the block's lower corners come down over two of its ridges (edge

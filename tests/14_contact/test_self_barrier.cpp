@@ -161,7 +161,7 @@ Eigen::Vector3d momentum(const dynamics::Body& body, const Eigen::VectorXd& v, E
 
 }  // namespace
 
-TEST_CASE("self-contact barrier: energy, gradient and Hessian against central differences, PSD", "[self][ex14.7]")
+TEST_CASE("self-contact barrier: energy, gradient and Hessian against central differences, PSD", "[self][ex14.9]")
 {
     // Two one-cell cubes face to face 0.4 mm apart, the second turned 0.3 rad about x (the faces'
     // normal) and shifted, so that vertices stand over the other's face and edges cross at angles:
@@ -211,7 +211,7 @@ TEST_CASE("self-contact barrier: energy, gradient and Hessian against central di
 }
 
 TEST_CASE("broad phase: brute force, the AABB tree and the spatial hash find the same pairs, every pair within r",
-          "[self][ex14.7]")
+          "[self][ex14.9]")
 {
     const TetMesh block = box_mesh(3, 2, 2, Eigen::Vector3d(0.3, 0.2, 0.2));
     const TetMesh pair_of_blocks = two_bodies(box_at(Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(0.1), 2),
@@ -270,7 +270,7 @@ TEST_CASE("broad phase: brute force, the AABB tree and the spatial hash find the
 }
 
 TEST_CASE("two blocks thrown at each other: momentum kept, the motion point-symmetric, no edge through a face, "
-          "and they part", "[self][ex14.7]")
+          "and they part", "[self][ex14.9]")
 {
     // Block one: 2×2×2 cells of 10 cm at the origin, moving +x at 0.5 m/s. Block two: block one
     // reflected through the point c (x → 2c − x, tets turned back to positive volume), 2 mm away and
@@ -306,7 +306,7 @@ TEST_CASE("two blocks thrown at each other: momentum kept, the motion point-symm
     CHECK(bodies.contact->smallest_distance(bodies.state.u) >= 1e-3);  // and they parted: no pair within d̂
 }
 
-TEST_CASE("two bars crossed at right angles, pushed together: only their edges meet, and hold", "[self][ex14.7]")
+TEST_CASE("two bars crossed at right angles, pushed together: only their edges meet, and hold", "[self][ex14.9]")
 {
     // Bar one along x (30 × 10 × 5 cm, one cell: vertices only at its ends), bar two along y above it,
     // 2 mm higher; where they cross, no vertex of either stands over the other's faces: the contact
@@ -349,7 +349,7 @@ TEST_CASE("two bars crossed at right angles, pushed together: only their edges m
     CHECK(lower.z() < 0.0);                 // the lower bar moves down again: they bounced
 }
 
-TEST_CASE("self-contact's refusals: no obstacle without it, and primitives closer than d-hat at rest", "[self][ex14.7]")
+TEST_CASE("self-contact's refusals: no obstacle without it, and primitives closer than d-hat at rest", "[self][ex14.9]")
 {
     dynamics::Scene scene;
     scene.mesh = box_mesh(2, 2, 2, Eigen::Vector3d::Constant(0.1));  // cells of 5 cm
@@ -364,7 +364,7 @@ TEST_CASE("self-contact's refusals: no obstacle without it, and primitives close
     CHECK_THROWS_WITH(ContactPotential(body, none, options), Catch::Contains("closer than d̂"));
 }
 
-TEST_CASE("self-contact's time of impact: never after the first contact, never far before it", "[self][ex14.7]")
+TEST_CASE("self-contact's time of impact: never after the first contact, never far before it", "[self][ex14.9]")
 {
     // Two cubes 1 cm apart closing by 4 cm (first contact at s = 1/4, face on face: point–triangle
     // pairs), and two crossed one-cell bars 2 mm apart closing by 4 mm (first contact at s = 1/2,
