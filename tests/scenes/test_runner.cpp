@@ -20,8 +20,10 @@
 #include <vtkNew.h>
 #include <vtkPNGReader.h>
 #include <vtkPointData.h>
+#include <vtkSmartPointer.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <csignal>
 #include <filesystem>
@@ -538,24 +540,39 @@ void pointer(Display* display, Window window, int type, int x, int y)
     XFlush(display);
 }
 
-/// The centre of the body's coloured pixels in a picture of the live view (x, y from the top
-/// left): the pixels that are neither white, grey nor black, left of the colour bar.
-std::pair<int, int> body_centre(const std::filesystem::path& png)
+/// A PNG's pixels: rgb(x, y) from the top left, each channel 0 … 255.
+struct Picture {
+    int width = 0, height = 0;
+    vtkSmartPointer<vtkDataArray> pixels;
+    std::array<double, 3> rgb(int x, int y) const
+    {
+        const vtkIdType i = static_cast<vtkIdType>(height - 1 - y) * width + x;  // VTK's rows start at the bottom
+        return {pixels->GetComponent(i, 0), pixels->GetComponent(i, 1), pixels->GetComponent(i, 2)};
+    }
+};
+
+Picture read_picture(const std::filesystem::path& png)
 {
     vtkNew<vtkPNGReader> reader;
     reader->SetFileName(png.string().c_str());
     reader->Update();
     int size[3];
     reader->GetOutput()->GetDimensions(size);
-    vtkDataArray* pixels = reader->GetOutput()->GetPointData()->GetScalars();
+    return {size[0], size[1], reader->GetOutput()->GetPointData()->GetScalars()};
+}
+
+/// The centre of the body's coloured pixels in a picture of the live view (x, y from the top
+/// left): the pixels that are neither white, grey nor black, left of the colour bar.
+std::pair<int, int> body_centre(const std::filesystem::path& png)
+{
+    const Picture picture = read_picture(png);
     double sum_x = 0.0, sum_y = 0.0, count = 0.0;
-    for (int y = 0; y < size[1]; ++y)
-        for (int x = 0; x < size[0] * 3 / 4; ++x) {
-            const vtkIdType i = static_cast<vtkIdType>(y) * size[0] + x;
-            const double r = pixels->GetComponent(i, 0), g = pixels->GetComponent(i, 1), b = pixels->GetComponent(i, 2);
+    for (int y = 0; y < picture.height; ++y)
+        for (int x = 0; x < picture.width * 3 / 4; ++x) {
+            const auto [r, g, b] = picture.rgb(x, y);
             if (std::max({r, g, b}) - std::min({r, g, b}) > 40.0) {
                 sum_x += x;
-                sum_y += size[1] - 1 - y;  // VTK's rows start at the bottom
+                sum_y += y;
                 count += 1.0;
             }
         }
@@ -567,19 +584,13 @@ std::pair<int, int> body_centre(const std::filesystem::path& png)
 /// many, and in how many rows (a near-vertical spring's length in pixels).
 std::pair<int, int> red_pixels(const std::filesystem::path& png)
 {
-    vtkNew<vtkPNGReader> reader;
-    reader->SetFileName(png.string().c_str());
-    reader->Update();
-    int size[3];
-    reader->GetOutput()->GetDimensions(size);
-    vtkDataArray* pixels = reader->GetOutput()->GetPointData()->GetScalars();
+    const Picture picture = read_picture(png);
     int count = 0, rows = 0;
-    for (int y = 0; y < size[1]; ++y) {
+    for (int y = 0; y < picture.height; ++y) {
         int in_row = 0;
-        for (int x = 0; x < size[0]; ++x) {
-            const vtkIdType i = static_cast<vtkIdType>(y) * size[0] + x;
-            if (pixels->GetComponent(i, 0) > 120.0 && pixels->GetComponent(i, 1) < 80.0 && pixels->GetComponent(i, 2) < 80.0)
-                ++in_row;
+        for (int x = 0; x < picture.width; ++x) {
+            const auto [r, g, b] = picture.rgb(x, y);
+            in_row += r > 120.0 && g < 80.0 && b < 80.0 ? 1 : 0;
         }
         count += in_row;
         rows += in_row > 0 ? 1 : 0;
