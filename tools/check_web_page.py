@@ -10,10 +10,22 @@ frames (the two sets of body pixels differ).
 Headless WebGL here: --use-angle=swiftshader --enable-unsafe-swiftshader (ANGLE on SwiftShader,
 the CPU renderer Chromium ships); --use-gl=swiftshader gives a page without WebGL in Chromium 156.
 
+Then the positions, read back through the page's own decoding: the page opened at
+#positions=0,1,… writes what its test hook window.femPlayer.positions(k) returns (frame k's surface
+vertices decoded into float32 by the function the 3D view draws with) into <pre id="fem-positions">,
+which chromium --dump-dom prints; every coordinate must be the .vtu frame k's X + warp·u of its
+point within the stated bound, half a quantisation step (high − low)/65535/2 on its axis (the page's
+low and high), plus float32's rounding of the drawn value (2⁻²⁴ of the axis's largest |x|). The
+comparison is checked to catch a decoding off by one step: the page's positions moved by one step
+on one axis, and decoded over 65536 steps instead of 65535, must both fail it.
+
 Exit 0: passed; 1: failed; 77 (ctest SKIP): no chromium, or no libjs-three for fem_scene --html.
 """
 import argparse
+import base64
+import html
 import json
+import re
 import pathlib
 import shutil
 import struct
@@ -82,6 +94,107 @@ def body_pixels(path):
     return found
 
 
+def vtu_arrays(path):
+    """{name: list of numbers} of a .vtu written by VTK's XML writer (common/vtk_io): every
+    DataArray in format="binary", zlib-compressed (header UInt32: blocks, block size, last block's
+    size, each block's compressed size; base64 apart from the data) or uncompressed, or "ascii"."""
+    text = pathlib.Path(path).read_text()
+    head = re.search(r"<VTKFile[^>]*>", text).group(0)
+    compressed = "vtkZLibDataCompressor" in head
+    if 'header_type="UInt64"' in head:
+        word, word_format = 8, "<Q"
+    else:
+        word, word_format = 4, "<I"
+    kinds = {"Float64": "d", "Float32": "f", "Int64": "q", "Int32": "i", "UInt8": "B", "UInt32": "I", "UInt64": "Q"}
+    arrays = {}
+    for m in re.finditer(r"<DataArray(?P<attrs>[^>]*)>(?P<body>[^<]*)", text):  # the data, before any <InformationKey>
+        attrs = dict(re.findall(r'(\w+)="([^"]*)"', m["attrs"]))
+        kind, body = kinds[attrs["type"]], m["body"].strip()
+        if attrs.get("format") == "ascii":
+            arrays[attrs["Name"]] = [float(v) for v in body.split()]
+            continue
+        if compressed:
+            count = struct.unpack(word_format, base64.b64decode(body[:8 if word == 4 else 12])[:word])[0]
+            header_chars = 4 * -(-(3 + count) * word // 3)
+            header = base64.b64decode(body[:header_chars])
+            sizes = [struct.unpack(word_format, header[i * word:(i + 1) * word])[0] for i in range(3 + count)][3:]
+            data, raw, at = base64.b64decode(body[header_chars:]), b"", 0
+            for size in sizes:
+                raw += zlib.decompress(data[at:at + size])
+                at += size
+        else:
+            blob = base64.b64decode(body)
+            raw = blob[word:word + struct.unpack(word_format, blob[:word])[0]]
+        arrays[attrs["Name"]] = list(struct.unpack(f"<{len(raw) // struct.calcsize(kind)}{kind}", raw))
+    return arrays
+
+
+def drawn_positions(vtu, warp):
+    """X + warp·u of every point of a .vtu frame: a list of (x, y, z)."""
+    arrays = vtu_arrays(vtu)
+    rest, u = arrays["Points"], arrays["displacement"]
+    return [tuple(rest[3 * p + a] + warp * u[3 * p + a] for a in range(3)) for p in range(len(rest) // 3)]
+
+
+def worst_errors(page_frames, point_ids, vtu_frames, bound):
+    """(largest |page − vtu| / bound over every frame, vertex and axis, where): page_frames[k] the
+    3P page coordinates of frame k, vtu_frames[k] the .vtu frame's drawn positions, bound per axis."""
+    worst, where = 0.0, None
+    for k, coordinates in page_frames.items():
+        for i, point in enumerate(point_ids):
+            for a in range(3):
+                ratio = abs(coordinates[3 * i + a] - vtu_frames[k][point][a]) / bound[a]
+                if ratio > worst:
+                    worst, where = ratio, f"frame {k}, surface vertex {i} (.vtu point {point}), axis {'xyz'[a]}"
+    return worst, where
+
+
+def check_positions(chromium, page, data, out, stated):
+    """The failures of the positions' read-back (module doc): the page's decoded positions of every
+    frame against the .vtu frames of its run. stated: the bound fem_scene printed [m]."""
+    pvd = next(page.parent.glob("*.pvd")).read_text()
+    vtus = [page.parent / f for f in re.findall(r'file="([^"]+)"', pvd)]
+    if len(vtus) != data["frames"]:
+        return [f"the page has {data['frames']} frames, the .pvd {len(vtus)}"]
+    frames = ",".join(str(k) for k in range(data["frames"]))
+    command = [chromium, *CHROMIUM_FLAGS, f"--user-data-dir={out / 'profile'}", "--dump-dom",
+               "--virtual-time-budget=5000", f"{page.as_uri()}#positions={frames}"]
+    dom = subprocess.run(command, capture_output=True, text=True, timeout=180).stdout
+    found = re.search(r'<pre id="fem-positions"[^>]*>(.*?)</pre>', dom, re.S)
+    if not found:
+        return [f"the page wrote no <pre id=\"fem-positions\"> (its test hook): {' '.join(command)}"]
+    read = json.loads(html.unescape(found.group(1)))
+    page_frames = {int(k): v for k, v in read["frames"].items()}
+    if sorted(page_frames) != list(range(data["frames"])):
+        return [f"the page's hook gave frames {sorted(page_frames)}, not 0 … {data['frames'] - 1}"]
+    vtu_frames = [drawn_positions(v, data["warp"]) for v in vtus]
+    low, high = data["low"], data["high"]
+    half_step = [(high[a] - low[a]) / 65535 / 2 for a in range(3)]
+    largest = [max(abs(low[a]), abs(high[a])) for a in range(3)]
+    bound = [half_step[a] + 2.0 ** -24 * largest[a] + 1e-12 for a in range(3)]
+    worst, where = worst_errors(page_frames, read["point_ids"], vtu_frames, bound)
+    print(f"positions of {len(read['point_ids'])} surface vertices × {len(page_frames)} frames, read back from the "
+          f"page: largest error {worst:.3f} of the bound (half a step + float32: {', '.join(f'{b:.4g}' for b in bound)} m; "
+          f"at {where})")
+    failures = []
+    if max(half_step) > stated * (1 + 1e-4):
+        failures.append(f"the page's half step {max(half_step):.6g} m is more than the bound fem_scene states, {stated:.6g} m")
+    if worst > 1.0:
+        failures.append(f"a decoded position is off by {worst:.3f} of the bound at {where}")
+    # The comparison must catch a decoding off by one step: a coordinate one step over, and the
+    # codes read over 65536 steps instead of 65535 (the top of each axis one step short).
+    axis = max(range(3), key=lambda a: half_step[a])  # the longest axis: a step there is largest
+    one_over = {k: [c + (2 * half_step[axis] if i % 3 == axis else 0.0) for i, c in enumerate(v)]
+                for k, v in page_frames.items()}
+    short = {k: [low[i % 3] + (c - low[i % 3]) * 65535 / 65536 for i, c in enumerate(v)] for k, v in page_frames.items()}
+    for name, wrong in ((f"one step over on {'xyz'[axis]}", one_over), ("over 65536 steps", short)):
+        ratio, _ = worst_errors(wrong, read["point_ids"], vtu_frames, bound)
+        print(f"a decoding {name}: largest error {ratio:.3f} of the bound")
+        if ratio <= 1.0:
+            failures.append(f"the comparison passes a decoding {name}: it cannot tell a step")
+    return failures
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--exe", required=True, help="fem_scene")
@@ -107,7 +220,12 @@ def main():
     page = next((out / "run").glob("*.html"))
     text = page.read_text(encoding="utf-8")
     start = text.index('id="fem-data">') + len('id="fem-data">')
-    frames = json.loads(text[start:text.index("</script>", start)])["frames"]
+    data = json.loads(text[start:text.index("</script>", start)])
+    frames = data["frames"]
+    stated = re.search(r"positions to within (\S+) m", run.stdout)
+    if not stated:
+        print(f"fem_scene stated no bound ('positions to within … m'):\n{run.stdout}")
+        return 1
     shots = {}
     for frame in (0, frames - 1):
         shot = out / f"frame_{frame}.png"
@@ -122,7 +240,7 @@ def main():
     first, last = shots[0], shots[frames - 1]
     moved = len(first ^ last)
     print(f"pixels drawn in only one of the two frames: {moved}")
-    failures = []
+    failures = check_positions(chromium, page, data, out, float(stated.group(1)))
     if min(len(first), len(last)) < 2000:
         failures.append("the body is not drawn in colour in both frames (fewer than 2000 pixels): no WebGL?")
     if moved < 0.05 * max(len(first), len(last), 1):

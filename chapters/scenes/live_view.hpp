@@ -11,6 +11,7 @@
 
 #include <array>
 #include <cstddef>
+#include <map>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -51,16 +52,17 @@ std::vector<fig::Prop> obstacle_props(const SceneSpec& scene, const std::array<d
 /// right arrow steps one frame while paused, r restarts the run (throws Restart), c switches the
 /// colour field, q stops the run (fem::request_stop). The mouse pulls the body: pressing the left
 /// button on it picks the vertex under the pointer, which a spring then pulls toward the pointer
-/// (pull(); drawn as a line) until the button is released. The window's name says how long the
+/// (pull(); drawn as a red rod, a ball at the vertex) until the button is released. The window's name says how long the
 /// last frame took against its screen time, and whether the run keeps up with it.
 /// docs/scenes.md#the-live-view
 class LiveView {
 public:
     /// Thrown by frame() when r is pressed: the caller runs the scene again.
     struct Restart {};
-    /// Opens the window (fem::Error without a display). screenshot_step ≥ 0: save the window at that
-    /// step to screenshot (for the test against the PNG frame of the same step).
-    LiveView(const SceneSpec& scene, std::filesystem::path screenshot = {}, int screenshot_step = -1);
+    /// Opens the window (fem::Error without a display). screenshots: step → file, save the window
+    /// at that step to that file (for the test against the PNG frame of the same step, and the
+    /// picture of a pull in docs/scenes.md).
+    explicit LiveView(const SceneSpec& scene, std::map<int, std::filesystem::path> screenshots = {});
     /// Shows one frame (models: what the bodies use now, as frame_caption writes it) and handles the
     /// keys pressed since the last one.
     void frame(const io::MeshData& frame, int step, double time, const std::string& models);
@@ -80,8 +82,7 @@ private:
     std::vector<std::string> fields_;
     std::size_t field_ = 0;
     bool paused_ = false;
-    std::filesystem::path screenshot_;
-    int screenshot_step_;
+    std::map<int, std::filesystem::path> screenshots_;
     Timer clock_;  // since the last frame shown
     PullRequest pull_;
     std::string name_;  // the window's name, before the timing

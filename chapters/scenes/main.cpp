@@ -25,6 +25,7 @@
 
 #include <csignal>
 #include <iostream>
+#include <map>
 #include <memory>
 
 using namespace fem;
@@ -67,7 +68,7 @@ int main(int argc, char** argv)
                      "Also write <scene>.html: one self-contained web page that plays the run (as output.html = true)");
     cli.app.add_flag("--no-progress", no_progress, "No progress bar on stderr (it shows only on a terminal anyway)");
     bool view = false;
-    int screenshot = -1;
+    std::vector<int> screenshots;
     cli.app.add_flag("--view", view,
                      "Play the run live in a window (space: pause, right arrow: step, r: restart, c: colour field, "
                      "q: stop; press the mouse on the body and drag to pull it); without a display the run goes on "
@@ -79,7 +80,8 @@ int main(int argc, char** argv)
     cli.app.add_option("--pull-stiffness", pull_stiffness,
                        "With --view: the mouse's spring stiffness [N/m] (0: the body's mass x (2 pi 1 Hz)^2)")
         ->check(check::real(0.0, 1e9, check::Ends::closed))->capture_default_str();
-    cli.app.add_option("--screenshot", screenshot, "With --view: save the window at this step as view_<step>.png in --out")
+    cli.app.add_option("--screenshot", screenshots,
+                       "With --view: save the window at this step as view_<step>.png in --out (repeatable)")
         ->check(check::at_least<int>(0));
     std::vector<SceneSpec> scenes;
     std::shared_ptr<const SkinObserver> skin;  // the run's (the first scene's), bound once
@@ -90,7 +92,7 @@ int main(int argc, char** argv)
             quick = quick || std::string(argv[i]) == "--quick";
         if (files.size() > 1 && !compare)
             throw Error(str("scene: give one scene file, or several with --compare (got ", files.size(), ")"));
-        if (screenshot >= 0 && !view)
+        if (!screenshots.empty() && !view)
             throw Error("--screenshot: needs --view");
         if (view && compare)
             throw Error("--view: plays one run; --compare runs many without frames");
@@ -101,7 +103,7 @@ int main(int argc, char** argv)
         if (forever && !fig::display_available())
             throw Error("--forever: needs a display for --view (set DISPLAY, or run under xvfb-run -a): it runs "
                         "until the window's q");
-        if (forever && screenshot >= 0)
+        if (forever && !screenshots.empty())
             throw Error("--screenshot: writes a file, and --forever writes none");
         if (cli.app.count("--pull-stiffness") > 0 && !view)
             throw Error("--pull-stiffness: needs --view (the mouse pulls in the live view)");
@@ -149,7 +151,10 @@ int main(int argc, char** argv)
         options.skin = skin;
         std::unique_ptr<LiveView> live;
         if (view && fig::display_available()) {
-            live = std::make_unique<LiveView>(scenes.front(), run.file(str("view_", screenshot, ".png")), screenshot);
+            std::map<int, std::filesystem::path> pictures;
+            for (const int step : screenshots)
+                pictures[step] = run.file(str("view_", step, ".png"));
+            live = std::make_unique<LiveView>(scenes.front(), pictures);
             options.on_frame = [&](const io::MeshData& frame, int step, double time, const std::string& models) {
                 live->frame(frame, step, time, models);
             };

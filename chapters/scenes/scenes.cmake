@@ -57,7 +57,9 @@ if(FEM_BUILD_TESTS)
                    --exe $<TARGET_FILE:fem_scene> --table ${FEM_ROOT}/tests/scenes/bad_options.txt)
   set_tests_properties(scenes_bad_options PROPERTIES LABELS "scenes;run")
   # The web page (--html) in headless Chromium, network off: the body drawn at its first and last
-  # frame, and moved between them. SKIP (exit 77) without chromium or libjs-three (tools/setup.sh).
+  # frame, and moved between them; every frame's positions read back through the page's own decoding
+  # (its test hook) against the .vtu frames, within half a quantisation step. SKIP (exit 77) without
+  # chromium or libjs-three (tools/setup.sh).
   add_test(NAME scenes_web_page_browser
            COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/check_web_page.py --exe $<TARGET_FILE:fem_scene>
                    --scene ${FEM_ROOT}/scenes/cantilever.toml --out ${CMAKE_BINARY_DIR}/check_runs/scenes_web_page)

@@ -9,6 +9,9 @@
 // The frames are stored compactly: every surface vertex's drawn position X + warp·u quantised to
 // 16 bits per coordinate over the box of every frame (quantise_positions), base64 in the page, so
 // that a decoded coordinate is off by at most half a step, (high − low) / 65535 / 2 on its axis.
+// The page's test hook, window.femPlayer.positions(k), gives frame k's positions as its 3D view
+// decodes and draws them (float32); #positions=0,1,… in the address writes them into the page for a
+// headless browser (tools/check_web_page.py reads them back against the .vtu frames).
 
 #include "scenes/scene_file.hpp"
 

@@ -101,9 +101,9 @@ std::vector<fig::Prop> obstacle_props(const SceneSpec& scene, const std::array<d
 
 // --- LiveView -------------------------------------------------------------------------------------
 
-LiveView::LiveView(const SceneSpec& scene, std::filesystem::path screenshot, int screenshot_step)
-    : scene_(scene), window_(frame_view(scene), str("fem_scene: ", scene.title)), screenshot_(std::move(screenshot)),
-      screenshot_step_(screenshot_step), name_(str("fem_scene: ", scene.title))
+LiveView::LiveView(const SceneSpec& scene, std::map<int, std::filesystem::path> screenshots)
+    : scene_(scene), window_(frame_view(scene), str("fem_scene: ", scene.title)), screenshots_(std::move(screenshots)),
+      name_(str("fem_scene: ", scene.title))
 {
     fields_ = {scene.output.colour};
     for (const std::string& field : scene.output.fields)
@@ -164,19 +164,24 @@ void LiveView::frame(const io::MeshData& frame, int step, double time, const std
             }
         }
         view.props = obstacle_props(scene_, box, time);
-        if (pull_.body >= 0) {  // the spring: a line from the pulled vertex to the pointer's point
+        if (pull_.body >= 0) {  // the spring: a red rod from the pulled vertex to the pointer's point
             int first = 0;
             for (int b = 0; b < pull_.body; ++b)
                 first += static_cast<int>(scene_.bodies[static_cast<std::size_t>(b)].mesh.V.rows());
             const Eigen::Vector3d rest = frame.points.row(first + pull_.vertex).transpose();
-            fig::Prop spring;  // one line cell
-            spring.colour = {0.8, 0.1, 0.1};
-            spring.shape.points.resize(2, 3);
-            spring.shape.points.row(0) = shown.points.row(first + pull_.vertex);
-            spring.shape.points.row(1) = (rest + scene_.output.warp * (pull_.target - rest)).transpose();
-            spring.shape.cells.resize(1, 2);
-            spring.shape.cells << 0, 1;
-            view.props.push_back(std::move(spring));
+            const Eigen::Vector3d vertex = shown.points.row(first + pull_.vertex).transpose();
+            const Eigen::Vector3d pointer = rest + scene_.output.warp * (pull_.target - rest);
+            // Sized by the box the camera frames (about 3 pixels across for the rod, 18 for the ball
+            // at the picked vertex, in a window of 720 rows framing it): seen from the back of a hall.
+            const double size = Eigen::Vector3d(box[1] - box[0], box[3] - box[2], box[5] - box[4]).norm();
+            for (const auto& [from, radius] : {std::pair{pointer, 0.0025 * size}, std::pair{vertex, 0.015 * size}}) {
+                const TriMesh shape = contact::swept_ball_surface(vertex, from, radius);
+                fig::Prop spring;
+                spring.colour = {0.85, 0.1, 0.1};
+                spring.shape.points = shape.V;
+                spring.shape.cells = shape.F;
+                view.props.push_back(std::move(spring));
+            }
         }
         if (!view.frame_bounds) {
             for (const fig::Prop& prop : view.props)
@@ -186,8 +191,8 @@ void LiveView::frame(const io::MeshData& frame, int step, double time, const std
         window_.show(shown, view);
     };
     draw();
-    if (step == screenshot_step_)
-        window_.save_png(screenshot_);
+    if (const auto picture = screenshots_.find(step); picture != screenshots_.end())
+        window_.save_png(picture->second);
     // The video's pace: the next frame comes no sooner than one of its frame intervals after this one.
     while (!paused_ && clock_.seconds() < slow_motion(scene_) / scene_.output.frame_rate)
         std::this_thread::sleep_for(std::chrono::milliseconds(5));

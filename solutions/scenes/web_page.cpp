@@ -386,7 +386,7 @@ Eigen::Vector3d WebPage::write(const std::filesystem::path& path, const std::vec
         ",\"field\":", json_string(scene_.output.colour), ",\"unit\":", json_string(view.unit),
         ",\"range\":", json_numbers(std::array<double, 2>{range.first, range.second}), ",\"range_note\":", json_string(note),
         ",\"colour_on\":\"", cell_field_ ? "triangles" : "points", "\"",
-        ",\"points\":", q.points, ",\"point_ids\":\"", base64_encode(le_bytes(points)), "\"",
+        ",\"warp\":", json_number(scene_.output.warp, 17), ",\"points\":", q.points, ",\"point_ids\":\"", base64_encode(le_bytes(points)), "\"",
         ",\"triangles\":\"", base64_encode(le_bytes(triangles)), "\"",
         ",\"low\":", json_numbers(q.low, 17), ",\"high\":", json_numbers(q.high, 17),
         ",\"positions\":\"", base64_encode(le_bytes(q.codes)), "\"",
@@ -477,6 +477,12 @@ html, body { margin: 0; height: 100%; overflow: hidden; background: #fff; color:
   const colours = new Uint8Array(buffer(D.colours));    // 8 bits over D.range, per triangle or point
   const F = tri.length / 3, perTriangle = D.colour_on === "triangles";
   const step = [0, 1, 2].map((a) => (D.high[a] - D.low[a]) / 65535);
+  // frame k's surface vertices as drawn, x y z each, decoded into out (3P numbers): low + code · step
+  function decode(k, out) {
+    const base = 3 * P * k;
+    for (let i = 0; i < 3 * P; ++i) out[i] = D.low[i % 3] + codes[base + i] * step[i % 3];
+    return out;
+  }
 
   // viridis, five stops interpolated in RGB (as the PNG frames' colour map, common/figures_mesh.cpp)
   const stops = [[0.267, 0.005, 0.329], [0.229, 0.322, 0.546], [0.128, 0.567, 0.551], [0.369, 0.789, 0.383], [0.993, 0.906, 0.144]];
@@ -581,8 +587,7 @@ html, body { margin: 0; height: 100%; overflow: hidden; background: #fff; color:
     }
     // frame k: positions decoded, colours looked up, obstacles moved
     function draw(k) {
-      const base = 3 * P * k;
-      for (let i = 0; i < 3 * P; ++i) vertex[i] = D.low[i % 3] + codes[base + i] * step[i % 3];
+      decode(k, vertex);
       for (let f = 0; f < F; ++f) for (let c = 0; c < 3; ++c) {
         const p = tri[3 * f + c], o = 9 * f + 3 * c;
         for (let a = 0; a < 3; ++a) position[o + a] = vertex[3 * p + a];
@@ -668,12 +673,29 @@ html, body { margin: 0; height: 100%; overflow: hidden; background: #fff; color:
 
   // #frame=N: open at frame N, paused (a link to one moment, and the browser test's two frames);
   // otherwise play from the first frame
-  const asked = /frame=(\d+)/.exec(location.hash);
+  const asked = /[#&]frame=(\d+)/.exec(location.hash);
   if (view3d) view3d.resize();
   plot();
   show(asked ? Number(asked[1]) : 0);
   play(!asked);
   requestAnimationFrame(tick);
+
+  // The test hook: window.femPlayer.positions(k) is frame k's surface vertices as the 3D view draws
+  // them (decode into float32, as draw does), x y z each, of the .vtu points pointIds. #positions=0,3
+  // in the address also writes them as JSON into a hidden pre element (id fem-positions) for a
+  // headless browser's --dump-dom (tools/check_web_page.py):
+  // {"point_ids": [...], "frames": {"0": [...], "3": [...]}}
+  const pointIds = Array.from(new Uint32Array(buffer(D.point_ids)));
+  window.femPlayer = { frames: N, pointIds: pointIds, positions: (k) => decode(k, new Float32Array(3 * P)) };
+  const dump = /[#&]positions=([\d,]+)/.exec(location.hash);
+  if (dump) {
+    const frames = {};
+    for (const k of dump[1].split(",").map(Number)) if (k < N) frames[k] = Array.from(window.femPlayer.positions(k));
+    const pre = document.createElement("pre");
+    pre.id = "fem-positions"; pre.style.display = "none";
+    pre.textContent = JSON.stringify({ point_ids: pointIds, frames: frames });
+    document.body.appendChild(pre);
+  }
 })();
 </script>
 </body>

@@ -20,8 +20,10 @@
 #include <vtkNew.h>
 #include <vtkPNGReader.h>
 #include <vtkPointData.h>
+#include <vtkSmartPointer.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <csignal>
 #include <filesystem>
@@ -538,29 +540,62 @@ void pointer(Display* display, Window window, int type, int x, int y)
     XFlush(display);
 }
 
-/// The centre of the body's coloured pixels in a picture of the live view (x, y from the top
-/// left): the pixels that are neither white, grey nor black, left of the colour bar.
-std::pair<int, int> body_centre(const std::filesystem::path& png)
+/// A PNG's pixels: rgb(x, y) from the top left, each channel 0 … 255.
+struct Picture {
+    int width = 0, height = 0;
+    vtkSmartPointer<vtkDataArray> pixels;
+    std::array<double, 3> rgb(int x, int y) const
+    {
+        const vtkIdType i = static_cast<vtkIdType>(height - 1 - y) * width + x;  // VTK's rows start at the bottom
+        return {pixels->GetComponent(i, 0), pixels->GetComponent(i, 1), pixels->GetComponent(i, 2)};
+    }
+};
+
+Picture read_picture(const std::filesystem::path& png)
 {
     vtkNew<vtkPNGReader> reader;
     reader->SetFileName(png.string().c_str());
     reader->Update();
     int size[3];
     reader->GetOutput()->GetDimensions(size);
-    vtkDataArray* pixels = reader->GetOutput()->GetPointData()->GetScalars();
+    return {size[0], size[1], reader->GetOutput()->GetPointData()->GetScalars()};
+}
+
+/// The centre of the body's coloured pixels in a picture of the live view (x, y from the top
+/// left): the pixels that are neither white, grey nor black, left of the colour bar.
+std::pair<int, int> body_centre(const std::filesystem::path& png)
+{
+    const Picture picture = read_picture(png);
     double sum_x = 0.0, sum_y = 0.0, count = 0.0;
-    for (int y = 0; y < size[1]; ++y)
-        for (int x = 0; x < size[0] * 3 / 4; ++x) {
-            const vtkIdType i = static_cast<vtkIdType>(y) * size[0] + x;
-            const double r = pixels->GetComponent(i, 0), g = pixels->GetComponent(i, 1), b = pixels->GetComponent(i, 2);
+    for (int y = 0; y < picture.height; ++y)
+        for (int x = 0; x < picture.width * 3 / 4; ++x) {
+            const auto [r, g, b] = picture.rgb(x, y);
             if (std::max({r, g, b}) - std::min({r, g, b}) > 40.0) {
                 sum_x += x;
-                sum_y += size[1] - 1 - y;  // VTK's rows start at the bottom
+                sum_y += y;
                 count += 1.0;
             }
         }
     REQUIRE(count > 100.0);
     return {static_cast<int>(sum_x / count), static_cast<int>(sum_y / count)};
+}
+
+/// The red pixels (the pull's spring) in a picture, red above 120, green and blue below 80: how
+/// many, and in how many rows (a near-vertical spring's length in pixels).
+std::pair<int, int> red_pixels(const std::filesystem::path& png)
+{
+    const Picture picture = read_picture(png);
+    int count = 0, rows = 0;
+    for (int y = 0; y < picture.height; ++y) {
+        int in_row = 0;
+        for (int x = 0; x < picture.width; ++x) {
+            const auto [r, g, b] = picture.rgb(x, y);
+            in_row += r > 120.0 && g < 80.0 && b < 80.0 ? 1 : 0;
+        }
+        count += in_row;
+        rows += in_row > 0 ? 1 : 0;
+    }
+    return {count, rows};
 }
 
 /// The first file of this name in the staging folders of a running fem_scene's --out.
@@ -586,14 +621,19 @@ TEST_CASE("the live view's mouse: pressing on the body pulls it toward the point
     }
     const std::filesystem::path out = output / "pull";
     std::filesystem::remove_all(out);
-    const std::string title = "live_view_pull_" + std::to_string(::getpid());
+    // The title finds the window, and is the caption of the pull's picture (docs/scenes.md).
+    const std::string title = "The cantilever pulled by the mouse";
     int output_fd = -1;
     // At rest until pulled (no gravity), so that the body stays where the first frame's picture shows
-    // it; corotational throughout: auto's switches would book work of their own.
+    // it; corotational throughout: auto's switches would book work of their own. The second
+    // picture, at step 90 (frame 18 of 5 steps each), is taken while the button is held: the
+    // pointer is pressed at frame 3 or so and held until that picture is written.
+    const int pulled_step = 90;
     const pid_t child = start_scene({(gallery / "cantilever.toml").string(), "--quick", "--view", "--no-figures",
-                                     "--no-progress", "--set", "time.duration=600", "--set", "title=" + title, "--set",
-                                     "body.material.model=corotational", "--set", "gravity=[0.0, 0.0, 0.0]",
-                                     "--screenshot", "0", "--out", out.string()},
+                                     "--no-progress", "--set", "time.duration=600", "--set", "title=\"" + title + "\"",
+                                     "--set", "body.material.model=corotational", "--set", "gravity=[0.0, 0.0, 0.0]",
+                                     "--screenshot", "0", "--screenshot", std::to_string(pulled_step), "--out",
+                                     out.string()},
                                     &output_fd);
     REQUIRE(child > 0);
     LineReader printed(output_fd);
@@ -609,15 +649,31 @@ TEST_CASE("the live view's mouse: pressing on the body pulls it toward the point
     }
     REQUIRE(window != 0);
     REQUIRE(!picture.empty());
-    const auto [x, y] = body_centre(picture);
+    const auto [centre_x, y] = body_centre(picture);
+    const int x = centre_x + 150;  // near the free end (the beam is 430 pixels long here, pinned on the left)
     pointer(display, window, ButtonPress, x, y);
-    pointer(display, window, MotionNotify, x, y - 120);  // up
+    pointer(display, window, MotionNotify, x, y + 150);  // down, in the view
     const std::string pulling = printed.wait_for("pulling vertex ");
     CHECK(pulling.find("of body 'beam'") != std::string::npos);
     const int frames = frames_so_far(out, "cantilever");
-    for (int poll = 0; poll < 2400 && frames_so_far(out, "cantilever") < frames + 12; ++poll)
+    CHECK(frames < pulled_step / 5);  // pulling before the second picture
+    std::filesystem::path pulled;
+    for (int poll = 0; poll < 2400 && (frames_so_far(out, "cantilever") < frames + 12 || pulled.empty()); ++poll) {
         std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    pointer(display, window, ButtonRelease, x, y - 120);
+        pulled = staged(out, "view_" + std::to_string(pulled_step) + ".png");
+    }
+    REQUIRE(!pulled.empty());
+    const int written = frames_so_far(out, "cantilever");  // the next frame: the picture is closed by then
+    for (int poll = 0; poll < 2400 && frames_so_far(out, "cantilever") < written + 1; ++poll)
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    // The spring is drawn plain to see: a red rod and a ball at the vertex, more than 2.5 red pixels
+    // a row on average over the rows it crosses (a line of one pixel: about 1), and over 60 rows
+    // long; the picture before the pull has none.
+    CHECK(red_pixels(picture).first == 0);
+    const auto [red, rows] = red_pixels(pulled);
+    CHECK(rows > 60);
+    CHECK(red > 2.5 * rows);
+    pointer(display, window, ButtonRelease, x, y + 150);
     const std::string released = printed.wait_for("released vertex ");
     CHECK(released != "");
     press(display, window, XK_q);
