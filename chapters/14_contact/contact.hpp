@@ -18,6 +18,7 @@
 // several components, against each other (self_barrier.hpp; no friction between them).
 
 #include "14_contact/feature_barrier.hpp"
+#include "14_contact/friction.hpp"
 #include "14_contact/obstacles.hpp"
 #include "14_contact/self_barrier.hpp"
 
@@ -48,16 +49,6 @@ struct ContactOptions {
     /// against bodies, a body against itself; no friction between them). Off: the body passes
     /// through itself, as every run before it did. docs/14_contact.md#bodies-against-bodies-and-self-contact
     bool self_contact = false;
-};
-
-/// One lagged friction pair: vertex v against obstacle o, with the normal force and tangent basis
-/// of the step's start.
-struct FrictionPair {
-    int vertex = 0, obstacle = 0;
-    double normal_force = 0.0;           ///< λ = κ Σ_p |b'(d_p(x_vᵗ))| over the obstacle's pieces [N]
-    double coefficient = 0.0;            ///< μ of the obstacle
-    Eigen::Matrix<double, 3, 2> tangent; ///< T: orthonormal, ⟂ ∇d(x_vᵗ)
-    Eigen::Vector3d start;               ///< x_vᵗ + Δt w_o: where the vertex sticks to the obstacle
 };
 
 /// The minimiser of ‖g + κ h‖ over κ: κ = −gᵀh/‖h‖² (g, h of one size), the κ whose barrier force
@@ -174,8 +165,9 @@ private:
                                double obstacle_time, std::string* blocked) const;
     /// −κ Σ_p b'(d_p) ∇d_p: the barrier force of one obstacle on the surface vertex at x, time time_.
     Eigen::Vector3d barrier_force(const Obstacle& obstacle, const Eigen::Vector3d& x) const;
-    /// −μλ f₁(y)/y T s: the friction force of one pair on its vertex at u.
-    Eigen::Vector3d friction_force(const FrictionPair& pair, const Eigen::VectorXd& u) const;
+    /// One obstacle pair's lagged friction at u: lagged_friction of r = x_v − start with μλ (its
+    /// gradient is minus the friction force on the vertex).
+    LaggedFriction pair_friction(const FrictionPair& pair, const Eigen::VectorXd& u) const;
 
     std::vector<std::shared_ptr<const Obstacle>> obstacles_;
     ContactOptions options_;
@@ -232,8 +224,5 @@ inline constexpr int most_obstacle_stages = 200;
 dynamics::StepInfo contact_step(hyper::NewtonBackwardEuler& newton, ContactPotential& contact, dynamics::Body& body,
                                 double time_step, dynamics::State& state, int updates = 1, int* solves = nullptr,
                                 int* stages = nullptr);
-
-/// The tangent-plane basis of a unit normal n: T (3×2) with orthonormal columns ⟂ n.
-Eigen::Matrix<double, 3, 2> tangent_basis(const Eigen::Vector3d& normal);
 
 }  // namespace fem::contact

@@ -1,6 +1,7 @@
 #include "14_contact/contact.hpp"
 
 #include "14_contact/barrier.hpp"
+#include "14_contact/friction.hpp"
 
 #include "12_hyperelastic_newton/materials.hpp"
 
@@ -40,19 +41,6 @@ double checked_activation_distance(double activation_distance)
 }
 
 }  // namespace
-
-Eigen::Matrix<double, 3, 2> tangent_basis(const Eigen::Vector3d& normal)
-{
-    const Eigen::Vector3d n = normal.normalized();
-    // The axis least aligned with n, crossed with it, gives a first tangent of length ≥ √(2/3).
-    Eigen::Index axis = 0;
-    n.cwiseAbs().minCoeff(&axis);
-    const Eigen::Vector3d first = n.cross(Eigen::Vector3d::Unit(axis)).normalized();
-    Eigen::Matrix<double, 3, 2> T;
-    T.col(0) = first;
-    T.col(1) = n.cross(first);
-    return T;
-}
 
 double balancing_stiffness(const Eigen::VectorXd& g, const Eigen::VectorXd& h)
 {
@@ -265,10 +253,8 @@ double ContactPotential::energy(const Eigen::VectorXd& u) const
     double total = barrier_energy(u, time_);
     if (!std::isfinite(total))
         return total;
-    for (const FrictionPair& pair : pairs_) {
-        const double y = (pair.tangent.transpose() * (position(u, pair.vertex) - pair.start)).norm();
-        total += pair.coefficient * pair.normal_force * friction_mollifier(y, friction_step_).f0;
-    }
+    for (const FrictionPair& pair : pairs_)
+        total += pair_friction(pair, u).value;
     return total;
 }
 
@@ -282,14 +268,10 @@ Eigen::Vector3d ContactPotential::barrier_force(const Obstacle& obstacle, const 
     return force;
 }
 
-Eigen::Vector3d ContactPotential::friction_force(const FrictionPair& pair, const Eigen::VectorXd& u) const
+LaggedFriction ContactPotential::pair_friction(const FrictionPair& pair, const Eigen::VectorXd& u) const
 {
-    const Eigen::Vector2d s = pair.tangent.transpose() * (position(u, pair.vertex) - pair.start);
-    const double y = s.norm();
-    const MollifierValue f = friction_mollifier(y, friction_step_);
-    // f₁(y)/y, finite at y = 0 where it tends to 2/ε.
-    const double f1_over_y = y > 0.0 ? f.f1 / y : 2.0 / friction_step_;
-    return -pair.coefficient * pair.normal_force * f1_over_y * (pair.tangent * s);
+    return lagged_friction(pair.tangent, position(u, pair.vertex) - pair.start, pair.coefficient * pair.normal_force,
+                           friction_step_);
 }
 
 Eigen::VectorXd ContactPotential::barrier_forces(const Eigen::VectorXd& u) const
@@ -309,7 +291,7 @@ Eigen::VectorXd ContactPotential::gradient(const Eigen::VectorXd& u) const
 {
     Eigen::VectorXd gradient = -barrier_forces(u);
     for (const FrictionPair& pair : pairs_)
-        gradient.segment<3>(3 * pair.vertex) -= friction_force(pair, u);
+        gradient.segment<3>(3 * pair.vertex) += pair_friction(pair, u).gradient;
     return gradient;
 }
 
@@ -324,7 +306,7 @@ double ContactPotential::obstacle_work(const Eigen::VectorXd& u, double time_ste
             work += obstacle->velocity().dot(barrier_force(*obstacle, position(u, v)));
     }
     for (const FrictionPair& pair : pairs_)
-        work += obstacles_[static_cast<std::size_t>(pair.obstacle)]->velocity().dot(friction_force(pair, u));
+        work -= obstacles_[static_cast<std::size_t>(pair.obstacle)]->velocity().dot(pair_friction(pair, u).gradient);
     return time_step * (work + features_.obstacle_power(u, time_, stiffness_));
 }
 
@@ -348,18 +330,8 @@ dynamics::SparseMatrix ContactPotential::hessian(const Eigen::VectorXd& u) const
                 add(v, stiffness_ * (b.second * n * n.transpose() + b.first * piece.hessian));
             }
         }
-    for (const FrictionPair& pair : pairs_) {
-        const Eigen::Vector2d s = pair.tangent.transpose() * (position(u, pair.vertex) - pair.start);
-        const double y = s.norm();
-        const MollifierValue f = friction_mollifier(y, friction_step_);
-        const double f1_over_y = y > 0.0 ? f.f1 / y : 2.0 / friction_step_;
-        // (f₁'y − f₁)/y³ s sᵀ: bounded as y → 0 (it is −s sᵀ/(y ε²) below ε), 0 at y = 0.
-        const Eigen::Matrix2d radial =
-            y > 0.0 ? Eigen::Matrix2d((f.f1_derivative * y - f.f1) / (y * y * y) * s * s.transpose())
-                    : Eigen::Matrix2d::Zero();
-        const Eigen::Matrix2d inner = radial + f1_over_y * Eigen::Matrix2d::Identity();
-        add(pair.vertex, pair.coefficient * pair.normal_force * pair.tangent * inner * pair.tangent.transpose());
-    }
+    for (const FrictionPair& pair : pairs_)
+        add(pair.vertex, pair_friction(pair, u).hessian);
     std::vector<Eigen::Triplet<double>> triplets;
     for (const auto& [vertex, block] : blocks) {
         const Eigen::Matrix3d projected = hyper::project_to_psd<3>(block, hyper::Projection::clamp);
