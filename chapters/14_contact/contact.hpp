@@ -15,7 +15,8 @@
 // an orthonormal basis of the tangent plane ⟂ ∇d_o(x_vᵗ), w_o the obstacle's velocity (IPC: lagged friction).
 // Added to it: the obstacles' edges and corners against the body's surface (feature_barrier.hpp) and,
 // with ContactOptions::self_contact, the body's surface against itself — several bodies, one mesh of
-// several components, against each other (self_barrier.hpp; no friction between them).
+// several components, against each other (self_barrier.hpp), with ContactOptions::body_friction > 0 lagged friction on those
+// pairs too (friction.hpp: Σ_k μ λ_k f₀(‖T_kᵀ Γ_k (x − xᵗ)‖) over the pairs within d̂ at the step's start).
 
 #include "14_contact/feature_barrier.hpp"
 #include "14_contact/friction.hpp"
@@ -49,6 +50,10 @@ struct ContactOptions {
     /// against bodies, a body against itself; no friction between them). Off: the body passes
     /// through itself, as every run before it did. docs/14_contact.md#bodies-against-bodies-and-self-contact
     bool self_contact = false;
+    /// μ between the body's surface primitives (bodies against bodies, a body against itself), with
+    /// self_contact: lagged friction on its point–triangle and edge–edge pairs (BodyFriction); 0: none.
+    /// docs/14_contact.md#friction-between-bodies
+    double body_friction = 0.0;
 };
 
 /// The minimiser of ‖g + κ h‖ over κ: κ = −gᵀh/‖h‖² (g, h of one size), the κ whose barrier force
@@ -68,7 +73,7 @@ public:
     /// The surface vertices of body's mesh (chapter 13's boundary faces) against every obstacle, and,
     /// with options.self_contact, its surface primitives against each other (SelfContactBarrier).
     /// fem::Error for no obstacle without self_contact, d̂ ≤ 0, κ < 0, a safety outside (0, 1),
-    /// ε_v ≤ 0, ε_d < 0, and, with self_contact, two surface primitives that share no vertex closer
+    /// ε_v ≤ 0, ε_d < 0, a body_friction < 0 or > 0 without self_contact, and, with self_contact, two surface primitives that share no vertex closer
     /// than d̂ at rest (their barrier would push the body at rest: a smaller d̂ is needed).
     ContactPotential(const dynamics::Body& body, std::vector<std::shared_ptr<const Obstacle>> obstacles,
                      ContactOptions options = {});
@@ -77,7 +82,8 @@ public:
     /// 100 κ_min; at the first step with a vertex within d̂, κ = balancing_stiffness(−f − f_ext,
     /// ∇B) clamped to [κ_min, κ_max] (B: the unit-κ barrier sum, over free dofs); later κ doubles,
     /// up to κ_max, when the smallest distance is below ε_d and smaller than at the last step); the
-    /// friction pairs from x_vᵗ (FrictionPair).
+    /// friction pairs from x_vᵗ (FrictionPair) and, with body_friction, the body's own pairs within d̂
+    /// (BodyFriction::lag, sticking to xᵗ).
     void begin_step(dynamics::Body& body, const dynamics::State& state, double time_step) override;
 
     /// P(u) of the header [J] (+∞ when some surface vertex has d ≤ 0).
@@ -156,6 +162,11 @@ public:
     double stiffness() const { return stiffness_; }
     /// The current step's lagged friction pairs (set by begin_step).
     const std::vector<FrictionPair>& friction_pairs() const { return pairs_; }
+    /// The current step's lagged friction pairs between the body's surface primitives (body_friction).
+    const std::vector<BodyFrictionPair>& body_friction_pairs() const { return body_friction_.pairs(); }
+    /// The barrier between the body's surface primitives (self_contact), else null: its pairs and
+    /// their forces (SelfContactBarrier::pairs) with the step's stiffness().
+    const SelfContactBarrier* self_barrier() const { return self_.get(); }
 
 private:
     Eigen::Vector3d position(const Eigen::VectorXd& u, int vertex) const;
@@ -173,6 +184,7 @@ private:
     ContactOptions options_;
     FeatureBarrier features_;  // the obstacles' edges and corners against the body's surface
     std::unique_ptr<SelfContactBarrier> self_;  // the body's surface against itself (self_contact), else null
+    BodyFriction body_friction_;                // the lagged friction of self_'s pairs (body_friction)
     Eigen::MatrixX3d rest_;            // X (#V × 3)
     std::vector<int> surface_;
     double average_mass_ = 0.0, diagonal_ = 0.0;

@@ -23,8 +23,14 @@
 
 #include "14_contact/ccd.hpp"
 #include "14_contact/distances.hpp"
+#include "14_contact/self_barrier.hpp"
+
+#include "common/mesh.hpp"
 
 #include <Eigen/Core>
+#include <Eigen/Sparse>
+
+#include <vector>
 
 namespace fem::contact {
 
@@ -107,5 +113,35 @@ BodyFrictionPair body_friction_pair(PrimitivePair kind, const int (&vertices)[4]
 /// (block ij: w_i w_j H), PSD as H; translations x + (t, t, t, t) change nothing (Σ w_i = 0).
 /// docs/14_contact.md#friction-between-bodies
 PrimitiveFunction body_friction(const BodyFrictionPair& pair, const Vector12d& x, double epsilon);
+
+/// The lagged friction between the surface primitives of one mesh (bodies against bodies, a body
+/// against itself): the pairs of SelfContactBarrier within d̂ at the lag, each a BodyFrictionPair,
+/// and the sum of their body_friction. docs/14_contact.md#friction-between-bodies
+class BodyFriction {
+public:
+    /// The mesh's rest positions X (#V×3) [m], which u displaces.
+    explicit BodyFriction(const MatrixX3d& rest) : rest_(rest) {}
+
+    /// Replaces the pairs: one per pair within d̂ (pairs: SelfContactBarrier::pairs at u_lag), with
+    /// λ = κ m |b'(d)| (κ = stiffness [N/m], b of barrier.hpp with d̂ [m]), weights and tangent basis at
+    /// u_lag, sticking to the vertices at u_start (3n each), μ = coefficient ≥ 0 (none when 0).
+    void lag(const std::vector<SurfacePair>& pairs, const Eigen::VectorXd& u_lag, const Eigen::VectorXd& u_start,
+             double stiffness, double coefficient, double activation_distance);
+    /// Σ_k body_friction of the pairs at u (3n) with ε = ε_v Δt [m] [J].
+    double energy(const Eigen::VectorXd& u, double epsilon) const;
+    /// Adds its gradient (3n), each pair's 12 scattered to its 4 vertices, to gradient.
+    void add_gradient(const Eigen::VectorXd& u, double epsilon, Eigen::VectorXd& gradient) const;
+    /// Appends its Hessian's entries (3n×3n; each pair's 12×12 block, PSD without projection).
+    void add_hessian(const Eigen::VectorXd& u, double epsilon, std::vector<Eigen::Triplet<double>>& triplets) const;
+    /// The pairs of the current lag.
+    const std::vector<BodyFrictionPair>& pairs() const { return pairs_; }
+
+private:
+    /// The 4 vertices of pair at u, stacked (12) [m].
+    Vector12d stacked(const BodyFrictionPair& pair, const Eigen::VectorXd& u) const;
+
+    MatrixX3d rest_;
+    std::vector<BodyFrictionPair> pairs_;
+};
 
 }  // namespace fem::contact

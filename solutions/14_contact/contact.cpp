@@ -62,6 +62,7 @@ ContactPotential::ContactPotential(const dynamics::Body& body, std::vector<std::
     : obstacles_(checked_obstacles(std::move(obstacles), options.self_contact)),
       options_(options),
       features_(body.mesh(), obstacles_, checked_activation_distance(options.activation_distance)),
+      body_friction_(body.mesh().V),
       rest_(body.mesh().V)
 {
     if (!(std::isfinite(options_.stiffness) && options_.stiffness >= 0.0))
@@ -69,6 +70,11 @@ ContactPotential::ContactPotential(const dynamics::Body& body, std::vector<std::
     if (!(options_.safety > 0.0 && options_.safety < 1.0))
         throw Error(str("contact: the line search's safety factor must lie in (0, 1), got ", options_.safety));
     require_positive(options_.friction_velocity, "friction velocity eps_v [m/s]");
+    if (!(std::isfinite(options_.body_friction) && options_.body_friction >= 0.0))
+        throw Error(str("contact: the friction coefficient between bodies must be >= 0, got ", options_.body_friction));
+    if (options_.body_friction > 0.0 && !options_.self_contact)
+        throw Error(str("contact: friction between bodies (", options_.body_friction,
+                        ") needs self-contact on: without it no pair of the body's surface is held"));
     if (!(std::isfinite(options_.doubling_distance) && options_.doubling_distance >= 0.0))
         throw Error(str("contact: the doubling distance must be >= 0, got ", options_.doubling_distance));
     surface_ = surface_primitives(body.mesh()).vertices;
@@ -181,6 +187,9 @@ void ContactPotential::begin_step(dynamics::Body& body, const dynamics::State& s
             pair.start = position(state.u, v) + time_step * obstacle.velocity();
             pairs_.push_back(pair);
         }
+    if (self_)
+        body_friction_.lag(options_.body_friction > 0.0 ? self_->pairs(lag, false) : std::vector<SurfacePair>{}, lag,
+                           state.u, stiffness_, options_.body_friction, options_.activation_distance);
     lag_u_.resize(0);
 }
 
@@ -255,7 +264,7 @@ double ContactPotential::energy(const Eigen::VectorXd& u) const
         return total;
     for (const FrictionPair& pair : pairs_)
         total += pair_friction(pair, u).value;
-    return total;
+    return total + body_friction_.energy(u, friction_step_);
 }
 
 Eigen::Vector3d ContactPotential::barrier_force(const Obstacle& obstacle, const Eigen::Vector3d& x) const
@@ -292,6 +301,7 @@ Eigen::VectorXd ContactPotential::gradient(const Eigen::VectorXd& u) const
     Eigen::VectorXd gradient = -barrier_forces(u);
     for (const FrictionPair& pair : pairs_)
         gradient.segment<3>(3 * pair.vertex) += pair_friction(pair, u).gradient;
+    body_friction_.add_gradient(u, friction_step_, gradient);
     return gradient;
 }
 
@@ -342,6 +352,7 @@ dynamics::SparseMatrix ContactPotential::hessian(const Eigen::VectorXd& u) const
     features_.add_hessian(u, time_, stiffness_, triplets);
     if (self_)
         self_->add_hessian(u, stiffness_, triplets);
+    body_friction_.add_hessian(u, friction_step_, triplets);
     dynamics::SparseMatrix H(u.size(), u.size());
     H.setFromTriplets(triplets.begin(), triplets.end());
     return H;

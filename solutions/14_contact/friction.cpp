@@ -3,6 +3,9 @@
 // docs/14_contact.md#friction
 #include "14_contact/friction.hpp"
 
+#include "14_contact/barrier.hpp"
+#include "14_contact/pair_barrier.hpp"
+
 #include "common/error.hpp"
 
 #include <Eigen/Geometry>
@@ -173,6 +176,68 @@ PrimitiveFunction body_friction(const BodyFrictionPair& pair, const Vector12d& x
             result.hessian.block<3, 3>(3 * i, 3 * j) = pair.weights(i) * pair.weights(j) * f.hessian;
     }
     return result;
+}
+
+namespace {
+
+/// The 4 vertices of a pair at u (3×4): X_v + u_v.
+Eigen::Matrix<double, 3, 4> corners(const MatrixX3d& rest, const Eigen::VectorXd& u, const int (&vertices)[4])
+{
+    Eigen::Matrix<double, 3, 4> x;
+    for (int k = 0; k < 4; ++k)
+        x.col(k) = rest.row(vertices[k]).transpose() + u.segment<3>(3 * vertices[k]);
+    return x;
+}
+
+}  // namespace
+
+void BodyFriction::lag(const std::vector<SurfacePair>& pairs, const Eigen::VectorXd& u_lag,
+                       const Eigen::VectorXd& u_start, double stiffness, double coefficient,
+                       double activation_distance)
+{
+    if (u_lag.size() != 3 * rest_.rows() || u_start.size() != u_lag.size())
+        throw Error(str("friction: the lag needs u_lag and u_start with 3n = ", 3 * rest_.rows(), " entries, got ",
+                        u_lag.size(), " and ", u_start.size()));
+    pairs_.clear();
+    if (coefficient == 0.0)
+        return;
+    for (const SurfacePair& pair : pairs) {
+        const double force = stiffness * pair.mollifier * std::abs(barrier(pair.distance, activation_distance).first);
+        pairs_.push_back(body_friction_pair(pair.kind, pair.vertices, corners(rest_, u_lag, pair.vertices),
+                                            corners(rest_, u_start, pair.vertices), force, coefficient));
+    }
+}
+
+Vector12d BodyFriction::stacked(const BodyFrictionPair& pair, const Eigen::VectorXd& u) const
+{
+    const Eigen::Matrix<double, 3, 4> x = corners(rest_, u, pair.vertices);
+    return Eigen::Map<const Vector12d>(x.data());
+}
+
+double BodyFriction::energy(const Eigen::VectorXd& u, double epsilon) const
+{
+    double total = 0.0;
+    for (const BodyFrictionPair& pair : pairs_)
+        total += body_friction(pair, stacked(pair, u), epsilon).value;
+    return total;
+}
+
+void BodyFriction::add_gradient(const Eigen::VectorXd& u, double epsilon, Eigen::VectorXd& gradient) const
+{
+    if (gradient.size() != u.size())
+        throw Error(str("friction: the gradient needs ", u.size(), " entries, got ", gradient.size()));
+    for (const BodyFrictionPair& pair : pairs_) {
+        const PrimitiveFunction f = body_friction(pair, stacked(pair, u), epsilon);
+        for (int k = 0; k < 4; ++k)
+            gradient.segment<3>(3 * pair.vertices[k]) += f.gradient.segment<3>(3 * k);
+    }
+}
+
+void BodyFriction::add_hessian(const Eigen::VectorXd& u, double epsilon,
+                               std::vector<Eigen::Triplet<double>>& triplets) const
+{
+    for (const BodyFrictionPair& pair : pairs_)
+        add_pair_block(pair.vertices, body_friction(pair, stacked(pair, u), epsilon).hessian, triplets);
 }
 
 }  // namespace fem::contact
