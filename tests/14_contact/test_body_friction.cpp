@@ -9,6 +9,8 @@
 #include "14_contact/distances.hpp"
 #include "14_contact/friction.hpp"
 
+#include "block_meshes.hpp"
+
 #include "12_hyperelastic_newton/force_models.hpp"
 #include "12_hyperelastic_newton/newton.hpp"
 
@@ -30,27 +32,10 @@
 
 using namespace fem;
 using namespace fem::contact;
+using fem::test::box_at;
+using fem::test::two_bodies;
 
 namespace {
-
-/// A one-cell box of the given size with its lowest corner at corner.
-TetMesh box_at(const Eigen::Vector3d& corner, const Eigen::Vector3d& size)
-{
-    TetMesh box = box_mesh(1, 1, 1, size);
-    box.V.rowwise() += corner.transpose();
-    return box;
-}
-
-/// One mesh of two components: a's vertices first, then b's.
-TetMesh two_bodies(const TetMesh& a, const TetMesh& b)
-{
-    TetMesh both;
-    both.V.resize(a.V.rows() + b.V.rows(), 3);
-    both.V << a.V, b.V;
-    both.T.resize(a.T.rows() + b.T.rows(), 4);
-    both.T << a.T, (b.T.array() + static_cast<int>(a.V.rows())).matrix();
-    return both;
-}
 
 /// The squared distance of a pair at x (3×4) by its own type (distances.hpp): what Γ x must measure.
 double pair_squared_distance(PrimitivePair kind, const Eigen::Matrix<double, 3, 4>& x)

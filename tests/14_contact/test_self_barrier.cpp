@@ -8,6 +8,8 @@
 #include "14_contact/distances.hpp"
 #include "14_contact/self_barrier.hpp"
 
+#include "block_meshes.hpp"
+
 #include "12_hyperelastic_newton/force_models.hpp"
 #include "12_hyperelastic_newton/newton.hpp"
 
@@ -31,27 +33,10 @@
 
 using namespace fem;
 using namespace fem::contact;
+using fem::test::box_at;
+using fem::test::two_bodies;
 
 namespace {
-
-/// One mesh of two components: a's vertices first, then b's (b's tets renumbered).
-TetMesh two_bodies(const TetMesh& a, const TetMesh& b)
-{
-    TetMesh both;
-    both.V.resize(a.V.rows() + b.V.rows(), 3);
-    both.V << a.V, b.V;
-    both.T.resize(a.T.rows() + b.T.rows(), 4);
-    both.T << a.T, (b.T.array() + static_cast<int>(a.V.rows())).matrix();
-    return both;
-}
-
-/// A one-cell box of the given size with its lowest corner at corner.
-TetMesh box_at(const Eigen::Vector3d& corner, const Eigen::Vector3d& size, int cells = 1)
-{
-    TetMesh box = box_mesh(cells, cells, cells, size);
-    box.V.rowwise() += corner.transpose();
-    return box;
-}
 
 /// The barrier with a fixed κ as a potential (energy, gradient) for test::central_differences.
 struct SelfPotential {
