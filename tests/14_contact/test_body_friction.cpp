@@ -9,7 +9,7 @@
 #include "14_contact/distances.hpp"
 #include "14_contact/friction.hpp"
 
-#include "block_meshes.hpp"
+#include "contact_bodies.hpp"
 
 #include "12_hyperelastic_newton/force_models.hpp"
 #include "12_hyperelastic_newton/newton.hpp"
@@ -58,49 +58,51 @@ Eigen::Vector3d block_velocity(const dynamics::Body& body, const Eigen::VectorXd
     return momentum / mass;
 }
 
-/// Two blocks of one mesh — the lower (first 8 vertices) pinned, the upper on it, 1.2 d̂ above at
-/// rest and moved down by 0.7 d̂ at t = 0 (so the pair is in contact from the first step, and the
-/// rest positions are further apart than d̂, as self-contact asks) — with μ between them, gravity g
-/// (3), the upper block's initial velocity v0 (3), Δt = 1/100 s.
-struct BlockOnBlock {
-    std::unique_ptr<dynamics::Body> body;
-    std::unique_ptr<ContactPotential> contact;
-    std::unique_ptr<hyper::NewtonBackwardEuler> newton;
-    dynamics::State state;
-    double time_step = 1.0 / 100.0;
-    static constexpr double reach = 1e-3;  // d̂ [m]
+constexpr double reach = 1e-3;  // d̂ [m] of the blocks
 
+/// The scene of two blocks of one mesh — the lower (first 8 vertices, 40 × 40 × 10 cm) pinned, the
+/// upper (10 cm) on it, 1.2 d̂ above at rest — with gravity g (3), Δt = 1/100 s.
+dynamics::Scene block_on_block_scene(const Eigen::Vector3d& gravity)
+{
+    dynamics::Scene scene;
+    scene.mesh = two_bodies(box_at(Eigen::Vector3d::Zero(), Eigen::Vector3d(0.4, 0.4, 0.1)),
+                            box_at(Eigen::Vector3d(0.04, 0.21, 0.1 + 1.2 * reach), Eigen::Vector3d::Constant(0.1)));
+    scene.material = {1e6, 0.3, 1000.0};
+    scene.gravity = gravity;
+    scene.time_step = 1.0 / 100.0;
+    for (int v = 0; v < 8; ++v)
+        scene.pinned.push_back(v);
+    return scene;
+}
+
+/// Self-contact with d̂ = reach and μ between the bodies.
+ContactOptions rough_contact(double friction)
+{
+    ContactOptions options;
+    options.self_contact = true;
+    options.body_friction = friction;
+    options.activation_distance = reach;
+    return options;
+}
+
+/// The upper block's (vertices 8 … 15) displacement or velocity: value (3) on each, zero elsewhere (48).
+Eigen::VectorXd on_upper_block(const Eigen::Vector3d& value)
+{
+    Eigen::VectorXd field = Eigen::VectorXd::Zero(3 * 16);
+    for (int v = 8; v < 16; ++v)
+        field.segment<3>(3 * v) = value;
+    return field;
+}
+
+/// block_on_block_scene stepped with μ between the blocks, the upper block moved down by 0.7 d̂ at
+/// t = 0 (so the pair is in contact from the first step, while the rest positions are further apart
+/// than d̂, as self-contact asks) and thrown at v0 (3).
+struct BlockOnBlock : test::ContactRun {
     BlockOnBlock(double friction, const Eigen::Vector3d& gravity, const Eigen::Vector3d& v0)
+        : ContactRun(block_on_block_scene(gravity), rough_contact(friction), {},
+                     on_upper_block(Eigen::Vector3d(0, 0, -0.7 * reach)), on_upper_block(v0))
     {
-        const TetMesh lower = box_at(Eigen::Vector3d::Zero(), Eigen::Vector3d(0.4, 0.4, 0.1));
-        const TetMesh upper = box_at(Eigen::Vector3d(0.04, 0.21, 0.1 + 1.2 * reach), Eigen::Vector3d::Constant(0.1));
-        dynamics::Scene scene;
-        scene.mesh = two_bodies(lower, upper);
-        scene.material = {1e6, 0.3, 1000.0};
-        scene.gravity = gravity;
-        scene.time_step = time_step;
-        for (int v = 0; v < 8; ++v)
-            scene.pinned.push_back(v);
-        body = std::make_unique<dynamics::Body>(scene,
-                                                hyper::make_force_model("stable-neo-hookean", scene.mesh, scene.material));
-        ContactOptions options;
-        options.self_contact = true;
-        options.body_friction = friction;
-        options.activation_distance = reach;
-        contact = std::make_unique<ContactPotential>(*body, std::vector<std::shared_ptr<const Obstacle>>{}, options);
-        hyper::NewtonOptions newton_options;
-        newton_options.relative_tolerance = 1e-9;
-        newton_options.max_iterations = 200;
-        newton = std::make_unique<hyper::NewtonBackwardEuler>(newton_options);
-        newton->set_potential(contact.get());
-        Eigen::VectorXd u0 = Eigen::VectorXd::Zero(3 * 16), velocity = Eigen::VectorXd::Zero(3 * 16);
-        for (int v = 8; v < 16; ++v) {
-            u0[3 * v + 2] = -0.7 * reach;
-            velocity.segment<3>(3 * v) = v0;
-        }
-        state = dynamics::initial_state(*body, u0, velocity);
     }
-    void step() { contact_step(*newton, *contact, *body, time_step, state); }
     /// The upper block's centre-of-mass velocity (3) [m/s].
     Eigen::Vector3d velocity() const { return block_velocity(*body, state.v, 8); }
 };
@@ -257,32 +259,22 @@ TEST_CASE("two blocks rubbing as they bounce off each other: momentum kept, thei
     const TetMesh two = box_at(Eigen::Vector3d(0.1012, 0.03, 0.02), Eigen::Vector3d::Constant(0.1));
     const TetMesh mesh = two_bodies(one, two);
     const auto run = [&](double mu) {
-        dynamics::Scene scene;
-        scene.mesh = mesh;
-        scene.material = {1e5, 0.3, 1000.0};
-        scene.gravity.setZero();
-        scene.time_step = 1.0 / 400.0;
-        dynamics::Body body(scene, hyper::make_force_model("stable-neo-hookean", mesh, scene.material));
         ContactOptions options;
         options.self_contact = true;
         options.body_friction = mu;
-        ContactPotential contact(body, {}, options);
-        hyper::NewtonOptions newton_options;
-        newton_options.relative_tolerance = 1e-9;
-        newton_options.max_iterations = 200;
-        hyper::NewtonBackwardEuler newton(newton_options);
-        newton.set_potential(&contact);
         Eigen::VectorXd velocity(3 * 16);
         for (int v = 0; v < 16; ++v)
             velocity.segment<3>(3 * v) = (v < 8 ? 1.0 : -1.0) * Eigen::Vector3d(0.3, 0.3, 0.0);
-        dynamics::State state = dynamics::initial_state(body, {}, velocity);
+        test::ContactRun blocks(test::free_scene(mesh), options, {}, {}, velocity);
+        const dynamics::Body& body = *blocks.body;
+        const dynamics::State& state = blocks.state;
         double worst = 0.0, scale = 0.0;
         for (int v = 0; v < 16; ++v)
             scale += body.dof_masses()[3 * v] * velocity.segment<3>(3 * v).norm();
         bool rubbed = false;
         for (int s = 0; s < 40; ++s) {
-            contact_step(newton, contact, body, scene.time_step, state);
-            rubbed = rubbed || !contact.body_friction_pairs().empty();
+            blocks.step();
+            rubbed = rubbed || !blocks.contact->body_friction_pairs().empty();
             Eigen::Vector3d total = Eigen::Vector3d::Zero();
             for (int v = 0; v < 16; ++v)
                 total += body.dof_masses()[3 * v] * state.v.segment<3>(3 * v);

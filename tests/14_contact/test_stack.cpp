@@ -6,11 +6,9 @@
 #include "14_contact/obstacles.hpp"
 #include "14_contact/self_barrier.hpp"
 
-#include "12_hyperelastic_newton/force_models.hpp"
-#include "12_hyperelastic_newton/newton.hpp"
+#include "contact_bodies.hpp"
 
 #include "10_linear_dynamics/body.hpp"
-#include "10_linear_dynamics/time_integration.hpp"
 
 #include "common/mesh.hpp"
 
@@ -47,26 +45,22 @@ TEST_CASE("a stack at rest: the barrier force between blocks k and k+1 equals th
     scene.material = {1e6, 0.3, 1000.0};
     scene.gravity = Eigen::Vector3d(0, 0, -g);
     scene.time_step = 1.0 / 100.0;
-    dynamics::Body body(scene, hyper::make_force_model("stable-neo-hookean", mesh, scene.material));
     ContactOptions options;
     options.self_contact = true;
     options.activation_distance = reach;
-    ContactPotential contact(body, {std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ())},
-                             options);
-    hyper::NewtonOptions newton_options;
-    newton_options.relative_tolerance = 1e-10;
-    newton_options.max_iterations = 200;
-    hyper::NewtonBackwardEuler newton(newton_options);
-    newton.set_potential(&contact);
     Eigen::VectorXd u0 = Eigen::VectorXd::Zero(3 * 24);
     for (int v = 0; v < 24; ++v)
         u0[3 * v + 2] = -0.7 * reach * block_of(v);
-    dynamics::State state = dynamics::initial_state(body, u0);
+    test::ContactRun stack(scene, options, {std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ())},
+                           u0, {}, 1e-10);
     // Settled: backward Euler damps the blocks' bounces on the barrier (1.5 s).
     for (int s = 0; s < 150; ++s)
-        contact_step(newton, contact, body, scene.time_step, state);
+        stack.step();
+    const dynamics::Body& body = *stack.body;
+    const ContactPotential& contact = *stack.contact;
+    const dynamics::State& state = stack.state;
     const dynamics::State before = state;
-    contact_step(newton, contact, body, scene.time_step, state);
+    stack.step();
 
     const Eigen::VectorXd& m = body.dof_masses();
     double weight[3] = {0, 0, 0};  // per block [N]
