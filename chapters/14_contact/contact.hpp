@@ -15,8 +15,8 @@
 // an orthonormal basis of the tangent plane ⟂ ∇d_o(x_vᵗ), w_o the obstacle's velocity (IPC: lagged friction).
 // Added to it: the obstacles' edges and corners against the body's surface (feature_barrier.hpp) and,
 // with ContactOptions::self_contact, the body's surface against itself — several bodies, one mesh of
-// several components, against each other (self_barrier.hpp), with ContactOptions::body_friction > 0 lagged friction on those
-// pairs too (friction.hpp: Σ_k μ λ_k f₀(‖T_kᵀ Γ_k (x − xᵗ)‖) over the pairs within d̂ at the step's start).
+// several components, against each other (self_barrier.hpp), with ContactOptions::body_friction > 0
+// lagged friction on those pairs too (friction.hpp: Σ_k μ λ_k f₀(‖T_kᵀ Γ_k (x − xᵗ)‖) over the pairs within d̂ at the step's start).
 
 #include "14_contact/feature_barrier.hpp"
 #include "14_contact/friction.hpp"
@@ -47,7 +47,7 @@ struct ContactOptions {
     /// is below it and still falling (IPC's value: 10⁻⁹).
     double doubling_distance = 1e-9;
     /// Whether the body's surface primitives hold each other off too (SelfContactBarrier: bodies
-    /// against bodies, a body against itself; no friction between them). Off: the body passes
+    /// against bodies, a body against itself; friction between them: body_friction). Off: the body passes
     /// through itself, as every run before it did. docs/14_contact.md#bodies-against-bodies-and-self-contact
     bool self_contact = false;
     /// μ between the body's surface primitives (bodies against bodies, a body against itself), with
@@ -73,8 +73,8 @@ public:
     /// The surface vertices of body's mesh (chapter 13's boundary faces) against every obstacle, and,
     /// with options.self_contact, its surface primitives against each other (SelfContactBarrier).
     /// fem::Error for no obstacle without self_contact, d̂ ≤ 0, κ < 0, a safety outside (0, 1),
-    /// ε_v ≤ 0, ε_d < 0, a body_friction < 0 or > 0 without self_contact, and, with self_contact, two surface primitives that share no vertex closer
-    /// than d̂ at rest (their barrier would push the body at rest: a smaller d̂ is needed).
+    /// ε_v ≤ 0, ε_d < 0, a body_friction < 0 or > 0 without self_contact, and, with self_contact,
+    /// two surface primitives that share no vertex closer than d̂ at rest (their barrier would push the body at rest: a smaller d̂ is needed).
     ContactPotential(const dynamics::Body& body, std::vector<std::shared_ptr<const Obstacle>> obstacles,
                      ContactOptions options = {});
 
@@ -88,12 +88,15 @@ public:
 
     /// P(u) of the header [J] (+∞ when some surface vertex has d ≤ 0).
     double energy(const Eigen::VectorXd& u) const override;
-    /// ∇P (3n): κ b'(d) ∇d per active pair and piece, plus μλ f₁(y) T ŷ per friction pair (ŷ = Tᵀ(x − start)/y).
+    /// ∇P (3n): κ b'(d) ∇d per active pair and piece, plus μλ f₁(y) T ŷ per friction pair (ŷ = Tᵀ(x − start)/y),
+    /// plus the body friction pairs' (BodyFriction::add_gradient).
     Eigen::VectorXd gradient(const Eigen::VectorXd& u) const override;
     /// ∇²P made PSD (3n×3n, vertex blocks only): each vertex's block is the sum of κ (b'' ∇d ∇dᵀ + b' ∇²d)
     /// over its active pairs and, per friction pair with s = Tᵀ(x − start), y = ‖s‖,
     /// μλ T [ (f₁'(y) y − f₁(y))/y³ · s sᵀ + f₁(y)/y · I₂ ] Tᵀ; the sum is projected once
-    /// (chapter 12's project_to_psd): b' ∇²d of a sphere is negative semi-definite.
+    /// (chapter 12's project_to_psd): b' ∇²d of a sphere is negative semi-definite; plus the
+    /// features' and self-contact's pair blocks (each projected) and the body friction pairs' 12×12
+    /// blocks (PSD as they are, BodyFriction::add_hessian).
     dynamics::SparseMatrix hessian(const Eigen::VectorXd& u) const override;
     /// min(1, safety × the earliest time of impact of any surface vertex's path x_v + s·Δx_v, of the
     /// features' pairs and (self_contact) of the surface pairs, SelfContactBarrier::time_of_impact).
