@@ -9,8 +9,6 @@
 
 #include "common/error.hpp"
 
-#include <Eigen/Geometry>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
