@@ -15,9 +15,11 @@
 // an orthonormal basis of the tangent plane ⟂ ∇d_o(x_vᵗ), w_o the obstacle's velocity (IPC: lagged friction).
 // Added to it: the obstacles' edges and corners against the body's surface (feature_barrier.hpp) and,
 // with ContactOptions::self_contact, the body's surface against itself — several bodies, one mesh of
-// several components, against each other (self_barrier.hpp; no friction between them).
+// several components, against each other (self_barrier.hpp), with ContactOptions::body_friction > 0
+// lagged friction on those pairs too (friction.hpp: Σ_k μ λ_k f₀(‖T_kᵀ Γ_k (x − xᵗ)‖) over the pairs within d̂ at the step's start).
 
 #include "14_contact/feature_barrier.hpp"
+#include "14_contact/friction.hpp"
 #include "14_contact/obstacles.hpp"
 #include "14_contact/self_barrier.hpp"
 
@@ -45,19 +47,13 @@ struct ContactOptions {
     /// is below it and still falling (IPC's value: 10⁻⁹).
     double doubling_distance = 1e-9;
     /// Whether the body's surface primitives hold each other off too (SelfContactBarrier: bodies
-    /// against bodies, a body against itself; no friction between them). Off: the body passes
+    /// against bodies, a body against itself; friction between them: body_friction). Off: the body passes
     /// through itself, as every run before it did. docs/14_contact.md#bodies-against-bodies-and-self-contact
     bool self_contact = false;
-};
-
-/// One lagged friction pair: vertex v against obstacle o, with the normal force and tangent basis
-/// of the step's start.
-struct FrictionPair {
-    int vertex = 0, obstacle = 0;
-    double normal_force = 0.0;           ///< λ = κ Σ_p |b'(d_p(x_vᵗ))| over the obstacle's pieces [N]
-    double coefficient = 0.0;            ///< μ of the obstacle
-    Eigen::Matrix<double, 3, 2> tangent; ///< T: orthonormal, ⟂ ∇d(x_vᵗ)
-    Eigen::Vector3d start;               ///< x_vᵗ + Δt w_o: where the vertex sticks to the obstacle
+    /// μ between the body's surface primitives (bodies against bodies, a body against itself), with
+    /// self_contact: lagged friction on its point–triangle and edge–edge pairs (BodyFriction); 0: none.
+    /// docs/14_contact.md#friction-between-bodies
+    double body_friction = 0.0;
 };
 
 /// The minimiser of ‖g + κ h‖ over κ: κ = −gᵀh/‖h‖² (g, h of one size), the κ whose barrier force
@@ -77,8 +73,8 @@ public:
     /// The surface vertices of body's mesh (chapter 13's boundary faces) against every obstacle, and,
     /// with options.self_contact, its surface primitives against each other (SelfContactBarrier).
     /// fem::Error for no obstacle without self_contact, d̂ ≤ 0, κ < 0, a safety outside (0, 1),
-    /// ε_v ≤ 0, ε_d < 0, and, with self_contact, two surface primitives that share no vertex closer
-    /// than d̂ at rest (their barrier would push the body at rest: a smaller d̂ is needed).
+    /// ε_v ≤ 0, ε_d < 0, a body_friction < 0 or > 0 without self_contact, and, with self_contact,
+    /// two surface primitives that share no vertex closer than d̂ at rest (their barrier would push the body at rest: a smaller d̂ is needed).
     ContactPotential(const dynamics::Body& body, std::vector<std::shared_ptr<const Obstacle>> obstacles,
                      ContactOptions options = {});
 
@@ -86,17 +82,21 @@ public:
     /// 100 κ_min; at the first step with a vertex within d̂, κ = balancing_stiffness(−f − f_ext,
     /// ∇B) clamped to [κ_min, κ_max] (B: the unit-κ barrier sum, over free dofs); later κ doubles,
     /// up to κ_max, when the smallest distance is below ε_d and smaller than at the last step); the
-    /// friction pairs from x_vᵗ (FrictionPair).
+    /// friction pairs from x_vᵗ (FrictionPair) and, with body_friction, the body's own pairs within d̂
+    /// (BodyFriction::lag, sticking to xᵗ).
     void begin_step(dynamics::Body& body, const dynamics::State& state, double time_step) override;
 
     /// P(u) of the header [J] (+∞ when some surface vertex has d ≤ 0).
     double energy(const Eigen::VectorXd& u) const override;
-    /// ∇P (3n): κ b'(d) ∇d per active pair and piece, plus μλ f₁(y) T ŷ per friction pair (ŷ = Tᵀ(x − start)/y).
+    /// ∇P (3n): κ b'(d) ∇d per active pair and piece, plus μλ f₁(y) T ŷ per friction pair (ŷ = Tᵀ(x − start)/y),
+    /// plus the body friction pairs' (BodyFriction::add_gradient).
     Eigen::VectorXd gradient(const Eigen::VectorXd& u) const override;
     /// ∇²P made PSD (3n×3n, vertex blocks only): each vertex's block is the sum of κ (b'' ∇d ∇dᵀ + b' ∇²d)
     /// over its active pairs and, per friction pair with s = Tᵀ(x − start), y = ‖s‖,
     /// μλ T [ (f₁'(y) y − f₁(y))/y³ · s sᵀ + f₁(y)/y · I₂ ] Tᵀ; the sum is projected once
-    /// (chapter 12's project_to_psd): b' ∇²d of a sphere is negative semi-definite.
+    /// (chapter 12's project_to_psd): b' ∇²d of a sphere is negative semi-definite; plus the
+    /// features' and self-contact's pair blocks (each projected) and the body friction pairs' 12×12
+    /// blocks (PSD as they are, BodyFriction::add_hessian).
     dynamics::SparseMatrix hessian(const Eigen::VectorXd& u) const override;
     /// min(1, safety × the earliest time of impact of any surface vertex's path x_v + s·Δx_v, of the
     /// features' pairs and (self_contact) of the surface pairs, SelfContactBarrier::time_of_impact).
@@ -165,6 +165,11 @@ public:
     double stiffness() const { return stiffness_; }
     /// The current step's lagged friction pairs (set by begin_step).
     const std::vector<FrictionPair>& friction_pairs() const { return pairs_; }
+    /// The current step's lagged friction pairs between the body's surface primitives (body_friction).
+    const std::vector<BodyFrictionPair>& body_friction_pairs() const { return body_friction_.pairs(); }
+    /// The barrier between the body's surface primitives (self_contact), else null: its pairs and
+    /// their forces (SelfContactBarrier::pairs) with the step's stiffness().
+    const SelfContactBarrier* self_barrier() const { return self_.get(); }
 
 private:
     Eigen::Vector3d position(const Eigen::VectorXd& u, int vertex) const;
@@ -174,13 +179,15 @@ private:
                                double obstacle_time, std::string* blocked) const;
     /// −κ Σ_p b'(d_p) ∇d_p: the barrier force of one obstacle on the surface vertex at x, time time_.
     Eigen::Vector3d barrier_force(const Obstacle& obstacle, const Eigen::Vector3d& x) const;
-    /// −μλ f₁(y)/y T s: the friction force of one pair on its vertex at u.
-    Eigen::Vector3d friction_force(const FrictionPair& pair, const Eigen::VectorXd& u) const;
+    /// One obstacle pair's lagged friction at u: lagged_friction of r = x_v − start with μλ (its
+    /// gradient is minus the friction force on the vertex).
+    LaggedFriction pair_friction(const FrictionPair& pair, const Eigen::VectorXd& u) const;
 
     std::vector<std::shared_ptr<const Obstacle>> obstacles_;
     ContactOptions options_;
     FeatureBarrier features_;  // the obstacles' edges and corners against the body's surface
     std::unique_ptr<SelfContactBarrier> self_;  // the body's surface against itself (self_contact), else null
+    BodyFriction body_friction_;                // the lagged friction of self_'s pairs (body_friction)
     Eigen::MatrixX3d rest_;            // X (#V × 3)
     std::vector<int> surface_;
     double average_mass_ = 0.0, diagonal_ = 0.0;
@@ -232,8 +239,5 @@ inline constexpr int most_obstacle_stages = 200;
 dynamics::StepInfo contact_step(hyper::NewtonBackwardEuler& newton, ContactPotential& contact, dynamics::Body& body,
                                 double time_step, dynamics::State& state, int updates = 1, int* solves = nullptr,
                                 int* stages = nullptr);
-
-/// The tangent-plane basis of a unit normal n: T (3×2) with orthonormal columns ⟂ n.
-Eigen::Matrix<double, 3, 2> tangent_basis(const Eigen::Vector3d& normal);
 
 }  // namespace fem::contact

@@ -11,6 +11,10 @@
 #include "14_contact/ccd.hpp"
 #include "14_contact/distances.hpp"
 
+#include <Eigen/Sparse>
+
+#include <vector>
+
 namespace fem::contact {
 
 /// m b(d) of a pair from its squared distance d² and mollifier m (each with gradient and Hessian in
@@ -20,6 +24,10 @@ namespace fem::contact {
 /// For d ≥ d̂ all 0; d² > 0 is the caller's to ensure. docs/14_contact.md#edges-and-corners-of-obstacles
 PrimitiveFunction mollified_barrier(const PrimitiveFunction& squared_distance, const PrimitiveFunction& mollifier,
                                     double activation_distance, bool with_derivatives);
+
+/// Appends a pair's 12×12 block (block (a, b): the 3×3 of its vertices a and b) to the triplets of
+/// a 3n×3n matrix, at the rows and columns of its 4 mesh vertices.
+void add_pair_block(const int (&vertices)[4], const Matrix12d& block, std::vector<Eigen::Triplet<double>>& triplets);
 
 /// The mollifier of a point–triangle pair: m = 1, ∇m = 0, ∇²m = 0 (12).
 PrimitiveFunction unit_mollifier();

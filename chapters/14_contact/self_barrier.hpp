@@ -17,6 +17,7 @@
 // by the tree over swept boxes and line_search_time_of_impact (pair_barrier.hpp) per candidate.
 
 #include "14_contact/broad_phase.hpp"
+#include "14_contact/ccd.hpp"
 #include "14_contact/distances.hpp"
 
 #include "common/mesh.hpp"
@@ -27,6 +28,16 @@
 #include <vector>
 
 namespace fem::contact {
+
+/// One pair of surface primitives within reach: its kind, its 4 mesh vertices (p, a, b, c or ea0,
+/// ea1, eb0, eb1), its distance d [m], its mollifier m (1 for a point and a triangle) and κ-free
+/// m b(d), with gradient and Hessian in their 12 coordinates when asked.
+struct SurfacePair {
+    PrimitivePair kind = PrimitivePair::point_triangle;
+    int vertices[4] = {0, 0, 0, 0};
+    double distance = 0.0, mollifier = 1.0;
+    PrimitiveFunction barrier;
+};
 
 /// The barrier of the header between the surface primitives of one mesh.
 class SelfContactBarrier {
@@ -48,6 +59,10 @@ public:
     /// projected to PSD on its own (chapter 12's project_to_psd, clamp), so the sum is PSD.
     /// fem::Error where a pair touches (d = 0) or on u's size.
     void add_hessian(const Eigen::VectorXd& u, double stiffness, std::vector<Eigen::Triplet<double>>& triplets) const;
+    /// The pairs within d̂ at u (3n), with their barrier's gradient and Hessian when with_derivatives
+    /// (κ-free: the force of pair k on its 4 vertices is −κ ∇(m_k b(d_k)), SurfacePair::barrier's
+    /// gradient). fem::Error where a pair touches (d = 0) or on u's size.
+    std::vector<SurfacePair> pairs(const Eigen::VectorXd& u, bool with_derivatives) const;
     /// The smallest distance of any pair within reach [m] at u (3n): +∞ when none is, 0 when a pair touches.
     double smallest_distance(const Eigen::VectorXd& u, double reach) const;
     /// The earliest time of impact s ∈ [0, 1] of any pair when the surface moves from u to u + du (3n
@@ -57,13 +72,6 @@ public:
     double time_of_impact(const Eigen::VectorXd& u, const Eigen::VectorXd& du) const;
 
 private:
-    /// One pair within reach: its 4 mesh vertices (p, a, b, c or ea0, ea1, eb0, eb1), its distance,
-    /// and κ-free m b(d) with gradient and Hessian in their 12 coordinates.
-    struct Pair {
-        int vertices[4] = {0, 0, 0, 0};
-        double distance = 0.0;
-        PrimitiveFunction barrier;
-    };
     /// Calls visit(pair) for every pair within reach at u; with_derivatives: with the barrier's
     /// gradient and Hessian. Returns false (stopping) at a pair with d = 0.
     template <class Visit>

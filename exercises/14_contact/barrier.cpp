@@ -26,19 +26,4 @@ BarrierValue barrier(double d, double activation_distance)
     return b;
 }
 
-MollifierValue friction_mollifier(double y, double epsilon)
-{
-    require_positive(epsilon, "friction smoothing ε = ε_v Δt [m]");
-    if (!(y >= 0.0))
-        throw Error(str("friction_mollifier: the tangential displacement y must be >= 0, got ", y));
-    MollifierValue f;
-    if (y >= epsilon)
-        return {y, 1.0, 0.0};
-    // EXERCISE 14.4 (friction_mollifier): see docs/14_contact.md#friction
-    // HINT: below ε: f₁ = 2y/ε − y²/ε², its derivative f₁' = 2/ε − 2y/ε², and its integral with
-    // HINT: f₀(ε) = ε (continuous with f₀ = y above ε): f₀ = y²/ε − y³/(3ε²) + ε/3.
-    throw fem::NotImplemented("14.4", "friction_mollifier", "docs/14_contact.md#friction");
-    return f;
-}
-
 }  // namespace fem::contact

@@ -1,14 +1,13 @@
 #include "14_contact/contact.hpp"
 
 #include "14_contact/barrier.hpp"
+#include "14_contact/friction.hpp"
 
 #include "12_hyperelastic_newton/materials.hpp"
 
 #include "04_tet_jacobians/tet_jacobians.hpp"
 
 #include "common/error.hpp"
-
-#include <Eigen/Geometry>
 
 #include <algorithm>
 #include <cmath>
@@ -41,19 +40,6 @@ double checked_activation_distance(double activation_distance)
 
 }  // namespace
 
-Eigen::Matrix<double, 3, 2> tangent_basis(const Eigen::Vector3d& normal)
-{
-    const Eigen::Vector3d n = normal.normalized();
-    // The axis least aligned with n, crossed with it, gives a first tangent of length ≥ √(2/3).
-    Eigen::Index axis = 0;
-    n.cwiseAbs().minCoeff(&axis);
-    const Eigen::Vector3d first = n.cross(Eigen::Vector3d::Unit(axis)).normalized();
-    Eigen::Matrix<double, 3, 2> T;
-    T.col(0) = first;
-    T.col(1) = n.cross(first);
-    return T;
-}
-
 double balancing_stiffness(const Eigen::VectorXd& g, const Eigen::VectorXd& h)
 {
     if (g.size() != h.size())
@@ -74,6 +60,7 @@ ContactPotential::ContactPotential(const dynamics::Body& body, std::vector<std::
     : obstacles_(checked_obstacles(std::move(obstacles), options.self_contact)),
       options_(options),
       features_(body.mesh(), obstacles_, checked_activation_distance(options.activation_distance)),
+      body_friction_(body.mesh().V),
       rest_(body.mesh().V)
 {
     if (!(std::isfinite(options_.stiffness) && options_.stiffness >= 0.0))
@@ -81,6 +68,11 @@ ContactPotential::ContactPotential(const dynamics::Body& body, std::vector<std::
     if (!(options_.safety > 0.0 && options_.safety < 1.0))
         throw Error(str("contact: the line search's safety factor must lie in (0, 1), got ", options_.safety));
     require_positive(options_.friction_velocity, "friction velocity eps_v [m/s]");
+    if (!(std::isfinite(options_.body_friction) && options_.body_friction >= 0.0))
+        throw Error(str("contact: the friction coefficient between bodies must be >= 0, got ", options_.body_friction));
+    if (options_.body_friction > 0.0 && !options_.self_contact)
+        throw Error(str("contact: friction between bodies (", options_.body_friction,
+                        ") needs self-contact on: without it no pair of the body's surface is held"));
     if (!(std::isfinite(options_.doubling_distance) && options_.doubling_distance >= 0.0))
         throw Error(str("contact: the doubling distance must be >= 0, got ", options_.doubling_distance));
     surface_ = surface_primitives(body.mesh()).vertices;
@@ -193,6 +185,9 @@ void ContactPotential::begin_step(dynamics::Body& body, const dynamics::State& s
             pair.start = position(state.u, v) + time_step * obstacle.velocity();
             pairs_.push_back(pair);
         }
+    if (self_)
+        body_friction_.lag(options_.body_friction > 0.0 ? self_->pairs(lag, false) : std::vector<SurfacePair>{}, lag,
+                           state.u, stiffness_, options_.body_friction, options_.activation_distance);
     lag_u_.resize(0);
 }
 
@@ -265,11 +260,9 @@ double ContactPotential::energy(const Eigen::VectorXd& u) const
     double total = barrier_energy(u, time_);
     if (!std::isfinite(total))
         return total;
-    for (const FrictionPair& pair : pairs_) {
-        const double y = (pair.tangent.transpose() * (position(u, pair.vertex) - pair.start)).norm();
-        total += pair.coefficient * pair.normal_force * friction_mollifier(y, friction_step_).f0;
-    }
-    return total;
+    for (const FrictionPair& pair : pairs_)
+        total += pair_friction(pair, u).value;
+    return total + body_friction_.energy(u, friction_step_);
 }
 
 Eigen::Vector3d ContactPotential::barrier_force(const Obstacle& obstacle, const Eigen::Vector3d& x) const
@@ -282,14 +275,10 @@ Eigen::Vector3d ContactPotential::barrier_force(const Obstacle& obstacle, const 
     return force;
 }
 
-Eigen::Vector3d ContactPotential::friction_force(const FrictionPair& pair, const Eigen::VectorXd& u) const
+LaggedFriction ContactPotential::pair_friction(const FrictionPair& pair, const Eigen::VectorXd& u) const
 {
-    const Eigen::Vector2d s = pair.tangent.transpose() * (position(u, pair.vertex) - pair.start);
-    const double y = s.norm();
-    const MollifierValue f = friction_mollifier(y, friction_step_);
-    // f₁(y)/y, finite at y = 0 where it tends to 2/ε.
-    const double f1_over_y = y > 0.0 ? f.f1 / y : 2.0 / friction_step_;
-    return -pair.coefficient * pair.normal_force * f1_over_y * (pair.tangent * s);
+    return lagged_friction(pair.tangent, position(u, pair.vertex) - pair.start, pair.coefficient * pair.normal_force,
+                           friction_step_);
 }
 
 Eigen::VectorXd ContactPotential::barrier_forces(const Eigen::VectorXd& u) const
@@ -309,7 +298,8 @@ Eigen::VectorXd ContactPotential::gradient(const Eigen::VectorXd& u) const
 {
     Eigen::VectorXd gradient = -barrier_forces(u);
     for (const FrictionPair& pair : pairs_)
-        gradient.segment<3>(3 * pair.vertex) -= friction_force(pair, u);
+        gradient.segment<3>(3 * pair.vertex) += pair_friction(pair, u).gradient;
+    body_friction_.add_gradient(u, friction_step_, gradient);
     return gradient;
 }
 
@@ -324,7 +314,7 @@ double ContactPotential::obstacle_work(const Eigen::VectorXd& u, double time_ste
             work += obstacle->velocity().dot(barrier_force(*obstacle, position(u, v)));
     }
     for (const FrictionPair& pair : pairs_)
-        work += obstacles_[static_cast<std::size_t>(pair.obstacle)]->velocity().dot(friction_force(pair, u));
+        work -= obstacles_[static_cast<std::size_t>(pair.obstacle)]->velocity().dot(pair_friction(pair, u).gradient);
     return time_step * (work + features_.obstacle_power(u, time_, stiffness_));
 }
 
@@ -348,18 +338,8 @@ dynamics::SparseMatrix ContactPotential::hessian(const Eigen::VectorXd& u) const
                 add(v, stiffness_ * (b.second * n * n.transpose() + b.first * piece.hessian));
             }
         }
-    for (const FrictionPair& pair : pairs_) {
-        const Eigen::Vector2d s = pair.tangent.transpose() * (position(u, pair.vertex) - pair.start);
-        const double y = s.norm();
-        const MollifierValue f = friction_mollifier(y, friction_step_);
-        const double f1_over_y = y > 0.0 ? f.f1 / y : 2.0 / friction_step_;
-        // (f₁'y − f₁)/y³ s sᵀ: bounded as y → 0 (it is −s sᵀ/(y ε²) below ε), 0 at y = 0.
-        const Eigen::Matrix2d radial =
-            y > 0.0 ? Eigen::Matrix2d((f.f1_derivative * y - f.f1) / (y * y * y) * s * s.transpose())
-                    : Eigen::Matrix2d::Zero();
-        const Eigen::Matrix2d inner = radial + f1_over_y * Eigen::Matrix2d::Identity();
-        add(pair.vertex, pair.coefficient * pair.normal_force * pair.tangent * inner * pair.tangent.transpose());
-    }
+    for (const FrictionPair& pair : pairs_)
+        add(pair.vertex, pair_friction(pair, u).hessian);
     std::vector<Eigen::Triplet<double>> triplets;
     for (const auto& [vertex, block] : blocks) {
         const Eigen::Matrix3d projected = hyper::project_to_psd<3>(block, hyper::Projection::clamp);
@@ -370,6 +350,7 @@ dynamics::SparseMatrix ContactPotential::hessian(const Eigen::VectorXd& u) const
     features_.add_hessian(u, time_, stiffness_, triplets);
     if (self_)
         self_->add_hessian(u, stiffness_, triplets);
+    body_friction_.add_hessian(u, friction_step_, triplets);
     dynamics::SparseMatrix H(u.size(), u.size());
     H.setFromTriplets(triplets.begin(), triplets.end());
     return H;

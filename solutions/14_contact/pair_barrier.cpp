@@ -50,6 +50,15 @@ PrimitiveFunction mollified_barrier(const PrimitiveFunction& squared_distance, c
     return result;
 }
 
+void add_pair_block(const int (&vertices)[4], const Matrix12d& block, std::vector<Eigen::Triplet<double>>& triplets)
+{
+    for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 4; ++b)
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j)
+                    triplets.emplace_back(3 * vertices[a] + i, 3 * vertices[b] + j, block(3 * a + i, 3 * b + j));
+}
+
 PrimitiveFunction unit_mollifier()
 {
     PrimitiveFunction one;

@@ -45,17 +45,19 @@ bool SelfContactBarrier::for_each_pair(const Eigen::VectorXd& u, double reach, b
     const auto at = [&](int v) -> Eigen::Vector3d { return x.row(v).transpose(); };
     const auto rest = [&](int v) -> Eigen::Vector3d { return rest_.row(v).transpose(); };
     const CandidatePairs candidates = tree_candidates(surface_, x, x, reach);
-    Pair pair;
+    SurfacePair pair;
     const auto offer = [&](const PrimitiveFunction& squared, const PrimitiveFunction& mollifier) {
         if (!(squared.value < reach * reach))
             return true;
         if (!(squared.value > 0.0))
             return false;
         pair.distance = std::sqrt(squared.value);
+        pair.mollifier = mollifier.value;
         pair.barrier = mollified_barrier(squared, mollifier, activation_distance_, with_derivatives);
         visit(pair);
         return true;
     };
+    pair.kind = PrimitivePair::point_triangle;
     for (const auto& [vertex, triangle] : candidates.point_triangle) {
         pair.vertices[0] = vertex;
         for (int c = 0; c < 3; ++c)
@@ -65,6 +67,7 @@ bool SelfContactBarrier::for_each_pair(const Eigen::VectorXd& u, double reach, b
         if (!offer(point_triangle_squared_distance(p, a, b, c, point_triangle_type(p, a, b, c)), unit_mollifier()))
             return false;
     }
+    pair.kind = PrimitivePair::edge_edge;
     for (const auto& [first, second] : candidates.edge_edge) {
         const int v[4] = {surface_.edges(first, 0), surface_.edges(first, 1), surface_.edges(second, 0),
                           surface_.edges(second, 1)};
@@ -83,7 +86,7 @@ bool SelfContactBarrier::for_each_pair(const Eigen::VectorXd& u, double reach, b
 double SelfContactBarrier::energy(const Eigen::VectorXd& u, double stiffness) const
 {
     double total = 0.0;
-    if (!for_each_pair(u, activation_distance_, false, [&](const Pair& pair) { total += pair.barrier.value; }))
+    if (!for_each_pair(u, activation_distance_, false, [&](const SurfacePair& pair) { total += pair.barrier.value; }))
         return infinity;
     return stiffness * total;
 }
@@ -92,7 +95,7 @@ void SelfContactBarrier::add_gradient(const Eigen::VectorXd& u, double stiffness
 {
     if (gradient.size() != u.size())
         throw Error(str("self-contact: the gradient needs ", u.size(), " entries, got ", gradient.size()));
-    const bool apart = for_each_pair(u, activation_distance_, true, [&](const Pair& pair) {
+    const bool apart = for_each_pair(u, activation_distance_, true, [&](const SurfacePair& pair) {
         for (int k = 0; k < 4; ++k)
             gradient.segment<3>(3 * pair.vertices[k]) += stiffness * pair.barrier.gradient.segment<3>(3 * k);
     });
@@ -103,24 +106,28 @@ void SelfContactBarrier::add_gradient(const Eigen::VectorXd& u, double stiffness
 void SelfContactBarrier::add_hessian(const Eigen::VectorXd& u, double stiffness,
                                      std::vector<Eigen::Triplet<double>>& triplets) const
 {
-    const bool apart = for_each_pair(u, activation_distance_, true, [&](const Pair& pair) {
+    const bool apart = for_each_pair(u, activation_distance_, true, [&](const SurfacePair& pair) {
         // Each pair's block is made PSD on its own (a sum of PSD blocks is PSD).
-        const Matrix12d block = stiffness * hyper::project_to_psd<12>(pair.barrier.hessian, hyper::Projection::clamp);
-        for (int a = 0; a < 4; ++a)
-            for (int b = 0; b < 4; ++b)
-                for (int i = 0; i < 3; ++i)
-                    for (int j = 0; j < 3; ++j)
-                        triplets.emplace_back(3 * pair.vertices[a] + i, 3 * pair.vertices[b] + j,
-                                              block(3 * a + i, 3 * b + j));
+        add_pair_block(pair.vertices,
+                       stiffness * hyper::project_to_psd<12>(pair.barrier.hessian, hyper::Projection::clamp), triplets);
     });
     if (!apart)
         throw Error("self-contact: the Hessian of the barrier was asked where two surface primitives touch (d = 0)");
 }
 
+std::vector<SurfacePair> SelfContactBarrier::pairs(const Eigen::VectorXd& u, bool with_derivatives) const
+{
+    std::vector<SurfacePair> within;
+    if (!for_each_pair(u, activation_distance_, with_derivatives,
+                       [&](const SurfacePair& pair) { within.push_back(pair); }))
+        throw Error("self-contact: the pairs of the barrier were asked where two surface primitives touch (d = 0)");
+    return within;
+}
+
 double SelfContactBarrier::smallest_distance(const Eigen::VectorXd& u, double reach) const
 {
     double smallest = infinity;
-    if (!for_each_pair(u, reach, false, [&](const Pair& pair) { smallest = std::min(smallest, pair.distance); }))
+    if (!for_each_pair(u, reach, false, [&](const SurfacePair& pair) { smallest = std::min(smallest, pair.distance); }))
         return 0.0;
     return smallest;
 }

@@ -4,6 +4,7 @@
 #include "14_contact/barrier.hpp"
 #include "14_contact/contact.hpp"
 #include "14_contact/contact_scenes.hpp"
+#include "14_contact/friction.hpp"
 #include "14_contact/mesh_obstacle.hpp"
 #include "14_contact/obstacles.hpp"
 

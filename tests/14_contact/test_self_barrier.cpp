@@ -8,6 +8,8 @@
 #include "14_contact/distances.hpp"
 #include "14_contact/self_barrier.hpp"
 
+#include "contact_bodies.hpp"
+
 #include "12_hyperelastic_newton/force_models.hpp"
 #include "12_hyperelastic_newton/newton.hpp"
 
@@ -31,27 +33,10 @@
 
 using namespace fem;
 using namespace fem::contact;
+using fem::test::box_at;
+using fem::test::two_bodies;
 
 namespace {
-
-/// One mesh of two components: a's vertices first, then b's (b's tets renumbered).
-TetMesh two_bodies(const TetMesh& a, const TetMesh& b)
-{
-    TetMesh both;
-    both.V.resize(a.V.rows() + b.V.rows(), 3);
-    both.V << a.V, b.V;
-    both.T.resize(a.T.rows() + b.T.rows(), 4);
-    both.T << a.T, (b.T.array() + static_cast<int>(a.V.rows())).matrix();
-    return both;
-}
-
-/// A one-cell box of the given size with its lowest corner at corner.
-TetMesh box_at(const Eigen::Vector3d& corner, const Eigen::Vector3d& size, int cells = 1)
-{
-    TetMesh box = box_mesh(cells, cells, cells, size);
-    box.V.rowwise() += corner.transpose();
-    return box;
-}
 
 /// The barrier with a fixed κ as a potential (energy, gradient) for test::central_differences.
 struct SelfPotential {
@@ -108,40 +93,33 @@ std::string edge_through_triangle(const SurfacePrimitives& surface, const Matrix
 /// Two bodies, one mesh (two_bodies: the first `half` vertices the first body), without gravity, thrown
 /// at each other at ±speed along axis, stepped by chapter 12's Newton backward Euler with
 /// self-contact as its potential (contact_step).
-struct Bodies {
-    std::unique_ptr<dynamics::Body> body;
-    std::unique_ptr<ContactPotential> contact;
-    std::unique_ptr<hyper::NewtonBackwardEuler> newton;
-    dynamics::State state;
+struct Bodies : test::ContactRun {
     SurfacePrimitives surface;
-    double time_step = 1.0 / 400.0;
 
-    Bodies(const TetMesh& mesh, Eigen::Index half, int axis, double speed) : surface(surface_primitives(mesh))
+    Bodies(const TetMesh& mesh, Eigen::Index half, int axis, double speed)
+        : ContactRun(test::free_scene(mesh), self_contact(), {}, {}, thrown(mesh, half, axis, speed)),
+          surface(surface_primitives(mesh))
     {
-        dynamics::Scene scene;
-        scene.mesh = mesh;
-        scene.material = {1e5, 0.3, 1000.0};
-        scene.gravity.setZero();
-        scene.time_step = time_step;
-        body = std::make_unique<dynamics::Body>(scene, hyper::make_force_model("stable-neo-hookean", mesh, scene.material));
+    }
+    static ContactOptions self_contact()
+    {
         ContactOptions options;
         options.self_contact = true;
-        contact = std::make_unique<ContactPotential>(*body, std::vector<std::shared_ptr<const Obstacle>>{}, options);
-        hyper::NewtonOptions newton_options;
-        newton_options.relative_tolerance = 1e-9;
-        newton_options.max_iterations = 200;
-        newton = std::make_unique<hyper::NewtonBackwardEuler>(newton_options);
-        newton->set_potential(contact.get());
+        return options;
+    }
+    /// ±speed along axis: + on the first half of the vertices, − on the rest (3n).
+    static Eigen::VectorXd thrown(const TetMesh& mesh, Eigen::Index half, int axis, double speed)
+    {
         Eigen::VectorXd velocity = Eigen::VectorXd::Zero(3 * mesh.V.rows());
         for (Eigen::Index v = 0; v < mesh.V.rows(); ++v)
             velocity[3 * v + axis] = v < half ? speed : -speed;
-        state = dynamics::initial_state(*body, {}, velocity);
+        return velocity;
     }
     /// One step; requires that no surface pair touches and no surface edge meets a surface triangle
     /// after it, and returns the smallest distance of a pair within d̂ (+∞: none).
     double step()
     {
-        contact_step(*newton, *contact, *body, time_step, state);
+        ContactRun::step();
         INFO("step " << state.step);
         const double distance = contact->smallest_distance(state.u);
         REQUIRE(distance > 0.0);

@@ -1,0 +1,147 @@
+#pragma once
+// Chapter 14: lagged, smoothed Coulomb friction (Li et al. 2020, §5) — of a surface vertex against an
+// obstacle and of two surface primitives of the bodies against each other (a point and a triangle,
+// two edges). docs/14_contact.md#friction
+//
+// Coulomb friction is not an energy; IPC makes it one per step in two moves. *Lagging*: per pair k in
+// contact at the step's start, its normal force λ_k, tangent basis T_k (3×2, orthonormal) and, for
+// two primitives, the barycentric weights of their closest points are taken there and held over the
+// step. *Smoothing*: the friction force's jump at zero sliding is replaced by the mollifier
+//
+//   f₁(y) = 2y/ε − y²/ε²  for 0 ≤ y < ε,   1 for y ≥ ε        (IPC: the friction mollifier; ε = ε_v Δt)
+//   f₀(y) = ∫ f₁ = y²/ε − y³/(3ε²) + ε/3  for y < ε,   y for y ≥ ε
+//
+// so each pair holds the energy μ λ_k f₀(‖s_k‖) of its tangential displacement over the step
+//
+//   s_k = T_kᵀ r_k,   r_k = Γ_k (x − x_start)   (3: the relative displacement of the closest points)
+//
+// with Γ_k (3×3m) the pair's weights: I for a vertex against an obstacle (x_start = x_vᵗ + Δt w_o,
+// the point the vertex sticks to on the moving obstacle), [w₀ I, w₁ I, w₂ I, w₃ I] for two
+// primitives (w = (1, −β₁, −β₂, −β₃) for a point and a triangle's closest point Σ β_i x_i;
+// (1 − α, α, −(1 − γ), −γ) for edges' closest points at parameters α, γ; x_start = xᵗ). The weights
+// of two primitives sum to zero: their friction forces are equal and opposite.
+
+#include "14_contact/ccd.hpp"
+#include "14_contact/distances.hpp"
+#include "14_contact/self_barrier.hpp"
+
+#include "common/mesh.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/Sparse>
+
+#include <vector>
+
+namespace fem::contact {
+
+/// f₀(y), f₁(y) = f₀'(y) and f₁'(y) of the friction mollifier at one tangential displacement y ≥ 0.
+struct MollifierValue {
+    double f0 = 0.0, f1 = 0.0, f1_derivative = 0.0;
+};
+
+/// The mollifier of the header at y ≥ 0 with ε = ε_v Δt > 0 [m]: f₀, f₁ = 2y/ε − y²/ε²,
+/// f₁' = 2/ε − 2y/ε² below ε; y, 1, 0 above. fem::Error for ε ≤ 0 or y < 0.
+/// docs/14_contact.md#friction
+MollifierValue friction_mollifier(double y, double epsilon);
+
+/// The tangent-plane basis of a normal n (3, nonzero): T (3×2) with orthonormal columns ⟂ n.
+Eigen::Matrix<double, 3, 2> tangent_basis(const Eigen::Vector3d& normal);
+
+/// One pair's lagged friction as a function of its relative displacement r (3) [m], with gradient
+/// and Hessian in r.
+struct LaggedFriction {
+    double value = 0.0;                                     ///< [J]
+    Eigen::Vector3d gradient = Eigen::Vector3d::Zero();     ///< [N]: minus the friction force
+    Eigen::Matrix3d hessian = Eigen::Matrix3d::Zero();      ///< [N/m], PSD
+};
+
+/// μλ f₀(y) of s = Tᵀ r, y = ‖s‖, with scale = μλ ≥ 0 [N], T (3×2) orthonormal, ε = ε_v Δt > 0 [m]:
+///   gradient  μλ f₁(y)/y · T s                          (f₁(y)/y → 2/ε as y → 0),
+///   Hessian   μλ T [ (f₁'(y) y − f₁(y))/y³ · s sᵀ + f₁(y)/y · I₂ ] Tᵀ,
+/// PSD by construction: the 2×2 bracket's eigenvalues are f₁'(y) ≥ 0 along s and f₁(y)/y ≥ 0 across
+/// it (the radial term is −s sᵀ/(y ε²) below ε, 0 at y = 0). fem::Error as friction_mollifier.
+/// docs/14_contact.md#friction
+LaggedFriction lagged_friction(const Eigen::Matrix<double, 3, 2>& tangent, const Eigen::Vector3d& relative,
+                               double scale, double epsilon);
+
+/// One lagged friction pair: vertex v against obstacle o, with the normal force and tangent basis
+/// of the step's start.
+struct FrictionPair {
+    int vertex = 0, obstacle = 0;
+    double normal_force = 0.0;           ///< λ = κ Σ_p |b'(d_p(x_vᵗ))| over the obstacle's pieces [N]
+    double coefficient = 0.0;            ///< μ of the obstacle
+    Eigen::Matrix<double, 3, 2> tangent; ///< T: orthonormal, ⟂ ∇d(x_vᵗ)
+    Eigen::Vector3d start;               ///< x_vᵗ + Δt w_o: where the vertex sticks to the obstacle
+};
+
+/// One lagged friction pair of two surface primitives of the bodies (a point and a triangle, two
+/// edges; the 4 mesh vertices in PrimitivePair's order), with what the step's start fixed.
+struct BodyFrictionPair {
+    int vertices[4] = {0, 0, 0, 0};
+    double normal_force = 0.0;              ///< λ = κ m |b'(d)| at the lag [N]
+    double coefficient = 0.0;               ///< μ between the bodies
+    Eigen::Matrix<double, 3, 2> tangent;    ///< T: orthonormal, ⟂ the closest points' difference
+    Eigen::Vector4d weights;                ///< w: Γ = [w₀ I, w₁ I, w₂ I, w₃ I], Σ w_i = 0
+    Vector12d start;                        ///< the 4 vertices at the step's start, stacked [m]
+};
+
+/// The weights w (4) of the closest points of the primitives at x (3×4, columns in PrimitivePair's
+/// order), Γ x = the first primitive's closest point minus the second's: for a point and a triangle
+/// by point_triangle_type (corner i: β_i = 1; edge ij: β_j = t, β_i = 1 − t with t the point's
+/// parameter along it; face: the barycentric coordinates of the point's projection), w = (1, −β);
+/// for two edges by edge_edge_type (an endpoint: parameter 0 or 1; an endpoint against an edge: the
+/// endpoint's parameter along it; edge_edge: the lines' closest parameters), w = (1 − α, α, −(1 − γ),
+/// −γ). fem::Error as the type functions. docs/14_contact.md#friction-between-bodies
+Eigen::Vector4d closest_point_weights(PrimitivePair kind, const Eigen::Matrix<double, 3, 4>& x);
+
+/// The tangent basis of a pair at x (3×4) by its closest-feature type: ⟂ the triangle's normal
+/// (b − a) × (c − a) for a point inside the triangle, ⟂ e_a × e_b for the insides of two edges, and
+/// ⟂ the closest points' difference Γ x for a point against an edge or a point (weights: those of
+/// closest_point_weights). Each is the plane ⟂ Γ x while the pair is apart. fem::Error when the
+/// normal is zero (a touching pair: d = 0). docs/14_contact.md#friction-between-bodies
+Eigen::Matrix<double, 3, 2> pair_tangent_basis(PrimitivePair kind, const Eigen::Matrix<double, 3, 4>& x,
+                                               const Eigen::Vector4d& weights);
+
+/// The pair of kind at the lag x_lag (3×4: its weights and tangent basis) that sticks to x_start
+/// (3×4, the vertices at the step's start), with λ = normal_force [N] ≥ 0 and μ = coefficient ≥ 0.
+BodyFrictionPair body_friction_pair(PrimitivePair kind, const int (&vertices)[4], const Eigen::Matrix<double, 3, 4>& x_lag,
+                                    const Eigen::Matrix<double, 3, 4>& x_start, double normal_force,
+                                    double coefficient);
+
+/// μλ f₀(‖Tᵀ Γ (x − x_start)‖) of a body pair at x (12: its 4 vertices stacked) with ε = ε_v Δt [m]:
+/// lagged_friction of r = Γ (x − x_start), its gradient Γᵀ g (block i: w_i g) and Hessian Γᵀ H Γ
+/// (block ij: w_i w_j H), PSD as H; translations x + (t, t, t, t) change nothing (Σ w_i = 0).
+/// docs/14_contact.md#friction-between-bodies
+PrimitiveFunction body_friction(const BodyFrictionPair& pair, const Vector12d& x, double epsilon);
+
+/// The lagged friction between the surface primitives of one mesh (bodies against bodies, a body
+/// against itself): the pairs of SelfContactBarrier within d̂ at the lag, each a BodyFrictionPair,
+/// and the sum of their body_friction. docs/14_contact.md#friction-between-bodies
+class BodyFriction {
+public:
+    /// The mesh's rest positions X (#V×3) [m], which u displaces.
+    explicit BodyFriction(const MatrixX3d& rest) : rest_(rest) {}
+
+    /// Replaces the pairs: one per pair within d̂ (pairs: SelfContactBarrier::pairs at u_lag), with
+    /// λ = κ m |b'(d)| (κ = stiffness [N/m], b of barrier.hpp with d̂ [m]), weights and tangent basis at
+    /// u_lag, sticking to the vertices at u_start (3n each), μ = coefficient ≥ 0 (none when 0).
+    void lag(const std::vector<SurfacePair>& pairs, const Eigen::VectorXd& u_lag, const Eigen::VectorXd& u_start,
+             double stiffness, double coefficient, double activation_distance);
+    /// Σ_k body_friction of the pairs at u (3n) with ε = ε_v Δt [m] [J].
+    double energy(const Eigen::VectorXd& u, double epsilon) const;
+    /// Adds its gradient (3n), each pair's 12 scattered to its 4 vertices, to gradient.
+    void add_gradient(const Eigen::VectorXd& u, double epsilon, Eigen::VectorXd& gradient) const;
+    /// Appends its Hessian's entries (3n×3n; each pair's 12×12 block, PSD without projection).
+    void add_hessian(const Eigen::VectorXd& u, double epsilon, std::vector<Eigen::Triplet<double>>& triplets) const;
+    /// The pairs of the current lag.
+    const std::vector<BodyFrictionPair>& pairs() const { return pairs_; }
+
+private:
+    /// The 4 vertices of pair at u, stacked (12) [m].
+    Vector12d stacked(const BodyFrictionPair& pair, const Eigen::VectorXd& u) const;
+
+    MatrixX3d rest_;
+    std::vector<BodyFrictionPair> pairs_;
+};
+
+}  // namespace fem::contact
