@@ -20,6 +20,7 @@
 
 #include "14_contact/feature_barrier.hpp"
 #include "14_contact/friction.hpp"
+#include "14_contact/intersections.hpp"
 #include "14_contact/obstacles.hpp"
 #include "14_contact/self_barrier.hpp"
 
@@ -54,6 +55,12 @@ struct ContactOptions {
     /// self_contact: lagged friction on its point–triangle and edge–edge pairs (BodyFriction); 0: none.
     /// docs/14_contact.md#friction-between-bodies
     double body_friction = 0.0;
+    /// A debug check: at every configuration the energy is asked of (each Newton iterate and each
+    /// line-search trial), no body edge meets a triangle of an obstacle with edges (a box, a mesh), no
+    /// such obstacle's edge a body triangle, and, with self_contact, no body edge a body triangle
+    /// (IntersectionCheck, intersections.hpp); fem::Error naming them otherwise. It costs a box tree a
+    /// call: for tests and for finding a bug, not for runs. docs/14_contact.md#never-an-intersection
+    bool check_intersections = false;
 };
 
 /// The minimiser of ‖g + κ h‖ over κ: κ = −gᵀh/‖h‖² (g, h of one size), the κ whose barrier force
@@ -187,6 +194,7 @@ private:
     ContactOptions options_;
     FeatureBarrier features_;  // the obstacles' edges and corners against the body's surface
     std::unique_ptr<SelfContactBarrier> self_;  // the body's surface against itself (self_contact), else null
+    std::unique_ptr<IntersectionCheck> check_;   // check_intersections, else null
     BodyFriction body_friction_;                // the lagged friction of self_'s pairs (body_friction)
     Eigen::MatrixX3d rest_;            // X (#V × 3)
     std::vector<int> surface_;

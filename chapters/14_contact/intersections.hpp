@@ -13,16 +13,25 @@
 //   orient(a, b, c, p) and orient(a, b, c, q) not of one strict sign, and
 //   orient(p, q, a, b), orient(p, q, b, c), orient(p, q, c, a) not of both strict signs.
 // Each sign is certified: orient is computed in double with Shewchuk's a-priori error bound
-// (|error| ≤ (7 + 56ε) ε × the permanent, ε = 2⁻⁵³); a value within its bound counts as zero. So
-// "apart" is only ever answered when it is proven; a touch, a coplanar pair or an uncertain sign
-// counts as meeting (the check never misses an intersection; it may flag a configuration within
-// round-off of touching, which a barrier with d̂ ≫ round-off never produces).
+// (|error| ≤ (7 + 56ε) ε × the permanent, ε = 2⁻⁵³); a value within its bound counts as zero. When
+// these signs leave it open — a segment in the triangle's plane, as an edge and a triangle of one
+// flat face of a mesh are — the shadows on the three coordinate planes are tried: a separating line
+// there (the segment's line, or a triangle edge's with the segment strictly beyond it, by certified
+// 2D orientations) proves them apart in space. So "apart" is only ever answered when it is proven;
+// a touch or an uncertain sign counts as meeting (the check never misses an intersection; it may
+// flag a configuration within round-off of touching, which a barrier with d̂ ≫ round-off never
+// produces).
+
+#include "14_contact/broad_phase.hpp"
+#include "14_contact/obstacles.hpp"
 
 #include "common/mesh.hpp"
 
 #include <Eigen/Core>
 
+#include <memory>
 #include <string>
+#include <vector>
 
 namespace fem::contact {
 
@@ -54,5 +63,28 @@ EdgeThroughTriangle first_edge_through_triangle(const MatrixX3d& x, const Eigen:
 
 /// "edge (i, j) meets triangle (a, b, c)" in vertex indices of x, for a message; empty when none.
 std::string describe(const EdgeThroughTriangle& crossing, const Eigen::MatrixX2i& edges, const MatrixX3i& triangles);
+
+/// The debug check of the contact potential (ContactOptions::check_intersections): a body's
+/// surface against the drawn triangles of its obstacles with edges and corners (boxes, meshes:
+/// Obstacle::local_features not empty; their triangles are their exact surface), and, with
+/// self-contact, against itself. A smooth obstacle (half-space, sphere, capsule) has no triangles of
+/// its own; its vertices-outside rule is the barrier's.
+class IntersectionCheck {
+public:
+    /// mesh: the body's rest mesh (its surface_primitives); obstacles as the contact potential's;
+    /// self_contact: whether the body's own edges and triangles are checked against each other.
+    IntersectionCheck(const TetMesh& mesh, const std::vector<std::shared_ptr<const Obstacle>>& obstacles,
+                      bool self_contact);
+    /// fem::Error naming the primitives ("at t = …: body edge (i, j) meets obstacle 2's triangle …")
+    /// when, at positions x (#V×3) and the obstacles at time [s], a body edge meets a triangle of an
+    /// obstacle, an obstacle edge meets a body triangle, or (self_contact) a body edge a body
+    /// triangle it shares no vertex with.
+    void require_none(const MatrixX3d& x, double time) const;
+
+private:
+    SurfacePrimitives surface_;
+    std::vector<std::pair<int, std::shared_ptr<const Obstacle>>> obstacles_;  // (index, obstacle) with triangles
+    bool self_contact_;
+};
 
 }  // namespace fem::contact

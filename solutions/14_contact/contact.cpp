@@ -83,6 +83,8 @@ ContactPotential::ContactPotential(const dynamics::Body& body, std::vector<std::
     diagonal_ = (rest_.colwise().maxCoeff() - rest_.colwise().minCoeff()).norm();
     stiffness_ = options_.stiffness;
     stiffness_set_ = options_.stiffness > 0.0;
+    if (options_.check_intersections)
+        check_ = std::make_unique<IntersectionCheck>(body.mesh(), obstacles_, options_.self_contact);
     if (options_.self_contact) {
         self_ = std::make_unique<SelfContactBarrier>(body.mesh(), options_.activation_distance);
         const double at_rest =
@@ -257,6 +259,8 @@ double ContactPotential::barrier_energy(const Eigen::VectorXd& u, double time) c
 
 double ContactPotential::energy(const Eigen::VectorXd& u) const
 {
+    if (check_)
+        check_->require_none(rest_ + u.reshaped<Eigen::RowMajor>(rest_.rows(), 3), time_);
     double total = barrier_energy(u, time_);
     if (!std::isfinite(total))
         return total;

@@ -6,6 +6,8 @@
 #include "common/error.hpp"
 
 #include <algorithm>
+#include <array>
+#include <set>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -35,6 +37,43 @@ int certified_orientation(const Eigen::Vector3d& a, const Eigen::Vector3d& b, co
     return 0;
 }
 
+namespace {
+
+/// The sign of (b − a) × (c − a) in the plane of coordinates (i, j) of a, b, c (each 3): ±1 when
+/// certain (Shewchuk's orient2d bound (3 + 16ε) ε × the permanent), 0 within it.
+int certified_orientation_2d(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, int i,
+                             int j)
+{
+    const double left = (a[i] - c[i]) * (b[j] - c[j]), right = (a[j] - c[j]) * (b[i] - c[i]);
+    const double determinant = left - right;  // (a − c) × (b − c) = (b − a) × (c − a)
+    constexpr double epsilon = std::numeric_limits<double>::epsilon() / 2.0;
+    const double bound = (3.0 + 16.0 * epsilon) * epsilon * (std::abs(left) + std::abs(right));
+    return determinant > bound ? 1 : determinant < -bound ? -1 : 0;
+}
+
+/// Whether the shadows of segment (p, q) and triangle (a, b, c) on the plane of coordinates (i, j)
+/// are proven apart: a separating line (the segment's line, or a line of a triangle edge with the
+/// segment strictly beyond it) by certified 2D orientations. Apart shadows mean apart in space.
+bool shadows_apart(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eigen::Vector3d& a,
+                   const Eigen::Vector3d& b, const Eigen::Vector3d& c, int i, int j)
+{
+    const int sa = certified_orientation_2d(p, q, a, i, j), sb = certified_orientation_2d(p, q, b, i, j),
+              sc = certified_orientation_2d(p, q, c, i, j);
+    if (sa != 0 && sa == sb && sb == sc)
+        return true;  // the triangle strictly on one side of the segment's line
+    const std::array<const Eigen::Vector3d*, 3> x{&a, &b, &c};
+    for (int k = 0; k < 3; ++k) {
+        const Eigen::Vector3d &from = *x[k], &to = *x[(k + 1) % 3], &third = *x[(k + 2) % 3];
+        const int inside = certified_orientation_2d(from, to, third, i, j);
+        if (inside != 0 && certified_orientation_2d(from, to, p, i, j) == -inside &&
+            certified_orientation_2d(from, to, q, i, j) == -inside)
+            return true;  // the segment strictly outside this edge's line
+    }
+    return false;
+}
+
+}  // namespace
+
 bool segment_meets_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eigen::Vector3d& a,
                             const Eigen::Vector3d& b, const Eigen::Vector3d& c)
 {
@@ -44,7 +83,12 @@ bool segment_meets_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& q, 
     const int e0 = certified_orientation(p, q, a, b), e1 = certified_orientation(p, q, b, c),
               e2 = certified_orientation(p, q, c, a);
     const bool some_positive = e0 > 0 || e1 > 0 || e2 > 0, some_negative = e0 < 0 || e1 < 0 || e2 < 0;
-    return !(some_positive && some_negative);  // the line strictly outside an edge: apart
+    if (some_positive && some_negative)
+        return false;  // the line strictly outside an edge: apart
+    // Undecided in space — a segment in (or within round-off of) the triangle's plane, as on a flat
+    // face of a mesh — or truly meeting: apart if the shadows on a coordinate plane are.
+    return !(shadows_apart(p, q, a, b, c, 1, 2) || shadows_apart(p, q, a, b, c, 2, 0) ||
+             shadows_apart(p, q, a, b, c, 0, 1));
 }
 
 EdgeThroughTriangle first_edge_through_triangle(const MatrixX3d& x, const Eigen::MatrixX2i& edges,
@@ -94,6 +138,71 @@ std::string describe(const EdgeThroughTriangle& crossing, const Eigen::MatrixX2i
     const auto t = triangles.row(crossing.triangle);
     return str("edge (", edges(crossing.edge, 0), ", ", edges(crossing.edge, 1), ") meets triangle (", t(0), ", ",
                t(1), ", ", t(2), ")");
+}
+
+namespace {
+
+/// The edges of triangles (#F×3), each once, lower index first.
+Eigen::MatrixX2i triangle_edges(const MatrixX3i& triangles)
+{
+    std::set<std::array<int, 2>> unique;
+    for (Eigen::Index f = 0; f < triangles.rows(); ++f)
+        for (int k = 0; k < 3; ++k) {
+            const int i = triangles(f, k), j = triangles(f, (k + 1) % 3);
+            unique.insert({std::min(i, j), std::max(i, j)});
+        }
+    Eigen::MatrixX2i edges(static_cast<Eigen::Index>(unique.size()), 2);
+    Eigen::Index row = 0;
+    for (const auto& [i, j] : unique)
+        edges.row(row++) << i, j;
+    return edges;
+}
+
+}  // namespace
+
+IntersectionCheck::IntersectionCheck(const TetMesh& mesh, const std::vector<std::shared_ptr<const Obstacle>>& obstacles,
+                                     bool self_contact)
+    : surface_(surface_primitives(mesh)), self_contact_(self_contact)
+{
+    for (std::size_t o = 0; o < obstacles.size(); ++o) {
+        const ObstacleFeatures features = obstacles[o]->local_features();
+        if (features.edges.rows() > 0 || features.corners.rows() > 0)
+            obstacles_.emplace_back(static_cast<int>(o), obstacles[o]);
+    }
+}
+
+void IntersectionCheck::require_none(const MatrixX3d& x, double time) const
+{
+    if (self_contact_) {
+        const EdgeThroughTriangle crossing = first_edge_through_triangle(x, surface_.edges, surface_.triangles);
+        if (crossing.found())
+            throw Error(str("intersection check at t = ", time, " s: the body's ",
+                            describe(crossing, surface_.edges, surface_.triangles)));
+    }
+    if (obstacles_.empty())
+        return;
+    const Eigen::Vector3d low = x.colwise().minCoeff(), high = x.colwise().maxCoeff();
+    const std::array<double, 6> around{low.x(), high.x(), low.y(), high.y(), low.z(), high.z()};
+    const int n = static_cast<int>(x.rows());
+    for (const auto& [index, obstacle] : obstacles_) {
+        const TriMesh drawn = obstacle->surface_at(around, time);
+        // One array: the body's vertices, then the obstacle's; the obstacle's indices offset by n.
+        MatrixX3d both(x.rows() + drawn.V.rows(), 3);
+        both << x, drawn.V;
+        const MatrixX3i obstacle_triangles = (drawn.F.array() + n).matrix();
+        const Eigen::MatrixX2i obstacle_edges = triangle_edges(obstacle_triangles);
+        const EdgeThroughTriangle body_edge = first_edge_through_triangle(both, surface_.edges, obstacle_triangles);
+        if (body_edge.found())
+            throw Error(str("intersection check at t = ", time, " s: a body edge through obstacle ", index, " (",
+                            obstacle->name(), "): ", describe(body_edge, surface_.edges, obstacle_triangles),
+                            " (obstacle vertices from ", n, ")"));
+        const EdgeThroughTriangle obstacle_edge = first_edge_through_triangle(both, obstacle_edges, surface_.triangles);
+        if (obstacle_edge.found())
+            throw Error(str("intersection check at t = ", time, " s: an edge of obstacle ", index, " (",
+                            obstacle->name(), ") through the body: ",
+                            describe(obstacle_edge, obstacle_edges, surface_.triangles), " (obstacle vertices from ",
+                            n, ")"));
+    }
 }
 
 }  // namespace fem::contact

@@ -110,7 +110,7 @@ struct BlockOnBlock : test::ContactRun {
 }  // namespace
 
 TEST_CASE("friction between primitives: weights, tangent bases, gradient and Hessian against central differences",
-          "[self]")
+          "[self][ex14.9]")
 {
     // Point–triangle and edge–edge pairs of every closest-feature type, 0.5 mm to 2 cm apart.
     struct Case {
@@ -180,7 +180,7 @@ TEST_CASE("friction between primitives: weights, tangent bases, gradient and Hes
     CHECK_THROWS_AS(body_friction_pair(PrimitivePair::point_triangle, vertices, cases[0].x, cases[0].x, -1.0, mu), Error);
 }
 
-TEST_CASE("friction between bodies: refusals, and no pair without contact or without μ", "[self]")
+TEST_CASE("friction between bodies: refusals, and no pair without contact or without μ", "[self][ex14.9]")
 {
     dynamics::Scene scene;
     scene.mesh = box_mesh(1, 1, 1, Eigen::Vector3d::Constant(0.1));
@@ -202,7 +202,7 @@ TEST_CASE("friction between bodies: refusals, and no pair without contact or wit
     CHECK(!rough.contact->body_friction_pairs().empty());
 }
 
-TEST_CASE("a block sliding on a pinned block decelerates at mu g and stops", "[self]")
+TEST_CASE("a block sliding on a pinned block decelerates at mu g and stops", "[self][ex14.9]")
 {
     const double g = 9.81, mu = 0.3, v0 = 0.5;
     BlockOnBlock blocks(mu, Eigen::Vector3d(0, 0, -g), Eigen::Vector3d(v0, 0, 0));
@@ -225,7 +225,7 @@ TEST_CASE("a block sliding on a pinned block decelerates at mu g and stops", "[s
 }
 
 TEST_CASE("a block on a tilted block: sticks when tan(theta) < mu, slides at g(sin - mu cos) when tan(theta) > mu",
-          "[self]")
+          "[self][ex14.9]")
 {
     const double g = 9.81, mu = 0.4, eps_v = ContactOptions{}.friction_velocity;
     for (double tangent : {0.5 * mu, 1.5 * mu}) {
@@ -250,7 +250,7 @@ TEST_CASE("a block on a tilted block: sticks when tan(theta) < mu, slides at g(s
     }
 }
 
-TEST_CASE("two blocks rubbing as they bounce off each other: momentum kept, their sliding slowed by mu times the normal impulse", "[self]")
+TEST_CASE("two blocks rubbing as they bounce off each other: momentum kept, their sliding slowed by mu times the normal impulse", "[self][ex14.9]")
 {
     // Two free cubes without gravity, 1.2 mm apart face to face in x, offset in y and z, thrown at each
     // other in x while sliding past each other in y; friction (internal) must keep Σ m v and take

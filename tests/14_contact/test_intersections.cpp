@@ -3,7 +3,13 @@
 // and the first edge through a triangle against testing every pair.
 // docs/14_contact.md#never-an-intersection
 #include "14_contact/broad_phase.hpp"
+#include "14_contact/contact.hpp"
 #include "14_contact/intersections.hpp"
+#include "14_contact/obstacles.hpp"
+
+#include "10_linear_dynamics/body.hpp"
+
+#include "contact_bodies.hpp"
 
 #include "common/error.hpp"
 #include "common/mesh.hpp"
@@ -12,10 +18,13 @@
 #include <catch2/catch.hpp>
 
 #include <Eigen/Dense>
+#include <Eigen/Geometry>
 
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <memory>
+#include <vector>
 
 using namespace fem;
 using namespace fem::contact;
@@ -56,15 +65,8 @@ EdgeThroughTriangle brute_force_crossing(const MatrixX3d& x, const Eigen::Matrix
 /// Two one-cell boxes of size 0.1, the second's lowest corner at corner: one vertex array.
 TetMesh two_boxes(const Eigen::Vector3d& corner)
 {
-    const TetMesh a = box_mesh(1, 1, 1, Eigen::Vector3d::Constant(0.1));
-    TetMesh b = a;
-    b.V.rowwise() += corner.transpose();
-    TetMesh both;
-    both.V.resize(a.V.rows() + b.V.rows(), 3);
-    both.V << a.V, b.V;
-    both.T.resize(a.T.rows() + b.T.rows(), 4);
-    both.T << a.T, (b.T.array() + static_cast<int>(a.V.rows())).matrix();
-    return both;
+    const Eigen::Vector3d size = Eigen::Vector3d::Constant(0.1);
+    return test::two_bodies(test::box_at(Eigen::Vector3d::Zero(), size), test::box_at(corner, size));
 }
 
 }  // namespace
@@ -130,6 +132,9 @@ TEST_CASE("segment and triangle: meets where the parametric crossing is inside, 
     CHECK(segment_meets_triangle(Eigen::Vector3d(0.25, 0.25, 1.0), Eigen::Vector3d(0.25, 0.25, 0.0), a, b, c));
     CHECK(segment_meets_triangle(Eigen::Vector3d(0.0, 0.0, 1.0), Eigen::Vector3d(0.0, 0.0, -1.0), a, b, c));
     CHECK(segment_meets_triangle(Eigen::Vector3d(-1.0, 0.2, 0.0), Eigen::Vector3d(2.0, 0.2, 0.0), a, b, c));
+    // In the plane, beside the triangle (across its long edge, and parallel to it): apart.
+    CHECK_FALSE(segment_meets_triangle(Eigen::Vector3d(0.6, 0.6, 0.0), Eigen::Vector3d(2.0, 0.6, 0.0), a, b, c));
+    CHECK_FALSE(segment_meets_triangle(Eigen::Vector3d(1.1, 0.0, 0.0), Eigen::Vector3d(0.0, 1.1, 0.0), a, b, c));
     // A hair above the face, parallel: apart.
     CHECK_FALSE(segment_meets_triangle(Eigen::Vector3d(-1.0, 0.2, 1e-12), Eigen::Vector3d(2.0, 0.2, 1e-12), a, b, c));
 }
@@ -158,6 +163,16 @@ TEST_CASE("first edge through a triangle: none between two boxes apart, the one 
         CHECK(tree.triangle == brute.triangle);
         CHECK_THAT(describe(tree, surface.edges, surface.triangles), Contains("meets triangle"));
     }
+    // Flat faces of finer boxes, moved rigidly by offsets that are not binary fractions: an edge and a
+    // triangle of one face lie in one plane (their orientations are round-off), apart in that plane.
+    for (unsigned seed = 1; seed <= 20; ++seed) {
+        TetMesh box = box_mesh(3, 2, 2, Eigen::Vector3d(0.1, 0.07, 0.03));
+        const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.1 * seed, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+        box.V = (box.V * turn.transpose()).rowwise() + 0.1 * random_vector(3, 500 + seed).transpose();
+        const SurfacePrimitives surface = surface_primitives(box);
+        INFO("seed " << seed);
+        CHECK_FALSE(first_edge_through_triangle(box.V, surface.edges, surface.triangles).found());
+    }
     // One box alone, however distorted within reason, has no edge through its own triangles.
     for (unsigned seed = 1; seed <= 20; ++seed) {
         TetMesh box = box_mesh(3, 3, 3, size);
@@ -185,4 +200,40 @@ TEST_CASE("first edge through a triangle: an index outside the positions or a no
     triangles << 1, 2, 3;
     x(2, 1) = std::numeric_limits<double>::quiet_NaN();
     CHECK_THROWS_WITH(first_edge_through_triangle(x, edges, triangles), Contains("not finite"));
+}
+
+TEST_CASE("the contact potential's debug check: an edge through a face of the body or of a box obstacle is "
+          "refused at the energy, naming both; apart, it is quiet", "[self][ex14.9]")
+{
+    dynamics::Scene scene;
+    scene.mesh = two_boxes(Eigen::Vector3d(0.0, 0.0, 0.1 + 1e-2));
+    const dynamics::Body body(scene);
+    ContactOptions options;
+    options.self_contact = true;
+    options.check_intersections = true;
+    const std::vector<std::shared_ptr<const Obstacle>> none;
+    const ContactPotential bodies(body, none, options);
+    Eigen::VectorXd u = Eigen::VectorXd::Zero(3 * scene.mesh.V.rows());
+    CHECK(std::isfinite(bodies.energy(u)));
+    // The upper box (vertices 8 to 15) moved 2 cm down and 3 cm across: 1 cm into the lower one.
+    for (Eigen::Index v = 8; v < 16; ++v) {
+        u[3 * v] = 0.03;
+        u[3 * v + 2] = -0.02;
+    }
+    CHECK_THROWS_WITH(bodies.energy(u), Contains("intersection check") && Contains("meets triangle"));
+
+    // One box above a box obstacle turned about z, its corner pushed down through the obstacle's top face.
+    dynamics::Scene one;
+    one.mesh = box_mesh(1, 1, 1, Eigen::Vector3d::Constant(0.1));
+    one.mesh.V.rowwise() += Eigen::RowVector3d(0.0, 0.0, 0.01);
+    const dynamics::Body block(one);
+    const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    const std::vector<std::shared_ptr<const Obstacle>> box{
+        std::make_shared<Box>(Eigen::Vector3d(0.05, 0.05, -0.5), Eigen::Vector3d(1.0, 1.0, 0.5), turn)};
+    options.self_contact = false;
+    const ContactPotential on_box(block, box, options);
+    Eigen::VectorXd w = Eigen::VectorXd::Zero(24);
+    CHECK(std::isfinite(on_box.energy(w)));
+    w[2] = -0.02;  // vertex 0, 1 cm below the obstacle's top face: its edges cross the face
+    CHECK_THROWS_WITH(on_box.energy(w), Contains("intersection check") && Contains("obstacle 0"));
 }

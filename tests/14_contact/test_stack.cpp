@@ -22,7 +22,7 @@ using namespace fem;
 using namespace fem::contact;
 
 TEST_CASE("a stack at rest: the barrier force between blocks k and k+1 equals the weight of the blocks above",
-          "[self]")
+          "[self][ex14.9]")
 {
     // Three one-cell cubes of 30, 20 and 10 cm (27, 8 and 1 kg), each on the one below and off its
     // centre (no vertex on a diagonal), the lowest on the floor z = 0. At rest they are 1.2 d̂ apart
@@ -47,6 +47,7 @@ TEST_CASE("a stack at rest: the barrier force between blocks k and k+1 equals th
     scene.time_step = 1.0 / 100.0;
     ContactOptions options;
     options.self_contact = true;
+    options.check_intersections = true;  // every Newton iterate and line-search trial
     options.activation_distance = reach;
     Eigen::VectorXd u0 = Eigen::VectorXd::Zero(3 * 24);
     for (int v = 0; v < 24; ++v)
