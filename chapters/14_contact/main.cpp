@@ -17,7 +17,10 @@
 //      (data/ccd-unit-tests; --ccd-queries FILE... runs only this study, on those files);
 //   5. bodies against bodies: the broad phase of self-contact (which surface pairs two blocks can
 //      bring within d̂ over a step) by every pair, chapter 13's AABB tree and a spatial hash, timed
-//      against the number of surface primitives.
+//      against the number of surface primitives;
+//   6. bodies against bodies, the cost: two coarse bunnies thrown at each other with self-contact,
+//      beside the same two without contact — per step the linear solves, the barrier with its broad
+//      phase and the collision check, momentum and the intersection check.
 //
 // Sample runs:
 //   ch14_contact                                   full run
@@ -26,7 +29,7 @@
 //   ch14_contact --ccd-queries data/ccd-unit-tests/edge-edge/data_0_0.csv   CCD on one query file
 //
 // Writes (under out/14_contact): drop_table.csv, slope_table.csv, mesh_table.csv, bowl_table.csv,
-// ccd_queries_table.csv, self_broad_phase_table.csv, drop.pvd and bowl.pvd (frames drop/drop_NNNN.vtu, …), charts drop_height,
+// ccd_queries_table.csv, self_broad_phase_table.csv, two_bunnies_table.csv, drop.pvd and bowl.pvd (frames drop/drop_NNNN.vtu, …), charts drop_height,
 // drop_force, slope_slide, slope_stick, slope_cost (.csv, .png, .svg) and the bowl's frames bowl_NNNN.png.
 // docs/14_contact.md
 
@@ -114,5 +117,6 @@ int main(int argc, char** argv)
         study::mesh_study(run, settings);
         study::ccd_study(run, study::ccd_benchmark_files());
         study::self_contact_study(run);
+        study::bodies_study(run);
     });
 }

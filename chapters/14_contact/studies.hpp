@@ -51,5 +51,9 @@ void bowl_study(const RunContext& run);
 /// of k³ cells closing on each other: candidate pairs, whether they agree, time per search;
 /// self_broad_phase_table.csv (study_self.cpp).
 void self_contact_study(const RunContext& run);
+/// Two coarse bunnies thrown at each other, with self-contact and without: per step the time in
+/// the linear solves, the barrier (with its broad phase) and the collision check, the momentum's
+/// drift, intersection-free or not; two_bunnies_table.csv (study_bodies.cpp).
+void bodies_study(const RunContext& run);
 
 }  // namespace fem::contact::study
