@@ -57,8 +57,9 @@ void check_groups_apart(const SceneSpec& scene, const std::vector<std::vector<in
 
 /// Whether segment (p, q) meets triangle (a, b, c), touching included, exactly up to long double's
 /// round-off in the signed volumes: p and q not strictly on one side of the triangle's plane, and the
-/// segment's line not strictly outside any of the triangle's edges. A degenerate (coplanar) case
-/// counts as meeting (conservative: "apart" means apart).
+/// segment's line not strictly outside any of the triangle's edges; when all lie in one plane, the
+/// same question in 2D (an end inside the closed triangle, or the segment meeting one of its edges,
+/// touching and collinear overlap counting as meeting).
 bool segment_meets_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eigen::Vector3d& a,
                             const Eigen::Vector3d& b, const Eigen::Vector3d& c);
 

@@ -43,6 +43,47 @@ long double orient(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eig
     return (B - A).cross(C - A).dot(D - A);
 }
 
+/// Twice the signed area of the 2D triangle (a, b, c), in long double.
+long double orient2(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c)
+{
+    return (static_cast<long double>(b.x()) - a.x()) * (static_cast<long double>(c.y()) - a.y()) -
+           (static_cast<long double>(b.y()) - a.y()) * (static_cast<long double>(c.x()) - a.x());
+}
+
+/// Whether 2D segments (p, q) and (r, s) meet, touching and collinear overlap included.
+bool segments_meet(const Eigen::Vector2d& p, const Eigen::Vector2d& q, const Eigen::Vector2d& r, const Eigen::Vector2d& s)
+{
+    const long double d1 = orient2(r, s, p), d2 = orient2(r, s, q), d3 = orient2(p, q, r), d4 = orient2(p, q, s);
+    if (((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0)))
+        return true;
+    // A point on the other segment's line within its box (collinear or touching cases).
+    const auto on = [](const Eigen::Vector2d& x, const Eigen::Vector2d& y, const Eigen::Vector2d& z, long double d) {
+        return d == 0 && (z.array() >= x.cwiseMin(y).array()).all() && (z.array() <= x.cwiseMax(y).array()).all();
+    };
+    return on(r, s, p, d1) || on(r, s, q, d2) || on(p, q, r, d3) || on(p, q, s, d4);
+}
+
+/// segment_meets_triangle when all five points lie in one plane: projected along the axis of the
+/// triangle's normal's largest component, the segment meets the triangle when an end lies in it
+/// (closed) or it meets one of its edges. A zero-area triangle is met when the segment meets its edges.
+bool coplanar_segment_meets_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eigen::Vector3d& a,
+                                     const Eigen::Vector3d& b, const Eigen::Vector3d& c)
+{
+    Eigen::Index axis = 0;
+    (b - a).cross(c - a).cwiseAbs().maxCoeff(&axis);
+    const auto flat = [axis](const Eigen::Vector3d& x) {
+        return Eigen::Vector2d(x[(axis + 1) % 3], x[(axis + 2) % 3]);
+    };
+    const Eigen::Vector2d P = flat(p), Q = flat(q), A = flat(a), B = flat(b), C = flat(c);
+    const auto inside = [&](const Eigen::Vector2d& x) {
+        const long double u = orient2(A, B, x), v = orient2(B, C, x), w = orient2(C, A, x);
+        return (u >= 0 && v >= 0 && w >= 0) || (u <= 0 && v <= 0 && w <= 0);
+    };
+    if (orient2(A, B, C) != 0 && (inside(P) || inside(Q)))
+        return true;
+    return segments_meet(P, Q, A, B) || segments_meet(P, Q, B, C) || segments_meet(P, Q, C, A);
+}
+
 /// The body each vertex of a group's joined mesh belongs to (its index in members) and its own index.
 struct Owner {
     std::vector<int> body, local;
@@ -135,6 +176,8 @@ bool segment_meets_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& q, 
     const long double sp = orient(a, b, c, p), sq = orient(a, b, c, q);
     if ((sp > 0 && sq > 0) || (sp < 0 && sq < 0))
         return false;
+    if (sp == 0 && sq == 0)
+        return coplanar_segment_meets_triangle(p, q, a, b, c);
     const long double e0 = orient(p, q, a, b), e1 = orient(p, q, b, c), e2 = orient(p, q, c, a);
     return !((e0 > 0 || e1 > 0 || e2 > 0) && (e0 < 0 || e1 < 0 || e2 < 0));
 }

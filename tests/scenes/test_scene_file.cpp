@@ -85,7 +85,7 @@ TEST_CASE("every gallery scene reads, with and without its quick overrides", "[s
             CHECK(!scene.bodies.empty());
             for (const BodySpec& body : scene.bodies) {
                 CHECK(body.mesh.T.rows() > 0);
-                CHECK((!body.pinned.empty() || !scene.obstacles.empty()));  // held, or caught by an obstacle
+                CHECK((!body.pinned.empty() || !scene.obstacles.empty() || scene.contact.bodies));  // held, caught by an obstacle, or thrown at another body
             }
         }
     }
