@@ -54,7 +54,8 @@ struct Motion {
     Eigen::Vector3d axis = Eigen::Vector3d::UnitX();   ///< rotate: the axis direction (unit)
     Eigen::Vector3d center = Eigen::Vector3d::Zero();  ///< rotate: a point on the axis [m]
     double angle = 0.0;                                ///< rotate: the total angle [rad]
-    Eigen::Vector3d displacement = Eigen::Vector3d::Zero();  ///< translate: the total displacement [m]
+    /// translate: the total displacement [m]; rotate: the axis's (the turned pins carried along by it)
+    Eigen::Vector3d displacement = Eigen::Vector3d::Zero();
     double start = 0.0, end = 0.0;                     ///< the ramp's time window [s], start < end
 };
 

@@ -28,7 +28,7 @@ namespace fem::scenes {
 
 /// How far a body's vertices can travel in the run, at most as far as its motion is driven [m]:
 /// ‖v₀‖ T + ½ (‖g‖ + ‖Σ loads‖/m) T² + the largest prescribed displacement of its pins (a rotation's
-/// chord bounded by twice the pinned vertex's distance from the axis), T the duration and m the
+/// chord bounded by twice the pinned vertex's distance from the axis, plus the axis's displacement), T the duration and m the
 /// body's mass. Elastic deformation driven by pins can move a free vertex further: the runner's check
 /// after every step (separate_bodies_apart) catches that.
 double travel_bound(const SceneSpec& scene, const BodySpec& body);

@@ -124,7 +124,8 @@ double travel_bound(const SceneSpec& scene, const BodySpec& body)
                 pins = std::max(pins, pin.motion.displacement.norm());
             else if (pin.motion.kind == Motion::Kind::rotate) {
                 const Eigen::Vector3d r = X - pin.motion.center;
-                pins = std::max(pins, 2.0 * (r - r.dot(pin.motion.axis) * pin.motion.axis).norm());
+                pins = std::max(pins, 2.0 * (r - r.dot(pin.motion.axis) * pin.motion.axis).norm() +
+                                          pin.motion.displacement.norm());
             }
         }
     const double acceleration = scene.gravity.norm() + (mass > 0.0 ? (loads.norm() + surface_loads) / mass : 0.0);
