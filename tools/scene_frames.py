@@ -32,8 +32,8 @@ MOMENTS = {
     "beam_on_sphere": 0.4,   # folded over the ball
     "bowl_drop": 0.3,        # landed on the bowl's wall, sliding down
     "two_bunnies": 0.1,      # squashed against each other
-    "block_stack": 0.5,      # stacked
-    "bar_coil": 1.8,         # twisted, buckling
+    "block_stack": 0.6,      # stacked
+    "bar_coil": 3.0,         # looped onto itself
 }
 
 
