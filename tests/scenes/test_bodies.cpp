@@ -313,3 +313,22 @@ TEST_CASE("segment_meets_triangle: crossing, apart, touching, and in the triangl
     CHECK_FALSE(segment_meets_triangle({1.5, 0, 0}, {2, 0, 0}, a, b, c));
     CHECK(segment_meets_triangle({1, 0, 0}, {2, 0, 0}, a, b, c));  // touching a corner
 }
+
+TEST_CASE("bodies stepped apart that come within d-hat all the same stop the run, naming both", "[scenes][bodies]")
+{
+    // A bar turned by its pinned end about the z axis sweeps its free end through the block: its pins
+    // barely move (their chord is their distance from the axis), so the travel bound leaves the two
+    // separate solves, and the check after every step must catch the bar arriving.
+    const SceneSpec scene = testing::scene_from(
+        "sweep",
+        two_bodies("name = \"bar\"\nmesh = { generator = \"box\", size = [0.3, 0.02, 0.02], cells = [6, 1, 1], translate = "
+                   "[0.0, -0.01, -0.01] }\nmaterial = { model = \"corotational\", youngs_modulus = 1e6, poisson_ratio = 0.3, "
+                   "density = 1000.0 }\n[[body.pin]]\nplane = { point = [0.0, 0.0, 0.0], normal = [1.0, 0.0, 0.0] }\n"
+                   "motion = \"rotate\"\naxis = [0.0, 0.0, 1.0]\ncenter = [0.0, 0.0, 0.0]\nangle = 90.0\nstart = 0.0\nend = 1.0",
+                   str("name = \"block\"\nmesh = { generator = \"box\", size = [0.05, 0.05, 0.05], translate = [0.15, 0.15, "
+                       "-0.025] }\n", rubber),
+                   "[contact]\nbodies = true\n[time]\nstep = \"1/60\"\nduration = 1.0"));
+    REQUIRE(contact_groups(scene) == std::vector<std::vector<int>>{{0}, {1}});
+    CHECK_THROWS_WITH(run_positions(scene), Catch::Contains("bodies 'bar' and 'block'") &&
+                                                Catch::Contains("stepped as separate solves"));
+}
