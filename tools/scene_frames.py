@@ -43,6 +43,9 @@ MOMENTS = {
     "slope_stick": 0.5,      # where it landed
     "beam_on_sphere": 0.4,   # folded over the ball
     "bowl_drop": 0.3,        # landed on the bowl's wall, sliding down
+    "two_bunnies": 0.1,      # squashed against each other
+    "block_stack": 0.6,      # stacked
+    "bar_coil": 3.0,         # looped onto itself
 }
 
 

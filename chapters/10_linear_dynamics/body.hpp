@@ -61,6 +61,9 @@ struct Scene {
     MassModel mass = MassModel::lumped;
     double time_step = 1.0 / 60.0;               ///< Δt [s], finite and > 0
     double duration = 1.0;                       ///< [s], a whole number of steps (see step_count)
+    /// ρ_t per tet [kg/m³] (#T entries) for a body of several materials (the scenes runner's bodies
+    /// joined into one solve, each with its own density); empty: material.density for every tet.
+    std::vector<double> densities;
 };
 
 /// The materials the chapters' command lines accept (--youngs, --density): the real solids, from
@@ -84,7 +87,8 @@ constexpr double highest_poisson_ratio = 0.499999995;  // λ/μ = 2ν/(1 − 2ν
 /// fem::Error, naming the field and what is allowed, unless: the mesh is valid (indices, no
 /// zero-volume or inverted tet: fem::validate with Inverted::reject), Y > 0, −1 < ν ≤ highest_poisson_ratio, ρ > 0,
 /// g finite, 0 ≤ α, β ≤ 0.02, Δt > 0, duration ≥ 0 and a whole number of steps, and every pinned
-/// vertex lies in [0, #V) and is listed once, and some vertex is free. Nothing pinned is allowed
+/// vertex lies in [0, #V) and is listed once, and some vertex is free; densities, when given, has one
+/// finite value > 0 per tet. Nothing pinned is allowed
 /// (the body falls freely).
 /// docs/10_linear_dynamics.md#scenes
 void validate(const Scene& scene);
@@ -221,7 +225,8 @@ private:
 class Body {
 public:
     /// validate(scene), then M (lumped or consistent, chapter 06), f_ext = gravity_load and the
-    /// free dofs. model: the force model (default: LinearElasticity of the scene's mesh and material).
+    /// free dofs; with Scene::densities, each summed over the tets of each density (block diagonal
+    /// for bodies that share no vertex). model: the force model (default: LinearElasticity of the scene's mesh and material).
     explicit Body(const Scene& scene, std::unique_ptr<ForceModel> model = nullptr);
 
     const Scene& scene() const { return scene_; }

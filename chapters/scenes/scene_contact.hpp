@@ -44,12 +44,15 @@ std::vector<std::shared_ptr<const contact::Obstacle>> scene_obstacles(const Scen
 class ContactIntegrator final : public dynamics::Integrator {
 public:
     /// own: the body's integrator without contact (backward Euler; not owned, it must outlive this);
-    /// levels: the body's force model (not owned), raised to Level::corotational for a contact step
-    /// taken at Level::linear (header comment). The contact potential is built for body against
-    /// obstacles with the scene's d̂ and ε_v (κ adaptive), Newton with the scene's solver and
-    /// tolerance. fem::Error as ContactPotential.
-    ContactIntegrator(dynamics::Integrator& own, SceneForces& levels, const dynamics::Body& body,
-                      std::vector<std::shared_ptr<const contact::Obstacle>> obstacles, const SceneSpec& scene);
+    /// levels: the force model of each body in it (not owned; one, or each body of a group stepped as
+    /// one solve, scene_group.hpp), each raised to Level::corotational for a contact step taken at
+    /// Level::linear (header comment). The contact potential is built for body against obstacles
+    /// with the scene's d̂ and ε_v (κ adaptive), with self_contact its surface against itself too (the
+    /// bodies of a group against each other, a body against itself), Newton with the scene's solver
+    /// and tolerance. fem::Error as ContactPotential.
+    ContactIntegrator(dynamics::Integrator& own, std::vector<SceneForces*> levels, const dynamics::Body& body,
+                      std::vector<std::shared_ptr<const contact::Obstacle>> obstacles, const SceneSpec& scene,
+                      bool self_contact = false);
 
     std::string name() const override { return last_contact_ ? newton_.name() + " with contact" : own_.name(); }
     int order() const override { return 1; }
@@ -70,7 +73,7 @@ public:
 
 private:
     dynamics::Integrator& own_;
-    SceneForces& levels_;
+    std::vector<SceneForces*> levels_;
     std::unique_ptr<contact::ContactPotential> potential_;
     hyper::NewtonBackwardEuler newton_;
     int contact_steps_ = 0;

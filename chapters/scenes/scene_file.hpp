@@ -54,7 +54,8 @@ struct Motion {
     Eigen::Vector3d axis = Eigen::Vector3d::UnitX();   ///< rotate: the axis direction (unit)
     Eigen::Vector3d center = Eigen::Vector3d::Zero();  ///< rotate: a point on the axis [m]
     double angle = 0.0;                                ///< rotate: the total angle [rad]
-    Eigen::Vector3d displacement = Eigen::Vector3d::Zero();  ///< translate: the total displacement [m]
+    /// translate: the total displacement [m]; rotate: the axis's (the turned pins carried along by it)
+    Eigen::Vector3d displacement = Eigen::Vector3d::Zero();
     double start = 0.0, end = 0.0;                     ///< the ramp's time window [s], start < end
 };
 
@@ -106,6 +107,9 @@ struct BodySpec {
     std::vector<Load> loads;
     Eigen::Vector3d initial_velocity = Eigen::Vector3d::Zero();  ///< of every free vertex [m/s]
     std::vector<int> pinned;            ///< the union of the pins' vertices, ascending
+    /// Whether its surface holds itself off (chapter 14's self-contact: a bar that coils onto itself).
+    /// docs/scenes.md#bodies-against-bodies
+    bool self_contact = false;
 };
 
 /// When model "auto" moves up from linear to corotational to hyperelastic (and back down), measured
@@ -162,6 +166,9 @@ struct ObstacleSpec {
 struct ContactSpec {
     double activation_distance = 1e-3;  ///< d̂ [m]: the barrier acts where a vertex is closer than this
     double friction_velocity = 1e-3;    ///< ε_v [m/s]: slower tangential motion sticks
+    /// Whether the bodies hold each other off (chapter 14's barrier between their surfaces, the
+    /// bodies that can meet stepped as one solve: scene_group.hpp). docs/scenes.md#bodies-against-bodies
+    bool bodies = false;
 };
 
 /// A whole scene, as read from its file.
@@ -240,6 +247,10 @@ std::vector<std::filesystem::path> input_files(const SceneSpec& scene);
 /// Chapter 10's Scene of one body of a scene: its mesh, material, pinned vertices, damping and mass,
 /// the scene's gravity, Δt and duration.
 dynamics::Scene dynamics_scene(const SceneSpec& scene, const BodySpec& body);
+
+/// Whether any step of the scene may need contact: it has obstacles, [contact] bodies with two or
+/// more bodies, or a body with self_contact. docs/scenes.md#bodies-against-bodies
+bool has_contact(const SceneSpec& scene);
 
 /// The type names of [[obstacle]], in the order the scene reader lists them ("half-space",
 /// "sphere", "box", "mesh", …): the registry in solutions/scenes/scene_obstacles.cpp, one entry a

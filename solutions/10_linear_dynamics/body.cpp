@@ -25,6 +25,12 @@ void validate(const Scene& scene)
                         "digits, and 0.5 is incompressible, which linear tets cannot model), got ",
                         m.poisson_ratio));
     require_positive(m.density, "density rho [kg/m^3]");
+    if (!scene.densities.empty()) {
+        if (scene.densities.size() != static_cast<std::size_t>(mesh.T.rows()))
+            throw Error(str("densities has ", scene.densities.size(), " entries, expected one per tet (", mesh.T.rows(), ")"));
+        for (double density : scene.densities)
+            require_positive(density, "a tet's density rho [kg/m^3]");
+    }
     for (int c = 0; c < 3; ++c)
         require_finite(scene.gravity[c], "gravity g [m/s^2]");
     for (const auto& [value, name] : {std::pair{scene.damping.alpha, "Rayleigh alpha"},
@@ -178,19 +184,52 @@ const Scene& validated(const Scene& scene)
 
 }  // namespace
 
+namespace {
+
+/// The mesh's tets of each density: (ρ, the mesh with only those tets, every vertex kept), one
+/// entry per distinct value of Scene::densities, or (material.density, the mesh) without them.
+std::vector<std::pair<double, TetMesh>> tets_by_density(const Scene& scene)
+{
+    if (scene.densities.empty())
+        return {{scene.material.density, scene.mesh}};
+    std::vector<double> values = scene.densities;
+    std::sort(values.begin(), values.end());
+    values.erase(std::unique(values.begin(), values.end()), values.end());
+    std::vector<std::pair<double, TetMesh>> parts;
+    for (double density : values) {
+        std::vector<Eigen::Index> rows;
+        for (Eigen::Index t = 0; t < scene.mesh.T.rows(); ++t)
+            if (scene.densities[static_cast<std::size_t>(t)] == density)
+                rows.push_back(t);
+        TetMesh part;
+        part.V = scene.mesh.V;
+        part.T = scene.mesh.T(rows, Eigen::all);
+        parts.emplace_back(density, std::move(part));
+    }
+    return parts;
+}
+
+}  // namespace
+
 Body::Body(const Scene& scene, std::unique_ptr<ForceModel> model)
     : scene_(validated(scene)),
       model_(model ? std::move(model) : std::make_unique<LinearElasticity>(scene.mesh, scene.material)),
       dofs_(static_cast<int>(scene.mesh.V.rows()), scene.pinned)
 {
-    const Material& m = scene.material;
-    M_ = scene.mass == MassModel::lumped ? assembly::lumped_mass_matrix(scene.mesh, m.density)
-                                         : assembly::consistent_mass_matrix(scene.mesh, m.density);
-    const Eigen::VectorXd masses = assembly::vertex_masses(scene.mesh, m.density);
+    const Eigen::Index n = scene.mesh.V.rows();
+    M_.resize(3 * n, 3 * n);
+    Eigen::VectorXd masses = Eigen::VectorXd::Zero(n);
+    gravity_load_ = Eigen::VectorXd::Zero(3 * n);
+    for (const auto& [density, tets] : tets_by_density(scene)) {
+        M_ += scene.mass == MassModel::lumped ? assembly::lumped_mass_matrix(tets, density)
+                                              : assembly::consistent_mass_matrix(tets, density);
+        masses += assembly::vertex_masses(tets, density);
+        gravity_load_ += assembly::gravity_load(tets, density, scene.gravity);
+    }
+    M_.makeCompressed();
     dof_masses_.resize(3 * masses.size());
     for (Eigen::Index v = 0; v < masses.size(); ++v)
         dof_masses_.segment<3>(3 * v).setConstant(masses[v]);
-    gravity_load_ = assembly::gravity_load(scene.mesh, m.density, scene.gravity);
     f_ext_ = gravity_load_;
     applied_ = Eigen::VectorXd::Zero(f_ext_.size());
     pin_velocity_ = Eigen::VectorXd::Zero(f_ext_.size());

@@ -4,6 +4,7 @@
 #include "scenes/run_outputs.hpp"
 #include "scenes/scene_contact.hpp"
 #include "scenes/scene_conditions.hpp"
+#include "scenes/scene_group.hpp"
 #include "scenes/web_page.hpp"
 
 #include "12_hyperelastic_newton/force_models.hpp"
@@ -12,6 +13,7 @@
 #include "common/interrupt.hpp"
 #include "common/motion.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <iostream>
@@ -29,11 +31,12 @@ std::string describe_segments(const std::vector<Segment>& segments)
 
 namespace {
 
-/// The integrator of a body whose model may change level: chapter 12's factory makes the one each
-/// level needs (on first use) and each step goes to the current level's.
+/// The integrator of a body (or a group of bodies stepped as one) whose model may change level:
+/// chapter 12's factory makes the one each level needs (on first use) and each step goes to the
+/// highest level of its bodies' (a group's joint solve takes the integrator its most demanding body needs).
 class LevelIntegrator final : public dynamics::Integrator {
 public:
-    LevelIntegrator(const SceneForces& forces, const SceneSpec& scene) : forces_(forces)
+    LevelIntegrator(std::vector<const SceneForces*> forces, const SceneSpec& scene) : forces_(std::move(forces))
     {
         settings_.integrator = scene.integrator;
         settings_.solver = scene.solver;
@@ -48,89 +51,258 @@ public:
     }
 
 private:
+    /// The body of the highest level (the first of them).
+    const SceneForces& leading() const
+    {
+        return **std::max_element(forces_.begin(), forces_.end(),
+                                  [](const SceneForces* a, const SceneForces* b) { return a->level() < b->level(); });
+    }
     dynamics::Integrator& current() const
     {
-        std::unique_ptr<dynamics::Integrator>& integrator = integrators_[static_cast<int>(forces_.level())];
+        const SceneForces& lead = leading();
+        std::unique_ptr<dynamics::Integrator>& integrator = integrators_[static_cast<int>(lead.level())];
         if (integrator == nullptr) {
             hyper::StepSettings settings = settings_;
-            if (forces_.level() == Level::hyperelastic)
+            if (lead.level() == Level::hyperelastic)
                 settings.integrator = "backward-euler";  // chapter 12's Newton steps backward Euler only
-            integrator = hyper::make_integrator_for(forces_.level_model(), settings);
+            integrator = hyper::make_integrator_for(lead.level_model(), settings);
         }
         return *integrator;
     }
-    const SceneForces& forces_;
+    std::vector<const SceneForces*> forces_;
     hyper::StepSettings settings_;
     mutable std::array<std::unique_ptr<dynamics::Integrator>, 3> integrators_;
 };
 
-/// One body of a running scene.
+struct GroupRun;
+
+/// One body of a running scene. Alone in its group, its Body is the one its group steps; in a group
+/// of several (scene_group.hpp), a view of its slice of the joint unknowns: its own mass, loads,
+/// pins and force model, which its step hook sets and its frames and energies read.
 struct BodyRun {
     const BodySpec* spec = nullptr;
     SceneForces* forces = nullptr;  // owned by body
     std::unique_ptr<dynamics::Body> body;
-    std::unique_ptr<LevelIntegrator> integrator;
-    std::unique_ptr<ContactIntegrator> contact;  // null: the scene has no obstacles
-    std::unique_ptr<dynamics::Simulation> simulation;
     bool automatic = false;  // the model is auto's choice of the moment
     std::shared_ptr<Pull> pull = std::make_shared<Pull>();  // what pulls it now (read by its step hook)
     std::vector<Segment> segments;
     std::vector<dynamics::StepRecord> records;
+    GroupRun* group = nullptr;
+    Eigen::Index offset = 0;  // its first vertex in its group's unknowns
 
-    const dynamics::State& state() const { return simulation->state(); }
+    /// Its slice of its group's state (u, v, forces, time and step; the elastic energy its own).
+    dynamics::State state() const;
 };
 
-BodyRun start_body(const BodySpec& spec, const SceneSpec& scene, const std::string& model,
-                   const std::vector<std::shared_ptr<const contact::Obstacle>>& obstacles)
+/// The bodies stepped as one solve: one body's own, or a group's joint Body (scene_group.hpp).
+struct GroupRun {
+    std::vector<BodyRun*> members;
+    std::unique_ptr<dynamics::Body> joint;  // null for one body
+    dynamics::Body* body = nullptr;         // joint, or the one member's
+    std::unique_ptr<LevelIntegrator> integrator;
+    std::unique_ptr<ContactIntegrator> contact;  // null: no obstacles and no bodies or self to meet
+    std::unique_ptr<dynamics::Simulation> simulation;
+
+    /// "body 'a'" or "bodies 'a', 'b'" for messages.
+    std::string names() const
+    {
+        std::string out;
+        for (const BodyRun* m : members)
+            out += str(out.empty() ? "" : ", ", "'", m->spec->name, "'");
+        return str(members.size() == 1 ? "body " : "bodies ", out);
+    }
+};
+
+dynamics::State BodyRun::state() const
+{
+    const dynamics::State& whole = group->simulation->state();
+    if (group->joint == nullptr)
+        return whole;
+    const Eigen::Index n = 3 * spec->mesh.V.rows(), first = 3 * offset;
+    dynamics::State s;
+    s.time = whole.time;
+    s.step = whole.step;
+    s.u = whole.u.segment(first, n);
+    s.v = whole.v.segment(first, n);
+    if (whole.forces.size() == whole.u.size())
+        s.forces = whole.forces.segment(first, n);
+    s.elastic_energy = body->model().energy(s.u);
+    return s;
+}
+
+/// A body of the scene: its force model (auto's levels), its own Body, its segments.
+BodyRun start_body(const BodySpec& spec, const SceneSpec& scene, const std::string& model)
 {
     BodyRun b;
     b.spec = &spec;
     const std::string chosen = model.empty() ? spec.model : model;
-    const bool automatic = chosen == "auto";
-    b.automatic = automatic;
+    b.automatic = chosen == "auto";
     const std::string hyperelastic = hyper::is_hyperelastic(chosen) ? chosen : scene.thresholds.hyperelastic;
     auto forces = std::make_unique<SceneForces>(spec.mesh, spec.material, hyperelastic,
-                                                automatic ? Level::linear : level_of(chosen));
+                                                b.automatic ? Level::linear : level_of(chosen));
     b.forces = forces.get();
     b.body = std::make_unique<dynamics::Body>(dynamics_scene(scene, spec), std::move(forces));
-    if (!obstacles.empty() && chosen == "linear")
-        throw Error(str("body '", spec.name, "': model linear cannot meet obstacles (its energy of a body at rest ",
-                        "far from where it started is round-off; docs/scenes.md#obstacles): use auto, corotational or a ",
-                        "hyperelastic model"));
-    b.integrator = std::make_unique<LevelIntegrator>(*b.forces, scene);
-    if (!obstacles.empty())
-        b.contact = std::make_unique<ContactIntegrator>(*b.integrator, *b.forces, *b.body, obstacles, scene);
-    SceneConditions conditions(spec, scene, b.forces, automatic, b.contact.get(), b.pull);
-    b.body->set_applied_loads(conditions.initial_loads());
+    b.segments.push_back({0, 0, b.forces->level(), b.forces->level_model()});
+    return b;
+}
+
+/// The initial velocity of a body (3n): the spec's on every vertex but the pins, which start at rest
+/// (their motions ramp up from zero speed).
+Eigen::VectorXd initial_velocity(const BodySpec& spec)
+{
     Eigen::VectorXd v0 = Eigen::VectorXd::Zero(3 * spec.mesh.V.rows());
     if (spec.initial_velocity.norm() > 0.0) {
         for (Eigen::Index v = 0; v < spec.mesh.V.rows(); ++v)
             v0.segment<3>(3 * v) = spec.initial_velocity;
         for (int v : spec.pinned)
-            v0.segment<3>(3 * v).setZero();  // pins start at rest: their motions ramp up from zero speed
+            v0.segment<3>(3 * v).setZero();
     }
-    dynamics::Integrator& integrator = b.contact ? static_cast<dynamics::Integrator&>(*b.contact) : *b.integrator;
-    b.simulation = std::make_unique<dynamics::Simulation>(*b.body, integrator, dynamics::initial_state(*b.body, {}, v0));
-    b.simulation->set_before_step(std::move(conditions));
-    b.segments.push_back({0, 0, b.forces->level(), b.forces->level_model()});
-    return b;
+    return v0;
 }
 
-/// One step of one body, with its record and the segment of the model it used.
-void step_body(BodyRun& b)
+/// The step hook of a group of several bodies: each body's own (SceneConditions) on its slice and
+/// its own Body, their loads and pin velocities then gathered into the joint Body.
+class GroupConditions {
+public:
+    GroupConditions(std::vector<BodyRun*> members, std::vector<SceneConditions> conditions)
+        : members_(std::move(members)), conditions_(std::move(conditions))
+    {
+    }
+    bool operator()(dynamics::Body& joint, const dynamics::State&, double step_end)
+    {
+        bool changed = false;
+        Eigen::VectorXd loads(joint.external_forces().size()), pins(loads.size());
+        for (std::size_t i = 0; i < members_.size(); ++i) {
+            BodyRun& m = *members_[i];
+            changed = conditions_[i](*m.body, m.state(), step_end) || changed;
+            const Eigen::Index first = 3 * m.offset, n = 3 * m.spec->mesh.V.rows();
+            loads.segment(first, n) = m.body->applied_loads();
+            pins.segment(first, n) = m.body->pin_velocity();
+        }
+        joint.set_applied_loads(loads);
+        joint.set_pin_velocity(pins);
+        return changed;
+    }
+
+private:
+    std::vector<BodyRun*> members_;
+    std::vector<SceneConditions> conditions_;
+};
+
+/// The solve of a group of bodies (indices into bodies): its Body (the member's own, or the joint
+/// one of scene_group.hpp), its integrator, contact (obstacles; the bodies against each other and
+/// themselves in a group of several; a lone body's self_contact) and step hook.
+std::unique_ptr<GroupRun> start_group(std::vector<BodyRun>& bodies, const std::vector<int>& members,
+                                      const SceneSpec& scene,
+                                      const std::vector<std::shared_ptr<const contact::Obstacle>>& obstacles)
+{
+    auto g = std::make_unique<GroupRun>();
+    std::vector<SceneForces*> levels;
+    Eigen::Index offset = 0;
+    for (int i : members) {
+        BodyRun& b = bodies[static_cast<std::size_t>(i)];
+        b.group = g.get();
+        b.offset = offset;
+        offset += b.spec->mesh.V.rows();
+        g->members.push_back(&b);
+        levels.push_back(b.forces);
+    }
+    const bool joined = members.size() > 1;
+    const bool self_contact = joined || bodies[static_cast<std::size_t>(members.front())].spec->self_contact;
+    Eigen::VectorXd v0(3 * offset);
+    for (BodyRun* b : g->members)
+        v0.segment(3 * b->offset, 3 * b->spec->mesh.V.rows()) = initial_velocity(*b->spec);
+    if (joined) {
+        std::vector<dynamics::ForceModel*> parts;
+        std::vector<Eigen::Index> counts;
+        for (BodyRun* b : g->members) {
+            parts.push_back(b->forces);
+            counts.push_back(b->spec->mesh.V.rows());
+        }
+        g->joint = std::make_unique<dynamics::Body>(joined_scene(scene, members),
+                                                    std::make_unique<JointForces>(parts, counts));
+        g->body = g->joint.get();
+    } else {
+        g->body = g->members.front()->body.get();
+    }
+    for (BodyRun* b : g->members)
+        if ((!obstacles.empty() || self_contact) && b->forces->level_model() == "linear" && !b->automatic)
+            throw Error(str("body '", b->spec->name, "': model linear cannot meet obstacles or bodies (its energy of a "
+                            "body at rest far from where it started is round-off; docs/scenes.md#obstacles): use auto, "
+                            "corotational or a hyperelastic model"));
+    g->integrator = std::make_unique<LevelIntegrator>(std::vector<const SceneForces*>(levels.begin(), levels.end()), scene);
+    if (!obstacles.empty() || self_contact)
+        g->contact = std::make_unique<ContactIntegrator>(*g->integrator, levels, *g->body, obstacles, scene, self_contact);
+    std::vector<SceneConditions> conditions;
+    for (BodyRun* b : g->members) {
+        conditions.emplace_back(*b->spec, scene, b->forces, b->automatic, g->contact.get(), b->pull);
+        b->body->set_applied_loads(conditions.back().initial_loads());
+    }
+    Eigen::VectorXd loads(3 * offset);
+    for (std::size_t i = 0; i < g->members.size(); ++i)
+        loads.segment(3 * g->members[i]->offset, 3 * g->members[i]->spec->mesh.V.rows()) = conditions[i].initial_loads();
+    g->body->set_applied_loads(loads);
+    dynamics::Integrator& integrator = g->contact ? static_cast<dynamics::Integrator&>(*g->contact) : *g->integrator;
+    g->simulation = std::make_unique<dynamics::Simulation>(*g->body, integrator, dynamics::initial_state(*g->body, {}, v0));
+    if (joined)
+        g->simulation->set_before_step(GroupConditions(g->members, std::move(conditions)));
+    else
+        g->simulation->set_before_step(std::move(conditions.front()));
+    return g;
+}
+
+/// Each member's record of its group's last step (or step 0). Alone: the group's. In a group of
+/// several: its own energies (its slice, its masses, loads and model); the group's books (work in,
+/// damping and integrator dissipated, iterations, time) on its first body's record, the others'
+/// integrator dissipated the energy H they gave to the group's other bodies (H(0) − H(t)), so each
+/// record keeps chapter 10's balance H(0) + W_in − H − D − I = 0 and the sums are the group's.
+void record_members(GroupRun& g)
+{
+    const dynamics::StepRecord& whole = g.simulation->last();
+    if (g.joint == nullptr) {
+        g.members.front()->records.push_back(whole);
+        return;
+    }
+    double given = 0.0;
+    for (std::size_t i = 0; i < g.members.size(); ++i) {
+        BodyRun& m = *g.members[i];
+        dynamics::StepRecord r;
+        r.step = whole.step;
+        r.time = whole.time;
+        r.energies = dynamics::energies(*m.body, m.state());
+        const double start = m.records.empty() ? r.energies.total() : m.records.front().energies.total();
+        if (i > 0) {
+            r.integrator_dissipated = start - r.energies.total();
+            given += r.integrator_dissipated;
+        }
+        m.records.push_back(r);
+    }
+    dynamics::StepRecord& first = g.members.front()->records.back();
+    first.work_in = whole.work_in;
+    first.damping_dissipated = whole.damping_dissipated;
+    first.integrator_dissipated = whole.integrator_dissipated - given;
+    first.newton_iterations = whole.newton_iterations;
+    first.solver_iterations = whole.solver_iterations;
+    first.seconds = whole.seconds;
+}
+
+/// One step of a group, with each member's record and the segment of the model it used.
+void step_group(GroupRun& g)
 {
     try {
-        b.simulation->run(1);
+        g.simulation->run(1);
     } catch (const Error& e) {
-        throw Error(str("body '", b.spec->name, "': ", e.what()));
+        throw Error(str(g.names(), ": ", e.what()));
     }
-    b.records.push_back(b.simulation->last());
-    const int step = b.simulation->state().step;
-    Segment& last = b.segments.back();
-    if (last.level == b.forces->level())
-        last.last_step = step;
-    else
-        b.segments.push_back({step, step, b.forces->level(), b.forces->level_model()});
+    record_members(g);
+    const int step = g.simulation->state().step;
+    for (BodyRun* b : g.members) {
+        Segment& last = b->segments.back();
+        if (last.level == b->forces->level())
+            last.last_step = step;
+        else
+            b->segments.push_back({step, step, b->forces->level(), b->forces->level_model()});
+    }
 }
 
 /// Sets each body's pull from request (stiffness 0: the body's default), printing a line when a
@@ -203,10 +375,15 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
     std::shared_ptr<const SkinObserver> skin = options.skin;
     if (scene.skin && !skin && run != nullptr && scene.output.pvd)
         skin = make_skin_observer(*scene.skin, scene.bodies[skinned]);
+    check_start_gaps(scene);
     std::vector<BodyRun> bodies;
-    const auto obstacles = scene_obstacles(scene);
     for (const BodySpec& spec : scene.bodies)
-        bodies.push_back(start_body(spec, scene, options.model, obstacles));
+        bodies.push_back(start_body(spec, scene, options.model));
+    const auto obstacles = scene_obstacles(scene);
+    const std::vector<std::vector<int>> group_members = contact_groups(scene);
+    std::vector<std::unique_ptr<GroupRun>> groups;
+    for (const std::vector<int>& members : group_members)
+        groups.push_back(start_group(bodies, members, scene, obstacles));
 
     const int steps = dynamics::step_count(scene.duration, scene.time_step);
     const int frame_every = steps_per_frame(scene);
@@ -226,7 +403,7 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
     result.frames.resize(bodies.size());
     std::vector<std::string> models;  // per frame, for its caption
     const auto frame = [&] {
-        const dynamics::State& first = bodies.front().state();
+        const dynamics::State first = bodies.front().state();
         models.push_back(frame_models(bodies));
         if (recorder || options.on_frame || page) {
             const io::MeshData data = scene_frame(bodies, scene.output);
@@ -248,9 +425,9 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
         for (const BodyRun& b : bodies)
             history.add(b.spec->name, b.body->model().name(), b.records.back());
     };
-    for (BodyRun& b : bodies) {
-        b.simulation->run(0);  // step 0's record: the energies at the start
-        b.records.push_back(b.simulation->last());
+    for (std::unique_ptr<GroupRun>& g : groups) {
+        g->simulation->run(0);  // step 0's record: the energies at the start
+        record_members(*g);
     }
     log_step();
     frame();
@@ -264,9 +441,15 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
         if (options.pull)
             update_pulls(bodies, options.pull(), options.pull_stiffness);
         int newton = 0;
-        for (BodyRun& b : bodies) {
-            step_body(b);
-            newton += b.records.back().newton_iterations;
+        for (std::unique_ptr<GroupRun>& g : groups) {
+            step_group(*g);
+            newton += g->simulation->last().newton_iterations;
+        }
+        if (groups.size() > 1 && scene.contact.bodies) {
+            std::vector<MatrixX3d> positions;
+            for (const BodyRun& b : bodies)
+                positions.push_back(b.body->positions(b.state().u));
+            check_groups_apart(scene, group_members, positions);
         }
         result.newton_iterations += newton;
         result.steps = k;
@@ -281,14 +464,15 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
         progress.finish();
     for (BodyRun& b : bodies) {
         result.segments.push_back(b.segments);
-        result.contact_steps.push_back(b.contact ? b.contact->contact_steps() : 0);
+        result.contact_steps.push_back(b.group->contact ? b.group->contact->contact_steps() : 0);
         result.records.push_back(std::move(b.records));
     }
 
     if (options.print_models)
         for (const BodyRun& b : bodies)
             std::cout << "body " << b.spec->name << ": " << describe_segments(b.segments) << " (steps per model)"
-                      << (b.contact ? str("; contact in ", b.contact->contact_steps(), " of ", result.steps, " steps") : "")
+                      << (b.group->contact ? str("; contact in ", b.group->contact->contact_steps(), " of ", result.steps, " steps") : "")
+                      << (b.group->members.size() > 1 ? str("; one solve with ", b.group->names()) : "")
                       << "\n";
     if (run == nullptr)
         return result;

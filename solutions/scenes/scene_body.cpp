@@ -24,7 +24,7 @@ BodySpec read_body(const toml::table& table, const std::string& name, const Sour
                    const std::filesystem::path& scene_file, double duration, double time_step, int index)
 {
     const Fields fields(table, name, file,
-                        {"name", "mesh", "material", "mass", "damping", "pin", "load", "initial_velocity"});
+                        {"name", "mesh", "material", "mass", "damping", "pin", "load", "initial_velocity", "self_contact"});
     BodySpec body;
     body.name = fields.text("name", str("body", index));
     // It names files and the rows of steps.csv: printable, and nothing a path or a CSV row would split at.
@@ -68,6 +68,7 @@ BodySpec read_body(const toml::table& table, const std::string& name, const Sour
         body.damping.beta = damping.number("beta", 0.0, in_range, "a number in [0, 0.02] (s)");
     }
     body.initial_velocity = fields.vector("initial_velocity", Eigen::Vector3d::Zero());
+    body.self_contact = fields.flag("self_contact", false);
     // A body that moves farther than its own size in one step leaves the pins' neighbours strained
     // beyond any model's range at the first step (1e6 m/s read as "not positive definite").
     const double extent = body_size(body.mesh);

@@ -3,6 +3,8 @@
 
 #include "12_hyperelastic_newton/force_models.hpp"
 
+#include <algorithm>
+
 namespace fem::scenes {
 
 std::vector<std::shared_ptr<const contact::Obstacle>> scene_obstacles(const SceneSpec& scene)
@@ -15,9 +17,10 @@ std::vector<std::shared_ptr<const contact::Obstacle>> scene_obstacles(const Scen
 
 namespace {
 
-contact::ContactOptions contact_options(const SceneSpec& scene)
+contact::ContactOptions contact_options(const SceneSpec& scene, bool self_contact)
 {
     contact::ContactOptions options;
+    options.self_contact = self_contact;
     options.activation_distance = scene.contact.activation_distance;
     options.friction_velocity = scene.contact.friction_velocity;
     return options;
@@ -33,12 +36,14 @@ hyper::NewtonOptions contact_newton_options(const SceneSpec& scene)
 
 }  // namespace
 
-ContactIntegrator::ContactIntegrator(dynamics::Integrator& own, SceneForces& levels, const dynamics::Body& body,
+ContactIntegrator::ContactIntegrator(dynamics::Integrator& own, std::vector<SceneForces*> levels,
+                                     const dynamics::Body& body,
                                      std::vector<std::shared_ptr<const contact::Obstacle>> obstacles,
-                                     const SceneSpec& scene)
+                                     const SceneSpec& scene, bool self_contact)
     : own_(own),
-      levels_(levels),
-      potential_(std::make_unique<contact::ContactPotential>(body, std::move(obstacles), contact_options(scene))),
+      levels_(std::move(levels)),
+      potential_(std::make_unique<contact::ContactPotential>(body, std::move(obstacles),
+                                                             contact_options(scene, self_contact))),
       newton_(contact_newton_options(scene))
 {
     newton_.set_potential(potential_.get());
@@ -63,10 +68,12 @@ dynamics::StepInfo ContactIntegrator::step(dynamics::Body& body, double time_ste
     // hook books a change of model: the jump of H at the same (u, v) is work put in, and the state's
     // forces and elastic energy are the new model's before the step reads them.
     double model_change = 0.0;
-    if (levels_.level() == Level::linear)
+    if (std::any_of(levels_.begin(), levels_.end(), [](const SceneForces* f) { return f->level() == Level::linear; }))
         model_change = dynamics::apply_step_hook(
             [this](dynamics::Body&, const dynamics::State&, double) {
-                levels_.set_level(Level::corotational);
+                for (SceneForces* forces : levels_)
+                    if (forces->level() == Level::linear)
+                        forces->set_level(Level::corotational);
                 return true;
             },
             body, state, end);

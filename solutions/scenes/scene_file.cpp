@@ -200,15 +200,16 @@ void read_bodies(const Fields& top, SceneSpec& scene)
     }
 }
 
-/// [contact]: the barrier's activation distance d̂ and the friction's ε_v.
+/// [contact]: the barrier's activation distance d̂, the friction's ε_v and whether bodies meet.
 void read_contact(const Fields& top, SceneSpec& scene)
 {
     const toml::table* contact_table = top.subtable("contact");
     if (contact_table == nullptr)
         return;
-    const Fields c(*contact_table, "contact", top.source(), {"activation_distance", "friction_velocity"});
+    const Fields c(*contact_table, "contact", top.source(), {"activation_distance", "friction_velocity", "bodies"});
     scene.contact.activation_distance = c.positive("activation_distance", scene.contact.activation_distance);
     scene.contact.friction_velocity = c.positive("friction_velocity", scene.contact.friction_velocity);
+    scene.contact.bodies = c.flag("bodies", scene.contact.bodies);
 }
 
 /// With obstacles, the contact constants and gravity against the size D of the smallest body (the
@@ -220,7 +221,7 @@ void read_contact(const Fields& top, SceneSpec& scene)
 /// size in one step, which the collision-free line search can still cut). docs/scenes.md#obstacles
 void check_contact_scales(const Fields& top, const SceneSpec& scene)
 {
-    if (scene.obstacles.empty())
+    if (!has_contact(scene))
         return;
     double size = std::numeric_limits<double>::infinity();
     std::string smallest;
@@ -370,11 +371,17 @@ std::vector<std::filesystem::path> input_files(const SceneSpec& scene)
     return files;
 }
 
+bool has_contact(const SceneSpec& scene)
+{
+    return !scene.obstacles.empty() || (scene.contact.bodies && scene.bodies.size() >= 2) ||
+           std::any_of(scene.bodies.begin(), scene.bodies.end(), [](const BodySpec& b) { return b.self_contact; });
+}
+
 dynamics::Scene dynamics_scene(const SceneSpec& scene, const BodySpec& body)
 {
     return dynamics::Scene{.mesh = body.mesh, .material = body.material, .pinned = body.pinned,
                            .gravity = scene.gravity, .damping = body.damping, .mass = body.mass,
-                           .time_step = scene.time_step, .duration = scene.duration};
+                           .time_step = scene.time_step, .duration = scene.duration, .densities = {}};
 }
 
 }  // namespace fem::scenes

@@ -53,8 +53,9 @@ Motion read_motion(const Fields& fields, double duration)
     for (const std::string key : {"axis", "center", "angle"})
         if (!rotate && fields.has(key))
             fields.fail(*fields.get(key), key, "belongs to motion = \"rotate\"");
-    if (!translate && fields.has("displacement"))
-        fields.fail(*fields.get("displacement"), "displacement", "belongs to motion = \"translate\"");
+    if (!translate && !rotate && fields.has("displacement"))
+        fields.fail(*fields.get("displacement"), "displacement",
+                    "belongs to motion = \"translate\" (or \"rotate\", the axis carried along)");
     if (kind == "fixed") {
         for (const std::string key : {"start", "end"})
             if (fields.has(key))
@@ -66,6 +67,7 @@ Motion read_motion(const Fields& fields, double duration)
         m.axis = fields.vector("axis", Eigen::Vector3d::UnitX(), true).normalized();
         m.center = fields.vector("center", Eigen::Vector3d::Zero());
         m.angle = fields.finite("angle", 0.0) * std::acos(-1.0) / 180.0;
+        m.displacement = fields.vector("displacement", Eigen::Vector3d::Zero());
     } else {
         m.kind = Motion::Kind::translate;
         m.displacement = fields.vector("displacement", Eigen::Vector3d::Zero());
@@ -119,7 +121,7 @@ Eigen::Vector3d prescribed_displacement(const Motion& motion, const Eigen::Vecto
     if (motion.kind == Motion::Kind::translate)
         return s * motion.displacement;
     const Eigen::Matrix3d R = Eigen::AngleAxisd(s * motion.angle, motion.axis).toRotationMatrix();
-    return R * (X - motion.center) + motion.center - X;
+    return R * (X - motion.center) + motion.center - X + s * motion.displacement;
 }
 
 }  // namespace fem::scenes

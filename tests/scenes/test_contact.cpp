@@ -300,7 +300,7 @@ TEST_CASE("auto raised to corotational for a contact step books the jump of H, a
     SceneForces& levels = *owned;
     dynamics::Body body(dynamics_scene(scene, spec), std::move(owned));
     const std::unique_ptr<dynamics::Integrator> own = dynamics::make_integrator("backward-euler");
-    ContactIntegrator integrator(*own, levels, body, scene_obstacles(scene), scene);
+    ContactIntegrator integrator(*own, {&levels}, body, scene_obstacles(scene), scene);
 
     const Eigen::Vector3d centre = spec.mesh.V.colwise().mean().transpose();
     const Eigen::Matrix3d R = Eigen::AngleAxisd(std::numbers::pi / 6.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();

@@ -85,7 +85,7 @@ TEST_CASE("every gallery scene reads, with and without its quick overrides", "[s
             CHECK(!scene.bodies.empty());
             for (const BodySpec& body : scene.bodies) {
                 CHECK(body.mesh.T.rows() > 0);
-                CHECK((!body.pinned.empty() || !scene.obstacles.empty()));  // held, or caught by an obstacle
+                CHECK((!body.pinned.empty() || !scene.obstacles.empty() || scene.contact.bodies));  // held, caught by an obstacle, or thrown at another body
             }
         }
     }
@@ -214,6 +214,11 @@ TEST_CASE("prescribed motion: the smooth ramp reaches the rotation and holds it"
     CHECK((half - Eigen::Vector3d(0.2, 0.5, 1.0)).norm() < 1e-15);
     const Eigen::Vector3d end = X + prescribed_displacement(turn, X, 10.0);
     CHECK((end - Eigen::Vector3d(0.2, 0.0, 0.5)).norm() < 1e-15);
+    // A screw: the same turn with its axis carried by 0.1 m along x, half of it half way.
+    Motion screw = turn;
+    screw.displacement = Eigen::Vector3d(0.1, 0.0, 0.0);
+    CHECK((X + prescribed_displacement(screw, X, 2.0) - Eigen::Vector3d(0.25, 0.5, 1.0)).norm() < 1e-15);
+    CHECK((X + prescribed_displacement(screw, X, 10.0) - Eigen::Vector3d(0.3, 0.0, 0.5)).norm() < 1e-15);
     Motion shift;
     shift.kind = Motion::Kind::translate;
     shift.displacement = Eigen::Vector3d(0.0, 0.0, 0.3);
