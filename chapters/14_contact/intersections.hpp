@@ -57,9 +57,11 @@ struct EdgeThroughTriangle {
 /// box tree over the triangles' boxes (skin::box_hierarchy, boxes_meeting) queried with each edge's
 /// box, then segment_meets_triangle. The first by edge, then by triangle row; none: found() false.
 /// One mesh's edges and triangles, or several bodies' and obstacles' stacked into one x with their
-/// indices offset. fem::Error for an index outside x or a non-finite position.
+/// indices offset. owner (#V entries, e.g. each vertex's body; empty: every pair): only an edge and a
+/// triangle whose first vertices have different owners are tested. fem::Error for an index outside
+/// x, a non-finite position or an owner list of another size.
 EdgeThroughTriangle first_edge_through_triangle(const MatrixX3d& x, const Eigen::MatrixX2i& edges,
-                                                const MatrixX3i& triangles);
+                                                const MatrixX3i& triangles, const std::vector<int>& owner = {});
 
 /// "edge (i, j) meets triangle (a, b, c)" in vertex indices of x, for a message; empty when none.
 std::string describe(const EdgeThroughTriangle& crossing, const Eigen::MatrixX2i& edges, const MatrixX3i& triangles);

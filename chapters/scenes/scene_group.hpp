@@ -45,8 +45,8 @@ std::vector<std::vector<int>> contact_groups(const SceneSpec& scene);
 /// bodies): fem::Error naming both bodies and the primitives, e.g. "body 'a' vertex 12 is 2e-4 m from
 /// body 'b' triangle (3, 7, 9), closer than d̂ = 1e-3 m", for every surface point–triangle and
 /// edge–edge pair of two bodies within d̂, every surface edge of one that crosses a surface triangle of
-/// the other (segment_meets_triangle), and a body whose first surface vertex lies inside another's
-/// surface (winding number > ½, chapter 13). Nothing without [contact] bodies.
+/// the other (chapter 14's first_edge_through_triangle), and a body whose first surface vertex lies
+/// inside another's surface (winding number > ½, chapter 13). Nothing without [contact] bodies.
 void check_start_gaps(const SceneSpec& scene);
 
 /// After a step: fem::Error when two bodies of different groups (stepped as separate solves) have
@@ -54,21 +54,6 @@ void check_start_gaps(const SceneSpec& scene);
 /// grouping's travel bound did not hold (a pin drove one further), and their contact would be missed.
 void check_groups_apart(const SceneSpec& scene, const std::vector<std::vector<int>>& groups,
                         const std::vector<MatrixX3d>& positions);
-
-/// Whether segment (p, q) meets triangle (a, b, c), touching included, exactly up to long double's
-/// round-off in the signed volumes: p and q not strictly on one side of the triangle's plane, and the
-/// segment's line not strictly outside any of the triangle's edges; when all lie in one plane, the
-/// same question in 2D (an end inside the closed triangle, or the segment meeting one of its edges,
-/// touching and collinear overlap counting as meeting).
-bool segment_meets_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eigen::Vector3d& a,
-                            const Eigen::Vector3d& b, const Eigen::Vector3d& c);
-
-/// The first surface edge of surface that meets a surface triangle it shares no vertex with, at
-/// positions x (#V×3), as "edge (i, j) meets triangle (a, b, c)"; empty when none does. Pairs whose
-/// bounding boxes do not meet are skipped (they cannot meet). vertex_owner (#V entries, or empty:
-/// all pairs): only pairs whose edge and triangle belong to different owners are tested.
-std::string edge_through_triangle(const contact::SurfacePrimitives& surface, const MatrixX3d& x,
-                                  const std::vector<int>& vertex_owner = {});
 
 /// The joined mesh of the bodies members (their vertices one after another, tets renumbered).
 TetMesh joined_mesh(const SceneSpec& scene, const std::vector<int>& members);

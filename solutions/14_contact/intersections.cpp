@@ -92,9 +92,11 @@ bool segment_meets_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& q, 
 }
 
 EdgeThroughTriangle first_edge_through_triangle(const MatrixX3d& x, const Eigen::MatrixX2i& edges,
-                                                const MatrixX3i& triangles)
+                                                const MatrixX3i& triangles, const std::vector<int>& owner)
 {
     const Eigen::Index n = x.rows();
+    if (!owner.empty() && static_cast<Eigen::Index>(owner.size()) != n)
+        throw Error(str("first_edge_through_triangle: ", owner.size(), " owners for ", n, " positions"));
     if (!x.allFinite())
         throw Error("first_edge_through_triangle: a position is not finite");
     if (edges.size() > 0 && (edges.minCoeff() < 0 || edges.maxCoeff() >= n))
@@ -123,6 +125,8 @@ EdgeThroughTriangle first_edge_through_triangle(const MatrixX3d& x, const Eigen:
             const auto triangle = triangles.row(t);
             if ((triangle.array() == i).any() || (triangle.array() == j).any())
                 continue;  // an edge of the triangle, or one meeting it at a corner
+            if (!owner.empty() && owner[std::size_t(i)] == owner[std::size_t(triangle(0))])
+                continue;  // one owner's own edge and triangle
             if (segment_meets_triangle(p, q, x.row(triangle(0)).transpose(), x.row(triangle(1)).transpose(),
                                        x.row(triangle(2)).transpose()))
                 return {static_cast<int>(e), t};

@@ -3,6 +3,7 @@
 #include "scenes/scene_group.hpp"
 
 #include "14_contact/distances.hpp"
+#include "14_contact/intersections.hpp"
 
 #include "13_skinning/skinning.hpp"
 
@@ -33,55 +34,6 @@ Box bounding_box(const MatrixX3d& x, double grow)
 bool boxes_meet(const Box& a, const Box& b)
 {
     return (a.row(0).array() <= b.row(1).array()).all() && (b.row(0).array() <= a.row(1).array()).all();
-}
-
-/// 6 × the signed volume of (a, b, c, d) in long double.
-long double orient(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, const Eigen::Vector3d& d)
-{
-    using Vector = Eigen::Matrix<long double, 3, 1>;
-    const Vector A = a.cast<long double>(), B = b.cast<long double>(), C = c.cast<long double>(), D = d.cast<long double>();
-    return (B - A).cross(C - A).dot(D - A);
-}
-
-/// Twice the signed area of the 2D triangle (a, b, c), in long double.
-long double orient2(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c)
-{
-    return (static_cast<long double>(b.x()) - a.x()) * (static_cast<long double>(c.y()) - a.y()) -
-           (static_cast<long double>(b.y()) - a.y()) * (static_cast<long double>(c.x()) - a.x());
-}
-
-/// Whether 2D segments (p, q) and (r, s) meet, touching and collinear overlap included.
-bool segments_meet(const Eigen::Vector2d& p, const Eigen::Vector2d& q, const Eigen::Vector2d& r, const Eigen::Vector2d& s)
-{
-    const long double d1 = orient2(r, s, p), d2 = orient2(r, s, q), d3 = orient2(p, q, r), d4 = orient2(p, q, s);
-    if (((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0)))
-        return true;
-    // A point on the other segment's line within its box (collinear or touching cases).
-    const auto on = [](const Eigen::Vector2d& x, const Eigen::Vector2d& y, const Eigen::Vector2d& z, long double d) {
-        return d == 0 && (z.array() >= x.cwiseMin(y).array()).all() && (z.array() <= x.cwiseMax(y).array()).all();
-    };
-    return on(r, s, p, d1) || on(r, s, q, d2) || on(p, q, r, d3) || on(p, q, s, d4);
-}
-
-/// segment_meets_triangle when all five points lie in one plane: projected along the axis of the
-/// triangle's normal's largest component, the segment meets the triangle when an end lies in it
-/// (closed) or it meets one of its edges. A zero-area triangle is met when the segment meets its edges.
-bool coplanar_segment_meets_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eigen::Vector3d& a,
-                                     const Eigen::Vector3d& b, const Eigen::Vector3d& c)
-{
-    Eigen::Index axis = 0;
-    (b - a).cross(c - a).cwiseAbs().maxCoeff(&axis);
-    const auto flat = [axis](const Eigen::Vector3d& x) {
-        return Eigen::Vector2d(x[(axis + 1) % 3], x[(axis + 2) % 3]);
-    };
-    const Eigen::Vector2d P = flat(p), Q = flat(q), A = flat(a), B = flat(b), C = flat(c);
-    const auto inside = [&](const Eigen::Vector2d& x) {
-        const long double u = orient2(A, B, x), v = orient2(B, C, x), w = orient2(C, A, x);
-        return (u >= 0 && v >= 0 && w >= 0) || (u <= 0 && v <= 0 && w <= 0);
-    };
-    if (orient2(A, B, C) != 0 && (inside(P) || inside(Q)))
-        return true;
-    return segments_meet(P, Q, A, B) || segments_meet(P, Q, B, C) || segments_meet(P, Q, C, A);
 }
 
 /// The body each vertex of a group's joined mesh belongs to (its index in members) and its own index.
@@ -171,46 +123,6 @@ std::vector<std::vector<int>> contact_groups(const SceneSpec& scene)
     return groups;
 }
 
-bool segment_meets_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eigen::Vector3d& a,
-                            const Eigen::Vector3d& b, const Eigen::Vector3d& c)
-{
-    const long double sp = orient(a, b, c, p), sq = orient(a, b, c, q);
-    if ((sp > 0 && sq > 0) || (sp < 0 && sq < 0))
-        return false;
-    if (sp == 0 && sq == 0)
-        return coplanar_segment_meets_triangle(p, q, a, b, c);
-    const long double e0 = orient(p, q, a, b), e1 = orient(p, q, b, c), e2 = orient(p, q, c, a);
-    return !((e0 > 0 || e1 > 0 || e2 > 0) && (e0 < 0 || e1 < 0 || e2 < 0));
-}
-
-std::string edge_through_triangle(const contact::SurfacePrimitives& surface, const MatrixX3d& x,
-                                  const std::vector<int>& vertex_owner)
-{
-    std::vector<Box> triangle_boxes;
-    for (Eigen::Index t = 0; t < surface.triangles.rows(); ++t) {
-        MatrixX3d corners(3, 3);
-        for (int k = 0; k < 3; ++k)
-            corners.row(k) = x.row(surface.triangles(t, k));
-        triangle_boxes.push_back(bounding_box(corners, 0.0));
-    }
-    const skin::BoxHierarchy tree = skin::box_hierarchy(triangle_boxes, 4);
-    for (Eigen::Index e = 0; e < surface.edges.rows(); ++e) {
-        const int i = surface.edges(e, 0), j = surface.edges(e, 1);
-        const Eigen::Vector3d p = x.row(i).transpose(), q = x.row(j).transpose();
-        for (int t : skin::boxes_meeting(tree, triangle_boxes, p.cwiseMin(q), p.cwiseMax(q))) {
-            const auto tri = surface.triangles.row(t);
-            if ((tri.array() == i).any() || (tri.array() == j).any())
-                continue;
-            if (!vertex_owner.empty() && vertex_owner[i] == vertex_owner[tri(0)])
-                continue;
-            if (segment_meets_triangle(p, q, x.row(tri(0)).transpose(), x.row(tri(1)).transpose(),
-                                       x.row(tri(2)).transpose()))
-                return str("edge (", i, ", ", j, ") meets triangle (", tri(0), ", ", tri(1), ", ", tri(2), ")");
-        }
-    }
-    return {};
-}
-
 TetMesh joined_mesh(const SceneSpec& scene, const std::vector<int>& members)
 {
     Eigen::Index vertices = 0, tets = 0;
@@ -277,9 +189,11 @@ void check_start_gaps(const SceneSpec& scene)
         if (d < d_hat)
             refuse(str(name(a0), " edge ", local({a0, a1}), " from ", name(b0), " edge ", local({b0, b1})), d);
     }
-    const std::string crossing = edge_through_triangle(surface, mesh.V, owner.body);
-    if (!crossing.empty())
-        throw Error(str(scene.file.string(), ": the bodies start intersecting (", crossing,
+    const contact::EdgeThroughTriangle crossing =
+        contact::first_edge_through_triangle(mesh.V, surface.edges, surface.triangles, owner.body);
+    if (crossing.found())
+        throw Error(str(scene.file.string(), ": the bodies start intersecting (",
+                        contact::describe(crossing, surface.edges, surface.triangles),
                         " in the joined numbering): bodies must start at least d̂ apart"));
     // A body wholly inside another crosses no surface: its first surface vertex against each other body.
     for (std::size_t i = 0; i < scene.bodies.size(); ++i)

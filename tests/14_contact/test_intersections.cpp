@@ -139,6 +139,22 @@ TEST_CASE("segment and triangle: meets where the parametric crossing is inside, 
     CHECK_FALSE(segment_meets_triangle(Eigen::Vector3d(-1.0, 0.2, 1e-12), Eigen::Vector3d(2.0, 0.2, 1e-12), a, b, c));
 }
 
+TEST_CASE("segment and triangle: crossing, apart, touching, and in the triangle's plane")
+{
+    const Eigen::Vector3d a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
+    CHECK(segment_meets_triangle({0.2, 0.2, -1}, {0.2, 0.2, 1}, a, b, c));       // through the inside
+    CHECK_FALSE(segment_meets_triangle({0.8, 0.8, -1}, {0.8, 0.8, 1}, a, b, c)); // past the long edge
+    CHECK_FALSE(segment_meets_triangle({0.2, 0.2, 0.1}, {0.2, 0.2, 1}, a, b, c)); // above it
+    CHECK(segment_meets_triangle({0.2, 0.2, 0.0}, {0.2, 0.2, 1}, a, b, c));      // an end on it
+    CHECK(segment_meets_triangle({0.5, 0.0, -1}, {0.5, 0.0, 1}, a, b, c));       // through an edge
+    // In the plane: inside, across an edge, apart, along an edge's line beyond it.
+    CHECK(segment_meets_triangle({0.1, 0.1, 0}, {0.2, 0.2, 0}, a, b, c));
+    CHECK(segment_meets_triangle({-1, 0.5, 0}, {1, 0.5, 0}, a, b, c));
+    CHECK_FALSE(segment_meets_triangle({2, 2, 0}, {3, 2, 0}, a, b, c));
+    CHECK_FALSE(segment_meets_triangle({1.5, 0, 0}, {2, 0, 0}, a, b, c));
+    CHECK(segment_meets_triangle({1, 0, 0}, {2, 0, 0}, a, b, c));  // touching a corner
+}
+
 TEST_CASE("first edge through a triangle: none between two boxes apart, the one the tree and every pair find "
           "when a box is pushed into the other, edges of one triangle never")
 {
@@ -203,7 +219,7 @@ TEST_CASE("first edge through a triangle: an index outside the positions or a no
 }
 
 TEST_CASE("the contact potential's debug check: an edge through a face of the body or of a box obstacle is "
-          "refused at the energy, naming both; apart, it is quiet", "[self][ex14.9]")
+          "refused at the energy, naming both, and apart it is quiet", "[self][ex14.9]")
 {
     dynamics::Scene scene;
     scene.mesh = two_boxes(Eigen::Vector3d(0.0, 0.0, 0.1 + 1e-2));

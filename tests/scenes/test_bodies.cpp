@@ -10,6 +10,7 @@
 #include "scenes/scene_group.hpp"
 
 #include "14_contact/broad_phase.hpp"
+#include "14_contact/intersections.hpp"
 
 #include "12_hyperelastic_newton/force_models.hpp"
 
@@ -77,7 +78,9 @@ std::string crossing_at(const RunResult& run, std::size_t k, const TetMesh& join
         x.middleRows(row, body[k].rows()) = body[k];
         row += body[k].rows();
     }
-    return edge_through_triangle(contact::surface_primitives(joined), x, owner);
+    const contact::SurfacePrimitives surface = contact::surface_primitives(joined);
+    return contact::describe(contact::first_edge_through_triangle(x, surface.edges, surface.triangles, owner),
+                             surface.edges, surface.triangles);
 }
 
 std::vector<int> vertex_owners(const SceneSpec& scene)
@@ -296,22 +299,6 @@ TEST_CASE("the new gallery scenes' quick runs: no surface edge through a surface
             CHECK(crossing_at(run, k, joined, {}).empty());
         }
     }
-}
-
-TEST_CASE("segment_meets_triangle: crossing, apart, touching, and in the triangle's plane", "[scenes][bodies]")
-{
-    const Eigen::Vector3d a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
-    CHECK(segment_meets_triangle({0.2, 0.2, -1}, {0.2, 0.2, 1}, a, b, c));       // through the inside
-    CHECK_FALSE(segment_meets_triangle({0.8, 0.8, -1}, {0.8, 0.8, 1}, a, b, c)); // past the long edge
-    CHECK_FALSE(segment_meets_triangle({0.2, 0.2, 0.1}, {0.2, 0.2, 1}, a, b, c)); // above it
-    CHECK(segment_meets_triangle({0.2, 0.2, 0.0}, {0.2, 0.2, 1}, a, b, c));      // an end on it
-    CHECK(segment_meets_triangle({0.5, 0.0, -1}, {0.5, 0.0, 1}, a, b, c));       // through an edge
-    // In the plane: inside, across an edge, apart, along an edge's line beyond it.
-    CHECK(segment_meets_triangle({0.1, 0.1, 0}, {0.2, 0.2, 0}, a, b, c));
-    CHECK(segment_meets_triangle({-1, 0.5, 0}, {1, 0.5, 0}, a, b, c));
-    CHECK_FALSE(segment_meets_triangle({2, 2, 0}, {3, 2, 0}, a, b, c));
-    CHECK_FALSE(segment_meets_triangle({1.5, 0, 0}, {2, 0, 0}, a, b, c));
-    CHECK(segment_meets_triangle({1, 0, 0}, {2, 0, 0}, a, b, c));  // touching a corner
 }
 
 TEST_CASE("bodies stepped apart that come within d-hat all the same stop the run, naming both", "[scenes][bodies]")
