@@ -7,6 +7,7 @@
 #include "14_contact/contact.hpp"
 #include "14_contact/distances.hpp"
 #include "14_contact/self_barrier.hpp"
+#include "segment_triangle.hpp"
 
 #include "12_hyperelastic_newton/force_models.hpp"
 #include "12_hyperelastic_newton/newton.hpp"
@@ -66,28 +67,6 @@ struct SelfPotential {
     }
 };
 
-/// 6 × the signed volume of (a, b, c, d) in long double: > 0 when d is on the side of (a, b, c) its
-/// normal (b − a) × (c − a) points to.
-long double orient(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, const Eigen::Vector3d& d)
-{
-    const auto ld = [](const Eigen::Vector3d& x) { return Eigen::Matrix<long double, 3, 1>(x.cast<long double>()); };
-    return (ld(b) - ld(a)).cross(ld(c) - ld(a)).dot(ld(d) - ld(a));
-}
-
-/// Whether segment (p, q) meets triangle (a, b, c), touching included: p and q not strictly on one
-/// side of the plane, and the segment's line not strictly outside any of the triangle's edges (the
-/// three volumes of (p, q) with each edge of one sign or zero). Degenerate, coplanar cases count as
-/// meeting (conservative: a test that says "apart" means apart).
-bool segment_meets_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eigen::Vector3d& a,
-                            const Eigen::Vector3d& b, const Eigen::Vector3d& c)
-{
-    const long double sp = orient(a, b, c, p), sq = orient(a, b, c, q);
-    if ((sp > 0 && sq > 0) || (sp < 0 && sq < 0))
-        return false;
-    const long double e0 = orient(p, q, a, b), e1 = orient(p, q, b, c), e2 = orient(p, q, c, a);
-    return !((e0 > 0 || e1 > 0 || e2 > 0) && (e0 < 0 || e1 < 0 || e2 < 0));
-}
-
 /// The first surface edge that meets a surface triangle it shares no vertex with, at positions x,
 /// as "edge (i, j) meets triangle (a, b, c)"; empty when none does.
 std::string edge_through_triangle(const SurfacePrimitives& surface, const MatrixX3d& x)
@@ -98,7 +77,7 @@ std::string edge_through_triangle(const SurfacePrimitives& surface, const Matrix
             const int i = surface.edges(e, 0), j = surface.edges(e, 1);
             if ((tri.array() == i).any() || (tri.array() == j).any())
                 continue;
-            if (segment_meets_triangle(x.row(i).transpose(), x.row(j).transpose(), x.row(tri(0)).transpose(),
+            if (test::segment_meets_triangle(x.row(i).transpose(), x.row(j).transpose(), x.row(tri(0)).transpose(),
                                        x.row(tri(1)).transpose(), x.row(tri(2)).transpose()))
                 return str("edge (", i, ", ", j, ") meets triangle (", tri(0), ", ", tri(1), ", ", tri(2), ")");
         }

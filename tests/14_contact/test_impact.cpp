@@ -1,0 +1,217 @@
+// Chapter 14: a block fired at obstacles with corners and edges (a box, turned and not, a mesh
+// triangle, a tent of four) and at the floor, at 10, 100 and 1,000 m/s: every step converges and
+// nothing is ever inside — no vertex in a solid or through a sheet, no obstacle edge through a body
+// face, no body edge through an obstacle face. docs/14_contact.md#what-is-guaranteed
+#include "14_contact/broad_phase.hpp"
+#include "14_contact/contact.hpp"
+#include "14_contact/contact_scenes.hpp"
+#include "14_contact/mesh_obstacle.hpp"
+#include "14_contact/obstacles.hpp"
+#include "segment_triangle.hpp"
+
+#include "12_hyperelastic_newton/newton.hpp"
+
+#include "common/error.hpp"
+#include "common/test_support.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <cmath>
+#include <iostream>
+#include <limits>
+#include <memory>
+#include <string>
+
+using namespace fem;
+using namespace fem::contact;
+
+namespace {
+
+/// What firing the block at an obstacle did.
+struct Impact {
+    int steps = 0;                 // steps that converged
+    std::string error;             // the first step's error that did not
+    int most_iterations = 0;       // Newton iterations of the hardest step
+    double smallest_fraction = 1;  // the smallest α a line search accepted
+    double smallest_distance = std::numeric_limits<double>::infinity();  // at the steps' ends
+    std::string inside;            // the first thing found inside, empty when nothing was
+    double seconds = 0.0;
+};
+
+/// The first thing inside the obstacle at positions x (#V×3), reached on a straight path from x0:
+/// a vertex in a solid or whose path crossed a sheet, an obstacle's edge through a surface
+/// triangle of the body, a surface edge of the body through one of the obstacle's triangles.
+std::string first_inside(const Obstacle& obstacle, const SurfacePrimitives& surface, const MatrixX3d& x0,
+                         const MatrixX3d& x)
+{
+    for (Eigen::Index v = 0; v < x.rows(); ++v) {
+        if (obstacle.has_inside() && !(obstacle.local_distance(x.row(v).transpose()) > 0.0))
+            return str("vertex ", v, " inside");
+        if (!obstacle.has_inside() && obstacle.crosses(x0.row(v).transpose(), x.row(v).transpose()))
+            return str("vertex ", v, " crossed the sheet");
+    }
+    const auto row = [](const auto& m, Eigen::Index i) -> Eigen::Vector3d { return m.row(i).transpose(); };
+    const ObstacleFeatures features = obstacle.local_features();
+    for (Eigen::Index e = 0; e < features.edges.rows(); ++e)
+        for (Eigen::Index t = 0; t < surface.triangles.rows(); ++t)
+            if (test::segment_meets_triangle(row(features.corners, features.edges(e, 0)),
+                                             row(features.corners, features.edges(e, 1)),
+                                             row(x, surface.triangles(t, 0)), row(x, surface.triangles(t, 1)),
+                                             row(x, surface.triangles(t, 2))))
+                return str("obstacle edge ", e, " through body triangle ", t);
+    const Eigen::Vector3d low = x.colwise().minCoeff().transpose(), high = x.colwise().maxCoeff().transpose();
+    const TriMesh faces = obstacle.local_surface({low.x(), high.x(), low.y(), high.y(), low.z(), high.z()});
+    for (Eigen::Index e = 0; e < surface.edges.rows(); ++e)
+        for (Eigen::Index f = 0; f < faces.F.rows(); ++f)
+            if (test::segment_meets_triangle(row(x, surface.edges(e, 0)), row(x, surface.edges(e, 1)),
+                                             row(faces.V, faces.F(f, 0)), row(faces.V, faces.F(f, 1)),
+                                             row(faces.V, faces.F(f, 2))))
+                return str("body edge ", e, " through obstacle triangle ", f);
+    return {};
+}
+
+/// The contact potential of a block, watched: every configuration Newton takes its gradient at
+/// (each accepted iterate, and trials on the segment to it, all within the safe step of the
+/// continuous collision check) is checked by first_inside against the one before it.
+class Watched final : public hyper::StepPotential {
+public:
+    Watched(ContactPotential& contact, const dynamics::Body& body, const Obstacle& obstacle)
+        : contact_(contact), body_(body), obstacle_(obstacle), surface_(surface_primitives(body.mesh()))
+    {
+    }
+    void begin_step(dynamics::Body& body, const dynamics::State& state, double time_step) override
+    {
+        contact_.begin_step(body, state, time_step);
+        last_ = body_.positions(state.u);
+    }
+    double energy(const Eigen::VectorXd& u) const override { return contact_.energy(u); }
+    Eigen::VectorXd gradient(const Eigen::VectorXd& u) const override
+    {
+        const MatrixX3d x = body_.positions(u);
+        if (inside.empty())
+            inside = first_inside(obstacle_, surface_, last_, x);
+        last_ = x;
+        return contact_.gradient(u);
+    }
+    dynamics::SparseMatrix hessian(const Eigen::VectorXd& u) const override { return contact_.hessian(u); }
+    double largest_safe_step(const Eigen::VectorXd& u, const Eigen::VectorXd& du) const override
+    {
+        return contact_.largest_safe_step(u, du);
+    }
+    Eigen::VectorXd start_velocity(const dynamics::Body& body, const dynamics::State& state,
+                                   double time_step) const override
+    {
+        return contact_.start_velocity(body, state, time_step);
+    }
+    mutable std::string inside;  // the first thing found inside, empty when nothing was
+
+private:
+    ContactPotential& contact_;
+    const dynamics::Body& body_;
+    const Obstacle& obstacle_;
+    SurfacePrimitives surface_;
+    mutable MatrixX3d last_;
+};
+
+/// Fires the one-cell block (edge 0.1 m, lowest face 0.2 m up, no gravity) straight down at speed
+/// [m/s] at obstacle for 10 steps of 1/100 s, with Newton's cap at 500 iterations, watching every
+/// configuration Newton takes (Watched); stops at the first step that fails.
+Impact fire(std::shared_ptr<const Obstacle> obstacle, double speed)
+{
+    const auto start = std::chrono::steady_clock::now();
+    BlockSettings settings;
+    settings.height = 0.2;
+    settings.gravity = 0.0;
+    settings.newton.max_iterations = 500;
+    settings.obstacles = {obstacle};
+    BlockScene block = block_scene(settings);
+    Watched watched(*block.contact, *block.body, *obstacle);
+    block.integrator->set_potential(&watched);
+    Eigen::VectorXd v = Eigen::VectorXd::Zero(block.state.u.size());
+    for (Eigen::Index i = 2; i < v.size(); i += 3)
+        v[i] = -speed;
+    block.state = dynamics::initial_state(*block.body, {}, v);
+    Impact impact;
+    for (int step = 0; step < 10 && watched.inside.empty(); ++step) {
+        try {
+            block.step();
+        } catch (const Error& e) {
+            impact.error = str("step ", step + 1, ": ", e.what());
+            break;
+        }
+        ++impact.steps;
+        const hyper::NewtonResult& newton = block.integrator->last();
+        impact.most_iterations = std::max(impact.most_iterations, newton.iterations);
+        for (double alpha : newton.step_lengths)
+            impact.smallest_fraction = std::min(impact.smallest_fraction, alpha);
+        impact.smallest_distance = std::min(impact.smallest_distance, block.contact->smallest_distance(block.state.u));
+    }
+    impact.inside = watched.inside;
+    impact.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return impact;
+}
+
+/// A box of half extent 3 cm under the block's centre, turned by turn, its highest point at z = 0:
+/// its corners and edges meet the block's lower face between its vertices.
+std::shared_ptr<const Obstacle> box_under(const Eigen::Matrix3d& turn)
+{
+    const Eigen::Vector3d half = Eigen::Vector3d::Constant(0.03);
+    double top = 0.0;
+    for (int k = 0; k < 8; ++k)
+        top = std::max(top, (turn * Eigen::Vector3d((k & 1) ? 1 : -1, (k & 2) ? 1 : -1, (k & 4) ? 1 : -1)
+                                        .cwiseProduct(half)).z());
+    return std::make_shared<Box>(Eigen::Vector3d(0.05, 0.05, -top), half, turn);
+}
+
+/// One triangle, its corner (0.05, 0.05, 0) pointing up under the block's centre.
+std::shared_ptr<const Obstacle> triangle_under()
+{
+    TriMesh triangle;
+    triangle.V.resize(3, 3);
+    triangle.V << 0.05, 0.05, 0.0, 0.6, -0.2, -0.1, -0.2, 0.6, -0.1;
+    triangle.F.resize(1, 3);
+    triangle.F << 0, 1, 2;
+    return std::make_shared<MeshObstacle>(triangle);
+}
+
+/// The tent: the square [-1, 1]² at z = 0 cut into four triangles at a raised apex (0.05, 0.05, 0.02)
+/// under the block's centre.
+std::shared_ptr<const Obstacle> tent()
+{
+    TriMesh tent;
+    tent.V.resize(5, 3);
+    tent.V << -1.0, -1.0, 0.0, 1.0, -1.0, 0.0, 1.0, 1.0, 0.0, -1.0, 1.0, 0.0, 0.05, 0.05, 0.02;
+    tent.F.resize(4, 3);
+    tent.F << 0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 4;
+    return std::make_shared<MeshObstacle>(tent);
+}
+
+const Eigen::Matrix3d turned = Eigen::AngleAxisd(0.6, Eigen::Vector3d(1.0, 2.0, 3.0).normalized()).toRotationMatrix();
+
+}  // namespace
+
+TEST_CASE("probe: the block fired at obstacles with corners at 10, 100 and 1000 m/s", "[.probe]")
+{
+    const std::pair<const char*, std::shared_ptr<const Obstacle>> obstacles[] = {
+        {"turned box", box_under(turned)},
+        {"aligned box", box_under(Eigen::Matrix3d::Identity())},
+        {"triangle", triangle_under()},
+        {"tent", tent()},
+        {"floor", std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ())}};
+    const char* only = std::getenv("PROBE_ONLY");
+    for (const auto& [name, obstacle] : obstacles)
+        for (double speed : {10.0, 100.0, 1000.0}) {
+            if (only && str(name, " ", speed) != only)
+                continue;
+            const Impact impact = fire(obstacle, speed);
+            std::cout << name << " at " << speed << " m/s: " << impact.steps << " steps, most iterations "
+                      << impact.most_iterations << ", smallest alpha " << impact.smallest_fraction
+                      << ", smallest distance " << impact.smallest_distance << ", inside: '" << impact.inside
+                      << "', " << impact.seconds << " s, error: " << impact.error << std::endl;
+        }
+}
