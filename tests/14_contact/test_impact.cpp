@@ -22,7 +22,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdlib>
 #include <cmath>
 #include <iostream>
 #include <limits>
@@ -199,6 +198,9 @@ const Eigen::Matrix3d turned = Eigen::AngleAxisd(0.6, Eigen::Vector3d(1.0, 2.0, 
 
 }  // namespace
 
+// The measurement behind the tests below (hidden; run `test_ch14 "[.probe]"`): for each obstacle and
+// speed, the steps that converged, Newton's most iterations in a step, the smallest line-search
+// step α, the smallest distance seen, what was inside, the wall time and the error.
 TEST_CASE("probe: the block fired at obstacles with corners at 10, 100 and 1000 m/s", "[.probe]")
 {
     const std::pair<const char*, std::shared_ptr<const Obstacle>> obstacles[] = {
@@ -207,11 +209,8 @@ TEST_CASE("probe: the block fired at obstacles with corners at 10, 100 and 1000 
         {"triangle", triangle_under()},
         {"tent", tent()},
         {"floor", std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ())}};
-    const char* only = std::getenv("PROBE_ONLY");
     for (const auto& [name, obstacle] : obstacles)
         for (double speed : {10.0, 100.0, 1000.0}) {
-            if (only && str(name, " ", speed) != only)
-                continue;
             const Impact impact = fire(obstacle, speed);
             std::cout << name << " at " << speed << " m/s: " << impact.steps << " steps, most iterations "
                       << impact.most_iterations << ", smallest alpha " << impact.smallest_fraction
@@ -255,7 +254,7 @@ TEST_CASE("fired at a turned box or a mesh triangle at 1000 m/s, every step conv
 }
 
 TEST_CASE("the coplanarity filter clears a point 3e-7 m under a face that slides away, and stops at the plane of one "
-          "pushed through it", "[ex14.7]")
+          "pushed through it", "[ex14.8]")
 {
     // A corner p held 3·10⁻⁷ m under a triangle that slides 5 cm along its plane and rises 0.3 mm:
     // f(t) keeps its sign, the pair is cleared for the whole step.
