@@ -9,6 +9,7 @@
 #include "14_contact/mesh_obstacle.hpp"
 #include "14_contact/obstacles.hpp"
 #include "14_contact/pair_barrier.hpp"
+#include "contact_delegate.hpp"
 #include "segment_triangle.hpp"
 
 #include "12_hyperelastic_newton/newton.hpp"
@@ -79,10 +80,10 @@ std::string first_inside(const Obstacle& obstacle, const SurfacePrimitives& surf
 /// The contact potential of a block, watched: every configuration Newton takes its gradient at
 /// (each accepted iterate, and trials on the segment to it, all within the safe step of the
 /// continuous collision check) is checked by first_inside against the one before it.
-class Watched final : public hyper::StepPotential {
+class Watched final : public test::ContactDelegate {
 public:
     Watched(ContactPotential& contact, const dynamics::Body& body, const Obstacle& obstacle)
-        : contact_(contact), body_(body), obstacle_(obstacle), surface_(surface_primitives(body.mesh()))
+        : ContactDelegate(contact), body_(body), obstacle_(obstacle), surface_(surface_primitives(body.mesh()))
     {
     }
     void begin_step(dynamics::Body& body, const dynamics::State& state, double time_step) override
@@ -90,7 +91,6 @@ public:
         contact_.begin_step(body, state, time_step);
         last_ = body_.positions(state.u);
     }
-    double energy(const Eigen::VectorXd& u) const override { return contact_.energy(u); }
     Eigen::VectorXd gradient(const Eigen::VectorXd& u) const override
     {
         const MatrixX3d x = body_.positions(u);
@@ -100,21 +100,10 @@ public:
         last_ = x;
         return contact_.gradient(u);
     }
-    dynamics::SparseMatrix hessian(const Eigen::VectorXd& u) const override { return contact_.hessian(u); }
-    double largest_safe_step(const Eigen::VectorXd& u, const Eigen::VectorXd& du) const override
-    {
-        return contact_.largest_safe_step(u, du);
-    }
-    Eigen::VectorXd start_velocity(const dynamics::Body& body, const dynamics::State& state,
-                                   double time_step) const override
-    {
-        return contact_.start_velocity(body, state, time_step);
-    }
     mutable std::string inside;  // the first thing found inside, empty when nothing was
     mutable double nearest = std::numeric_limits<double>::infinity();  // the smallest distance seen [m]
 
 private:
-    ContactPotential& contact_;
     const dynamics::Body& body_;
     const Obstacle& obstacle_;
     SurfacePrimitives surface_;

@@ -6,6 +6,7 @@
 #include "14_contact/contact_scenes.hpp"
 #include "14_contact/mesh_obstacle.hpp"
 #include "14_contact/obstacles.hpp"
+#include "contact_delegate.hpp"
 #include "rest_weight.hpp"
 
 #include "12_hyperelastic_newton/newton.hpp"
@@ -33,35 +34,17 @@ constexpr double degree = std::numbers::pi / 180.0;
 
 /// A contact potential that records the smallest distance of every configuration the line search
 /// and the step start evaluate: none of them may be inside an obstacle.
-class WatchedContact final : public hyper::StepPotential {
+class WatchedContact final : public test::ContactDelegate {
 public:
-    explicit WatchedContact(ContactPotential& contact) : contact_(contact) {}
-    void begin_step(dynamics::Body& body, const dynamics::State& state, double time_step) override
-    {
-        contact_.begin_step(body, state, time_step);
-    }
+    using ContactDelegate::ContactDelegate;
     double energy(const Eigen::VectorXd& u) const override
     {
         smallest = std::min(smallest, contact_.smallest_distance(u));
         ++evaluations;
         return contact_.energy(u);
     }
-    Eigen::VectorXd gradient(const Eigen::VectorXd& u) const override { return contact_.gradient(u); }
-    dynamics::SparseMatrix hessian(const Eigen::VectorXd& u) const override { return contact_.hessian(u); }
-    double largest_safe_step(const Eigen::VectorXd& u, const Eigen::VectorXd& du) const override
-    {
-        return contact_.largest_safe_step(u, du);
-    }
-    Eigen::VectorXd start_velocity(const dynamics::Body& body, const dynamics::State& state,
-                                   double time_step) const override
-    {
-        return contact_.start_velocity(body, state, time_step);
-    }
     mutable double smallest = std::numeric_limits<double>::infinity();
     mutable int evaluations = 0;
-
-private:
-    ContactPotential& contact_;
 };
 
 }  // namespace
