@@ -340,8 +340,8 @@ TEST_CASE("a block dropped on a turned box comes to rest on its top face, never 
 {
     BlockSettings settings;
     settings.height = 0.01;
-    // A slab under the block, turned 0.3 rad about z: its top face is z = 0, its time of impact
-    // conservative advancement.
+    // A slab under the block, turned 0.3 rad about z: its top face is z = 0, its time of impact the
+    // slab test's.
     const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()).toRotationMatrix();
     settings.obstacles = {std::make_shared<Box>(Eigen::Vector3d(0.05, 0.05, -0.05), Eigen::Vector3d(0.2, 0.2, 0.05), turn)};
     BlockScene block = block_scene(settings);
