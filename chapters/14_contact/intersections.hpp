@@ -66,6 +66,13 @@ EdgeThroughTriangle first_edge_through_triangle(const MatrixX3d& x, const Eigen:
 /// "edge (i, j) meets triangle (a, b, c)" in vertex indices of x, for a message; empty when none.
 std::string describe(const EdgeThroughTriangle& crossing, const Eigen::MatrixX2i& edges, const MatrixX3i& triangles);
 
+/// The first crossing between a body's surface (surface's primitives at positions x, #V×3) and a
+/// triangle mesh apart from it (an obstacle's triangles): a body edge through one of other's
+/// triangles, or one of other's edges through a body triangle, as "body edge (i, j) meets triangle
+/// (a, b, c)" or "edge (a, b) meets body triangle (i, j, k)" (other's vertices numbered from #V);
+/// empty when none. fem::Error as first_edge_through_triangle.
+std::string first_crossing(const MatrixX3d& x, const SurfacePrimitives& surface, const TriMesh& other);
+
 /// The debug check of the contact potential (ContactOptions::check_intersections): a body's
 /// surface against the drawn triangles of its obstacles with edges and corners (boxes, meshes:
 /// Obstacle::local_features not empty; their triangles are their exact surface), and, with

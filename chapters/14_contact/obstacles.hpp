@@ -53,8 +53,8 @@ public:
     /// ∇²d₀(p) (3×3, symmetric) [1/m]: 0 for a plane or a box face, (I − n nᵀ)/|p − c| for a sphere.
     virtual Eigen::Matrix3d local_hessian(const Eigen::Vector3d& p) const = 0;
     /// The first s ≥ 0 at which the path p + s·dp (p outside, d₀(p) > 0) reaches d₀ = 0, or +∞ when
-    /// it never does. Exact for a half-space, a sphere and a capsule; a box answers a conservative s (never
-    /// beyond the true one).
+    /// it never does. Exact for a half-space, a sphere, a capsule and a box; a mesh's falls back to a
+    /// conservative s (never beyond the true one) for a path in a triangle's plane.
     virtual double local_time_of_impact(const Eigen::Vector3d& p, const Eigen::Vector3d& dp) const = 0;
 
     /// The pieces p feels within reach, appended to pieces: a half-space, a sphere or a box is one
@@ -109,7 +109,7 @@ private:
 };
 
 /// Conservative advancement along p + s·dp for an obstacle whose d₀ is 1-Lipschitz (|∇d₀| ≤ 1: a
-/// box's, a mesh's): from s = 0, s ← s + d₀(p + s dp)/|dp| — the path cannot lose more distance
+/// mesh's): from s = 0, s ← s + d₀(p + s dp)/|dp| — the path cannot lose more distance
 /// than its length, so no s it reaches lies beyond the first zero of d₀ — stopped at the first s
 /// where d₀ has fallen to 5 % of its start (or after 100 advances); +∞ when the path does not reach
 /// the obstacle by s = 2 (callers step at most s = 1); 0 when d₀(p) ≤ 0.
@@ -160,7 +160,7 @@ private:
 /// q = Rᵀ(x − c), with e = |q| − h (per axis): outside d = |max(e, 0)| (the nearest face, edge or
 /// corner), inside d = max eᵢ. ∇d = R (sign(q) ∘ max(e, 0))/d outside; ∇²d = R (P_A − n nᵀ)/d Rᵀ with
 /// P_A the diagonal of the axes where eᵢ > 0 (0 on a face, a cylinder's on an edge, a sphere's at a
-/// corner). Its time of impact is conservative advancement (conservative_time_of_impact).
+/// corner). Its time of impact is exact, by the slab test (local_time_of_impact).
 class Box final : public Obstacle {
 public:
     /// fem::Error for a half extent ≤ 0, a rotation that is not orthonormal with det +1 (to 1e-9),
@@ -172,6 +172,9 @@ public:
     double local_distance(const Eigen::Vector3d& p) const override;
     Eigen::Vector3d local_gradient(const Eigen::Vector3d& p) const override;
     Eigen::Matrix3d local_hessian(const Eigen::Vector3d& p) const override;
+    /// Exact (the slab test): with q = Rᵀ(p − c), w = Rᵀ dp, the path is in slab i, |q_i + s w_i| ≤ h_i,
+    /// between s = (±h_i − q_i)/w_i; the first s ≥ 0 in all three (the latest entry, when no later
+    /// than the earliest exit), +∞ when there is none; 0 when d₀(p) ≤ 0.
     double local_time_of_impact(const Eigen::Vector3d& p, const Eigen::Vector3d& dp) const override;
     /// Its 8 corners c + R (±h₀, ±h₁, ±h₂) and 12 edges.
     ObstacleFeatures local_features() const override;

@@ -45,10 +45,27 @@ double additive_time_of_impact(PrimitivePair pair, const PrimitiveMotion& motion
 /// The most boxes inclusion_ccd evaluates for one pair inside a line search (line_search_time_of_impact).
 inline constexpr long long line_search_ccd_boxes = 4000;
 
-/// A lower bound of the first s ∈ [0, 1] at which the primitives of motion touch (+∞: never): the
-/// larger of inclusion_ccd's time of impact (tolerance 10⁻⁶, stopped at line_search_ccd_boxes, so
+/// The most intervals coplanar_free_time looks at for one pair.
+inline constexpr int coplanar_filter_intervals = 200;
+
+/// A time before which the primitives of motion cannot touch because they are never coplanar: the
+/// four points are coplanar where f(t) = det[A, B, C](t) = 0 (point–triangle: A = b − a, B = c − a,
+/// C = p − a; edge–edge: A = a₁ − a₀, B = b₀ − a₀, C = b₁ − a₀), a cubic in t, and touching needs
+/// f = 0. On an interval [t₀, t₁] each column moves linearly, so with τ = (t − t₀)/(t₁ − t₀)
+/// f = Σ_k S_k (1 − τ)^{3−k} τ^k, S_k the sum of the dets with k columns taken at t₁ and 3 − k at t₀:
+/// all S_k > 3ε (or all < −3ε), ε = 10⁻¹² max|x|³ bounding their round-off, and f has no root there.
+/// Intervals bisected depth first from t = 0 down to width 2⁻¹²: returns the start of the first
+/// that is not cleared (or of the one in hand after coplanar_filter_intervals), +∞ when all of
+/// [0, 1] is. Cheap and tight where the inclusion test is not: a pair that starts a few 10⁻⁷ m apart
+/// and slides or parts (a box's corner under a face) cannot be cleared by boxes in (t, u, v) short
+/// of ~10⁵ of them, while its f keeps one sign. docs/14_contact.md#edges-and-corners-of-obstacles
+double coplanar_free_time(PrimitivePair pair, const PrimitiveMotion& motion);
+
+/// A lower bound of the first s ∈ [0, 1] at which the primitives of motion touch (+∞: never): +∞ when
+/// coplanar_free_time clears [0, 1]; else, from its answer s₀ on (the motion restricted to [s₀, 1]),
+/// the larger of inclusion_ccd's time of impact (tolerance 10⁻⁶, stopped at line_search_ccd_boxes, so
 /// that edges moving in one plane cost no more than that) and additive_time_of_impact's, which keeps
-/// the answer above 0 while they are apart, where the first may answer 0 within its tolerance of a
+/// the answer above s₀ while they are apart, where the first may answer 0 within its tolerance of a
 /// contact or at its box limit. fem::Error as inclusion_ccd.
 /// docs/14_contact.md#edges-and-corners-of-obstacles
 double line_search_time_of_impact(PrimitivePair pair, const PrimitiveMotion& motion);

@@ -164,6 +164,25 @@ Eigen::MatrixX2i triangle_edges(const MatrixX3i& triangles)
 
 }  // namespace
 
+std::string first_crossing(const MatrixX3d& x, const SurfacePrimitives& surface, const TriMesh& other)
+{
+    // One array: the body's vertices, then other's, its indices offset by #V.
+    const int n = static_cast<int>(x.rows());
+    MatrixX3d both(x.rows() + other.V.rows(), 3);
+    both << x, other.V;
+    const MatrixX3i other_triangles = (other.F.array() + n).matrix();
+    const Eigen::MatrixX2i other_edges = triangle_edges(other_triangles);
+    const EdgeThroughTriangle body_edge = first_edge_through_triangle(both, surface.edges, other_triangles);
+    if (body_edge.found())
+        return "body " + describe(body_edge, surface.edges, other_triangles);
+    const EdgeThroughTriangle other_edge = first_edge_through_triangle(both, other_edges, surface.triangles);
+    if (other_edge.found()) {
+        const std::string text = describe(other_edge, other_edges, surface.triangles);
+        return text.substr(0, text.find("triangle")) + "body " + text.substr(text.find("triangle"));
+    }
+    return {};
+}
+
 IntersectionCheck::IntersectionCheck(const TetMesh& mesh, const std::vector<std::shared_ptr<const Obstacle>>& obstacles,
                                      bool self_contact)
     : surface_(surface_primitives(mesh)), self_contact_(self_contact)
@@ -187,25 +206,11 @@ void IntersectionCheck::require_none(const MatrixX3d& x, double time) const
         return;
     const Eigen::Vector3d low = x.colwise().minCoeff(), high = x.colwise().maxCoeff();
     const std::array<double, 6> around{low.x(), high.x(), low.y(), high.y(), low.z(), high.z()};
-    const int n = static_cast<int>(x.rows());
     for (const auto& [index, obstacle] : obstacles_) {
-        const TriMesh drawn = obstacle->surface_at(around, time);
-        // One array: the body's vertices, then the obstacle's; the obstacle's indices offset by n.
-        MatrixX3d both(x.rows() + drawn.V.rows(), 3);
-        both << x, drawn.V;
-        const MatrixX3i obstacle_triangles = (drawn.F.array() + n).matrix();
-        const Eigen::MatrixX2i obstacle_edges = triangle_edges(obstacle_triangles);
-        const EdgeThroughTriangle body_edge = first_edge_through_triangle(both, surface_.edges, obstacle_triangles);
-        if (body_edge.found())
-            throw Error(str("intersection check at t = ", time, " s: a body edge through obstacle ", index, " (",
-                            obstacle->name(), "): ", describe(body_edge, surface_.edges, obstacle_triangles),
-                            " (obstacle vertices from ", n, ")"));
-        const EdgeThroughTriangle obstacle_edge = first_edge_through_triangle(both, obstacle_edges, surface_.triangles);
-        if (obstacle_edge.found())
-            throw Error(str("intersection check at t = ", time, " s: an edge of obstacle ", index, " (",
-                            obstacle->name(), ") through the body: ",
-                            describe(obstacle_edge, obstacle_edges, surface_.triangles), " (obstacle vertices from ",
-                            n, ")"));
+        const std::string crossing = first_crossing(x, surface_, obstacle->surface_at(around, time));
+        if (!crossing.empty())
+            throw Error(str("intersection check at t = ", time, " s: obstacle ", index, " (", obstacle->name(),
+                            ") and the body: ", crossing));
     }
 }
 
