@@ -143,7 +143,7 @@ void bodies_study(const RunContext& run)
     scene.material = {1e5, 0.4, 1000.0};
     scene.gravity.setZero();
     scene.time_step = 1.0 / 400.0;
-    const int steps = run.quick ? 4 : 12;
+    const int steps = run.quick ? 4 : 8;
     Eigen::VectorXd v0 = Eigen::VectorXd::Zero(6 * n);
     const Eigen::RowVector3d centre = bunny.V.colwise().mean();
     for (Eigen::Index v = 0; v < 2 * n; ++v) {

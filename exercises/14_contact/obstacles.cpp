@@ -213,7 +213,24 @@ Eigen::Matrix3d Box::local_hessian(const Eigen::Vector3d& p) const
 
 double Box::local_time_of_impact(const Eigen::Vector3d& p, const Eigen::Vector3d& dp) const
 {
-    return conservative_time_of_impact(*this, p, dp);
+    if (!(local_distance(p) > 0.0))
+        return 0.0;
+    // The box is the meet of three slabs |q_i| ≤ h_i (q = Rᵀ(x − c)): the path is inside slab i for
+    // s between the roots of q_i + s w_i = ±h_i, inside the box from the latest entry to the earliest
+    // exit, and it meets the box when that entry comes no later than the exit.
+    const Eigen::Vector3d q = rotation_.transpose() * (p - centre_), w = rotation_.transpose() * dp;
+    double entry = 0.0, exit = infinity;
+    for (int axis = 0; axis < 3; ++axis) {
+        if (w[axis] == 0.0) {
+            if (std::abs(q[axis]) > half_[axis])
+                return infinity;  // parallel to the slab and outside it
+            continue;
+        }
+        const double low = (-half_[axis] - q[axis]) / w[axis], high = (half_[axis] - q[axis]) / w[axis];
+        entry = std::max(entry, std::min(low, high));
+        exit = std::min(exit, std::max(low, high));
+    }
+    return entry <= exit ? entry : infinity;
 }
 
 // --- Conservative advancement ------------------------------------------------------------------------

@@ -21,6 +21,7 @@ contact::ContactOptions contact_options(const SceneSpec& scene, bool self_contac
 {
     contact::ContactOptions options;
     options.self_contact = self_contact;
+    options.body_friction = self_contact ? scene.contact.friction : 0.0;
     options.activation_distance = scene.contact.activation_distance;
     options.friction_velocity = scene.contact.friction_velocity;
     return options;

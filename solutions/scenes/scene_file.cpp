@@ -200,16 +200,20 @@ void read_bodies(const Fields& top, SceneSpec& scene)
     }
 }
 
-/// [contact]: the barrier's activation distance d̂, the friction's ε_v and whether bodies meet.
+/// [contact]: the barrier's activation distance d̂, the friction's ε_v, whether bodies meet and the
+/// friction between them.
 void read_contact(const Fields& top, SceneSpec& scene)
 {
     const toml::table* contact_table = top.subtable("contact");
     if (contact_table == nullptr)
         return;
-    const Fields c(*contact_table, "contact", top.source(), {"activation_distance", "friction_velocity", "bodies"});
+    const Fields c(*contact_table, "contact", top.source(),
+                   {"activation_distance", "friction_velocity", "bodies", "friction"});
     scene.contact.activation_distance = c.positive("activation_distance", scene.contact.activation_distance);
     scene.contact.friction_velocity = c.positive("friction_velocity", scene.contact.friction_velocity);
     scene.contact.bodies = c.flag("bodies", scene.contact.bodies);
+    scene.contact.friction =
+        c.number("friction", scene.contact.friction, [](double mu) { return mu >= 0.0 && mu <= 10.0; }, "a number in [0, 10]");
 }
 
 /// With obstacles, the contact constants and gravity against the size D of the smallest body (the
@@ -218,9 +222,19 @@ void read_contact(const Fields& top, SceneSpec& scene)
 /// at the round-off of the positions, a larger one puts every body in contact with every obstacle
 /// from the start); ε_v Δt ≥ 10⁻¹⁰ D (the sticking creep ε_v Δt, friction's stiffness ~1/(ε_v Δt),
 /// above the round-off of a position); |g| Δt² ≤ D (from rest, gravity moves a body at most its own
-/// size in one step, which the collision-free line search can still cut). docs/scenes.md#obstacles
+/// size in one step, which the collision-free line search can still cut); and friction between
+/// bodies only where bodies meet. docs/scenes.md#obstacles
 void check_contact_scales(const Fields& top, const SceneSpec& scene)
 {
+    const bool between_bodies = (scene.contact.bodies && scene.bodies.size() >= 2) ||
+                                std::any_of(scene.bodies.begin(), scene.bodies.end(), [](const BodySpec& b) { return b.self_contact; });
+    if (scene.contact.friction > 0.0 && !between_bodies) {  // a setting never silently ignored
+        const toml::table* given = top.subtable("contact");
+        Fields(*given, "contact", top.source(), {})
+            .fail(*given->get("friction"), "friction",
+                  "friction between bodies needs bodies that meet: [contact] bodies = true with two or more bodies, "
+                  "or a body's self_contact = true");
+    }
     if (!has_contact(scene))
         return;
     double size = std::numeric_limits<double>::infinity();

@@ -319,3 +319,31 @@ TEST_CASE("bodies stepped apart that come within d-hat all the same stop the run
     CHECK_THROWS_WITH(run_positions(scene), Catch::Contains("bodies 'bar' and 'block'") &&
                                                 Catch::Contains("stepped as separate solves"));
 }
+
+TEST_CASE("friction between bodies reaches the solve: a block sliding on a slab resting on the floor stops with "
+          "contact.friction, slides on without", "[scenes][bodies]")
+{
+    // A 5 cm block 2 mm above a 30 cm slab that rests 2 mm above a rough floor (μ = 1, which holds the
+    // slab), the block sliding at 0.5 m/s; μ = 0.5 between the bodies stops it in v/(μg) ≈ 0.1 s.
+    const auto scene_with = [](double friction) {
+        return testing::scene_from(
+            str("rub_", friction),
+            str("title = \"rub\"\n[[body]]\nname = \"slab\"\nmesh = { generator = \"box\", size = [0.3, 0.3, 0.05], "
+                "cells = [3, 3, 1], translate = [-0.15, -0.15, 0.002] }\n",
+                rubber, "\n[[body]]\nname = \"block\"\nmesh = { generator = \"box\", size = [0.05, 0.05, 0.05], "
+                "cells = [1, 1, 1], translate = [-0.1, -0.025, 0.054] }\n",
+                rubber, "\ninitial_velocity = [0.5, 0.0, 0.0]\n[[obstacle]]\ntype = \"half-space\"\nfriction = 1.0\n",
+                "[time]\nstep = 0.01\nduration = 0.2\n[contact]\nbodies = true\nfriction = ", friction, "\n",
+                "[output]\npvd = false\npng = false\ncsv = false\ncharts = false\nvideo = \"none\"\nframe_rate = 100\n"));
+    };
+    const auto final_speed = [](const SceneSpec& scene) {
+        const RunResult run = run_positions(scene);
+        const std::vector<MatrixX3d>& block = run.frames[1];
+        const std::size_t last = block.size() - 1;
+        return ((block[last] - block[last - 1]).colwise().mean() / 0.01).x();
+    };
+    const double sliding = final_speed(scene_with(0.0)), rubbed = final_speed(scene_with(0.5));
+    INFO("final speed of the block: " << sliding << " m/s without friction, " << rubbed << " m/s with mu = 0.5");
+    CHECK(sliding > 0.45);
+    CHECK(std::abs(rubbed) < 0.05);
+}
