@@ -55,6 +55,11 @@ struct ContactOptions {
     /// self_contact: lagged friction on its point–triangle and edge–edge pairs (BodyFriction); 0: none.
     /// docs/14_contact.md#friction-between-bodies
     double body_friction = 0.0;
+    /// With self_contact, several bodies in one mesh: the body of each vertex (#V entries; empty:
+    /// one body) and per body whether its own surface holds itself off (empty: every body's does);
+    /// two bodies always hold each other off (SelfContactBarrier).
+    std::vector<int> vertex_body;
+    std::vector<bool> body_self_contact;
     /// A debug check: at every configuration the energy is asked of (each Newton iterate and each
     /// line-search trial), no body edge meets a triangle of an obstacle with edges (a box, a mesh), no
     /// such obstacle's edge a body triangle, and, with self_contact, no body edge a body triangle

@@ -42,9 +42,13 @@ struct SurfacePair {
 /// The barrier of the header between the surface primitives of one mesh.
 class SelfContactBarrier {
 public:
-    /// The surface primitives of mesh (surface_primitives); d̂ > 0 [m]. fem::Error for d̂ not a
-    /// finite number > 0.
-    SelfContactBarrier(const TetMesh& mesh, double activation_distance);
+    /// The surface primitives of mesh (surface_primitives); d̂ > 0 [m]. vertex_body: the body each
+    /// vertex belongs to (#V entries; empty: the mesh is one body); body_self_contact: per body
+    /// whether its own primitives hold each other off (empty: every body's do). A pair of two
+    /// different bodies always counts. fem::Error for d̂ not a finite number > 0, a vertex_body of
+    /// another size than #V, or a body without an entry in body_self_contact.
+    SelfContactBarrier(const TetMesh& mesh, double activation_distance, std::vector<int> vertex_body = {},
+                       std::vector<bool> body_self_contact = {});
 
     /// The primitives it pairs.
     const SurfacePrimitives& surface() const { return surface_; }
@@ -79,9 +83,14 @@ private:
     /// x (#V×3) moved by u (3n, vertex-major); fem::Error naming what when u's size is not 3n.
     MatrixX3d moved(const MatrixX3d& x, const Eigen::VectorXd& u, const char* what) const;
 
+    /// candidates without the pairs inside one body that does not hold itself off.
+    CandidatePairs kept(CandidatePairs candidates) const;
+
     MatrixX3d rest_;
     double activation_distance_;
     SurfacePrimitives surface_;
+    std::vector<int> vertex_body_;
+    std::vector<bool> body_self_contact_;
 };
 
 }  // namespace fem::contact

@@ -48,11 +48,13 @@ public:
     /// one solve, scene_group.hpp), each raised to Level::corotational for a contact step taken at
     /// Level::linear (header comment). The contact potential is built for body against obstacles
     /// with the scene's d̂ and ε_v (κ adaptive), with self_contact its surface against itself too (the
-    /// bodies of a group against each other, a body against itself), Newton with the scene's solver
-    /// and tolerance. fem::Error as ContactPotential.
+    /// bodies of a group against each other, and each member whose self_contacts entry is true — one
+    /// a member, in order — against itself; vertex_body: the member of each vertex), with the scene's
+    /// friction between bodies, Newton with the scene's solver and tolerance. fem::Error as
+    /// ContactPotential.
     ContactIntegrator(dynamics::Integrator& own, std::vector<SceneForces*> levels, const dynamics::Body& body,
                       std::vector<std::shared_ptr<const contact::Obstacle>> obstacles, const SceneSpec& scene,
-                      bool self_contact = false);
+                      bool self_contact = false, std::vector<int> vertex_body = {}, std::vector<bool> self_contacts = {});
 
     std::string name() const override { return last_contact_ ? newton_.name() + " with contact" : own_.name(); }
     int order() const override { return 1; }

@@ -86,7 +86,8 @@ ContactPotential::ContactPotential(const dynamics::Body& body, std::vector<std::
     if (options_.check_intersections)
         check_ = std::make_unique<IntersectionCheck>(body.mesh(), obstacles_, options_.self_contact);
     if (options_.self_contact) {
-        self_ = std::make_unique<SelfContactBarrier>(body.mesh(), options_.activation_distance);
+        self_ = std::make_unique<SelfContactBarrier>(body.mesh(), options_.activation_distance, options_.vertex_body,
+                                                     options_.body_self_contact);
         const double at_rest =
             self_->smallest_distance(Eigen::VectorXd::Zero(3 * rest_.rows()), options_.activation_distance);
         if (at_rest < options_.activation_distance)

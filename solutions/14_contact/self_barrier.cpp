@@ -21,10 +21,39 @@ constexpr double infinity = std::numeric_limits<double>::infinity();
 
 }  // namespace
 
-SelfContactBarrier::SelfContactBarrier(const TetMesh& mesh, double activation_distance)
-    : rest_(mesh.V), activation_distance_(activation_distance), surface_(surface_primitives(mesh))
+SelfContactBarrier::SelfContactBarrier(const TetMesh& mesh, double activation_distance, std::vector<int> vertex_body,
+                                       std::vector<bool> body_self_contact)
+    : rest_(mesh.V),
+      activation_distance_(activation_distance),
+      surface_(surface_primitives(mesh)),
+      vertex_body_(std::move(vertex_body)),
+      body_self_contact_(std::move(body_self_contact))
 {
     require_positive(activation_distance, "self-contact activation distance d̂ [m]");
+    if (!vertex_body_.empty() && static_cast<Eigen::Index>(vertex_body_.size()) != mesh.V.rows())
+        throw Error(str("self-contact: ", vertex_body_.size(), " vertex bodies for ", mesh.V.rows(), " vertices"));
+    if (!body_self_contact_.empty())
+        for (int body : vertex_body_)
+            if (body < 0 || body >= static_cast<int>(body_self_contact_.size()))
+                throw Error(str("self-contact: body ", body, " of a vertex has no self-contact setting (",
+                                body_self_contact_.size(), " given)"));
+}
+
+CandidatePairs SelfContactBarrier::kept(CandidatePairs candidates) const
+{
+    if (vertex_body_.empty() || body_self_contact_.empty())
+        return candidates;
+    const auto apart = [&](int a, int b) {  // two bodies, or one that holds itself off
+        const int body = vertex_body_[std::size_t(a)];
+        return body != vertex_body_[std::size_t(b)] || body_self_contact_[std::size_t(body)];
+    };
+    std::erase_if(candidates.point_triangle, [&](const std::array<int, 2>& pair) {
+        return !apart(pair[0], surface_.triangles(pair[1], 0));
+    });
+    std::erase_if(candidates.edge_edge, [&](const std::array<int, 2>& pair) {
+        return !apart(surface_.edges(pair[0], 0), surface_.edges(pair[1], 0));
+    });
+    return candidates;
 }
 
 MatrixX3d SelfContactBarrier::moved(const MatrixX3d& x, const Eigen::VectorXd& u, const char* what) const
@@ -44,7 +73,7 @@ bool SelfContactBarrier::for_each_pair(const Eigen::VectorXd& u, double reach, b
     const MatrixX3d x = moved(rest_, u, "the displacement u");
     const auto at = [&](int v) -> Eigen::Vector3d { return x.row(v).transpose(); };
     const auto rest = [&](int v) -> Eigen::Vector3d { return rest_.row(v).transpose(); };
-    const CandidatePairs candidates = tree_candidates(surface_, x, x, reach);
+    const CandidatePairs candidates = kept(tree_candidates(surface_, x, x, reach));
     SurfacePair pair;
     const auto offer = [&](const PrimitiveFunction& squared, const PrimitiveFunction& mollifier) {
         if (!(squared.value < reach * reach))
@@ -136,7 +165,7 @@ double SelfContactBarrier::time_of_impact(const Eigen::VectorXd& u, const Eigen:
 {
     const MatrixX3d x0 = moved(rest_, u, "the displacement u");
     const MatrixX3d x1 = moved(x0, du, "the step du");
-    const CandidatePairs candidates = tree_candidates(surface_, x0, x1, 0.0);
+    const CandidatePairs candidates = kept(tree_candidates(surface_, x0, x1, 0.0));
     double earliest = infinity;
     PrimitiveMotion motion;
     const auto add = [&](PrimitivePair kind, const int (&v)[4]) {

@@ -231,8 +231,19 @@ std::unique_ptr<GroupRun> start_group(std::vector<BodyRun>& bodies, const std::v
                             "body at rest far from where it started is round-off; docs/scenes.md#obstacles): use auto, "
                             "corotational or a hyperelastic model"));
     g->integrator = std::make_unique<LevelIntegrator>(std::vector<const SceneForces*>(levels.begin(), levels.end()), scene);
-    if (!obstacles.empty() || self_contact)
-        g->contact = std::make_unique<ContactIntegrator>(*g->integrator, levels, *g->body, obstacles, scene, self_contact);
+    if (!obstacles.empty() || self_contact) {
+        // In a group: the member of each vertex, and which members hold themselves off.
+        std::vector<int> vertex_body;
+        std::vector<bool> self_contacts;
+        if (joined)
+            for (std::size_t m = 0; m < g->members.size(); ++m) {
+                vertex_body.insert(vertex_body.end(), static_cast<std::size_t>(g->members[m]->spec->mesh.V.rows()),
+                                   static_cast<int>(m));
+                self_contacts.push_back(g->members[m]->spec->self_contact);
+            }
+        g->contact = std::make_unique<ContactIntegrator>(*g->integrator, levels, *g->body, obstacles, scene, self_contact,
+                                                         std::move(vertex_body), std::move(self_contacts));
+    }
     std::vector<SceneConditions> conditions;
     for (BodyRun* b : g->members) {
         conditions.emplace_back(*b->spec, scene, b->forces, b->automatic, g->contact.get(), b->pull);

@@ -17,10 +17,13 @@ std::vector<std::shared_ptr<const contact::Obstacle>> scene_obstacles(const Scen
 
 namespace {
 
-contact::ContactOptions contact_options(const SceneSpec& scene, bool self_contact)
+contact::ContactOptions contact_options(const SceneSpec& scene, bool self_contact, std::vector<int> vertex_body,
+                                        std::vector<bool> self_contacts)
 {
     contact::ContactOptions options;
     options.self_contact = self_contact;
+    options.vertex_body = std::move(vertex_body);
+    options.body_self_contact = std::move(self_contacts);
     options.body_friction = self_contact ? scene.contact.friction : 0.0;
     options.activation_distance = scene.contact.activation_distance;
     options.friction_velocity = scene.contact.friction_velocity;
@@ -40,11 +43,13 @@ hyper::NewtonOptions contact_newton_options(const SceneSpec& scene)
 ContactIntegrator::ContactIntegrator(dynamics::Integrator& own, std::vector<SceneForces*> levels,
                                      const dynamics::Body& body,
                                      std::vector<std::shared_ptr<const contact::Obstacle>> obstacles,
-                                     const SceneSpec& scene, bool self_contact)
+                                     const SceneSpec& scene, bool self_contact, std::vector<int> vertex_body,
+                                     std::vector<bool> self_contacts)
     : own_(own),
       levels_(std::move(levels)),
-      potential_(std::make_unique<contact::ContactPotential>(body, std::move(obstacles),
-                                                             contact_options(scene, self_contact))),
+      potential_(std::make_unique<contact::ContactPotential>(
+          body, std::move(obstacles),
+          contact_options(scene, self_contact, std::move(vertex_body), std::move(self_contacts)))),
       newton_(contact_newton_options(scene))
 {
     newton_.set_potential(potential_.get());

@@ -342,3 +342,44 @@ TEST_CASE("self-contact's time of impact: never after the first contact, never f
         CHECK(barrier.time_of_impact(u, -du) > 1.0);
     }
 }
+
+TEST_CASE("self-contact per body: two bodies always hold each other off, a body its own pairs only when asked",
+          "[self][ex14.9]")
+{
+    // Body 0: a block of 2×2×2 cells of 5 cm, whose own primitives come within 6 cm of each other
+    // (d̂ = 6 cm reaches across a cell); body 1: a one-cell block 10 cm away, whose own don't.
+    const TetMesh block = box_at(Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(0.1), 2);
+    const TetMesh far = box_at(Eigen::Vector3d(0.2, 0.0, 0.0), Eigen::Vector3d::Constant(0.1), 1);
+    const TetMesh mesh = two_bodies(block, far);
+    std::vector<int> vertex_body(static_cast<std::size_t>(mesh.V.rows()), 1);
+    std::fill(vertex_body.begin(), vertex_body.begin() + block.V.rows(), 0);
+    const Eigen::VectorXd rest = Eigen::VectorXd::Zero(3 * mesh.V.rows());
+    const double dhat = 0.06;
+    const SelfContactBarrier both(mesh, dhat, vertex_body, {true, true}), between(mesh, dhat, vertex_body, {false, false});
+    // With its own pairs, body 0 is closer than d̂ to itself at rest; without them nothing is within
+    // reach (the bodies are 10 cm apart).
+    CHECK(both.smallest_distance(rest, dhat) < dhat);
+    CHECK(between.smallest_distance(rest, dhat) == std::numeric_limits<double>::infinity());
+    // Moved to 4 cm apart, the bodies' pairs count either way.
+    Eigen::VectorXd closer = rest;
+    for (Eigen::Index v = block.V.rows(); v < mesh.V.rows(); ++v)
+        closer[3 * v] = -0.06;
+    CHECK(std::abs(between.smallest_distance(closer, dhat) - 0.04) < 1e-12);
+    for (const SurfacePair& pair : between.pairs(closer, false))
+        CHECK(vertex_body[std::size_t(pair.vertices[0])] != vertex_body[std::size_t(pair.vertices[3])]);
+    // Through the contact potential: a body's own pairs closer than d̂ at rest are refused only when it
+    // holds itself off.
+    dynamics::Scene scene = test::free_scene(mesh);
+    const dynamics::Body body(scene);
+    const std::vector<std::shared_ptr<const Obstacle>> none;
+    ContactOptions options;
+    options.self_contact = true;
+    options.activation_distance = dhat;
+    options.vertex_body = vertex_body;
+    options.body_self_contact = {false, false};
+    CHECK_NOTHROW(ContactPotential(body, none, options));
+    options.body_self_contact = {true, false};
+    CHECK_THROWS_WITH(ContactPotential(body, none, options), Catch::Contains("closer than d̂"));
+    options.body_self_contact = {true};
+    CHECK_THROWS_WITH(ContactPotential(body, none, options), Catch::Contains("no self-contact setting"));
+}
