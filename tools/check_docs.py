@@ -22,7 +22,10 @@ Checks:
      iteration counts within one, a "[±X]" column within X);
   5. every image the page shows exists.
 
---update reruns the executable, rewrites the tables and copies the figures named by
+The check runs the executable with --no-figures: it compares numbers, and the figures are drawn by
+the chapter's quick run (chNN_quick_run) and checked by figures_current; drawing them at full size
+here took about a third of each run's time. --update reruns the executable with its figures,
+rewrites the tables and copies the figures named by
 <!-- fem:figure NAME.png --> into docs/figures/NN_name/, a chart's NAME.svg beside its PNG (run it
 under xvfb-run -a). It never
 rewrites a quoted number: a sentence around a number that changed needs a person, so --update
@@ -210,7 +213,7 @@ def check_exercises(text, root, chapter):
     return problems
 
 
-def run_executable(text, bin_dir, out, root):
+def run_executable(text, bin_dir, out, root, figures):
     match = RUN.search(text)
     if not match:
         return None, ["the page has tables but no <!-- fem:run chNN_name [args] --> line"]
@@ -219,6 +222,8 @@ def run_executable(text, bin_dir, out, root):
     # {root} in the arguments stands for the project's folder (e.g. the scene files of docs/scenes.md).
     arguments = match["args"].replace("{root}", str(root)).split()
     command = [str(bin_dir / match["exe"]), *arguments, "--out", str(out)]
+    if not figures:
+        command.append("--no-figures")
     result = subprocess.run(command, capture_output=True, text=True, timeout=3000)
     if result.returncode != 0:
         return None, [f"`{' '.join(command)}` failed ({result.returncode}):\n{result.stdout}{result.stderr}"]
@@ -293,7 +298,7 @@ def main():
         if not (args.bin and args.out):
             problems.append("--bin and --out are needed to check the tables and quoted numbers")
         else:
-            out, run_problems = run_executable(text, args.bin, args.out, args.root)
+            out, run_problems = run_executable(text, args.bin, args.out, args.root, figures=args.update)
             problems += run_problems
             if out and args.update:
                 update(doc, text, out, args.root, args.chapter)
