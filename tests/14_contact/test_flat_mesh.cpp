@@ -1,0 +1,249 @@
+// Chapter 14: a flat region of a mesh obstacle holds a body as a plane does — over it a point feels
+// one barrier, the plane's, with no lateral push from the triangles next to the one it stands over;
+// the barriers' sum stays continuous across flat edges, over flat corners and round the region's
+// border; a block at rest on a flat mesh floor stays where it stands, as on the half-space, and one
+// that sticks to a tilted one creeps as on the half-space. docs/14_contact.md#mesh-obstacles
+#include "14_contact/barrier.hpp"
+#include "14_contact/contact_scenes.hpp"
+#include "14_contact/mesh_obstacle.hpp"
+#include "14_contact/obstacles.hpp"
+#include "slope_creep.hpp"
+
+#include "common/mesh.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <numbers>
+#include <vector>
+
+using namespace fem;
+using namespace fem::contact;
+
+namespace {
+
+constexpr double degree = std::numbers::pi / 180.0;
+
+/// The plane z = 0 as a mesh: square_mesh(cells, jitter) scaled to side × side, turned by `angle`
+/// about z and its corner (0, 0) moved to `corner` [m].
+TriMesh flat_floor(int cells, double jitter, double side, double angle, const Eigen::Vector2d& corner)
+{
+    TriMesh floor = square_mesh(cells, jitter);
+    const Eigen::Matrix2d turn = Eigen::Rotation2Dd(angle).toRotationMatrix();
+    for (Eigen::Index v = 0; v < floor.V.rows(); ++v)
+        floor.V.row(v).head<2>() = (turn * (side * floor.V.row(v).head<2>().transpose()) + corner).transpose();
+    return floor;
+}
+
+/// The barrier κ Σ b(dᵢ) over the pieces a point p sees within d̂, with its gradient and Hessian
+/// from the pieces' (Σ κ b'ᵢ gᵢ, Σ κ (b''ᵢ gᵢ gᵢᵀ + b'ᵢ Hᵢ)), and how many pieces there are.
+struct PointBarrier {
+    double energy = 0.0;
+    Eigen::Vector3d gradient = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d hessian = Eigen::Matrix3d::Zero();
+    int pieces = 0;
+};
+
+constexpr double dhat = 1e-3, kappa = 1e4;
+
+PointBarrier point_barrier(const Obstacle& obstacle, const Eigen::Vector3d& p)
+{
+    std::vector<DistancePiece> pieces;
+    obstacle.local_pieces(p, dhat, pieces);
+    PointBarrier sum;
+    sum.pieces = static_cast<int>(pieces.size());
+    for (const DistancePiece& piece : pieces) {
+        const BarrierValue b = barrier(piece.distance, dhat);
+        sum.energy += kappa * b.value;
+        sum.gradient += kappa * b.first * piece.gradient;
+        sum.hessian += kappa * (b.second * piece.gradient * piece.gradient.transpose() + b.first * piece.hessian);
+    }
+    return sum;
+}
+
+/// The most the energy changes between two neighbouring points of a path, over what the larger of
+/// their gradients allows along the step (a continuous energy stays near or below 1; a barrier
+/// counted twice or dropped on one side of a line jumps by b(d), many times that).
+double worst_jump(const Obstacle& obstacle, const std::vector<Eigen::Vector3d>& path)
+{
+    double worst = 0.0;
+    PointBarrier last = point_barrier(obstacle, path[0]);
+    for (std::size_t k = 1; k < path.size(); ++k) {
+        const PointBarrier next = point_barrier(obstacle, path[k]);
+        const double allowed = (path[k] - path[k - 1]).norm() * std::max(last.gradient.norm(), next.gradient.norm());
+        worst = std::max(worst, std::abs(next.energy - last.energy) / (allowed + 1e-12 * kappa));
+        last = next;
+    }
+    return worst;
+}
+
+/// A straight path of n + 1 points from a to b.
+std::vector<Eigen::Vector3d> segment_path(const Eigen::Vector3d& a, const Eigen::Vector3d& b, int n)
+{
+    std::vector<Eigen::Vector3d> path;
+    for (int k = 0; k <= n; ++k)
+        path.push_back(a + (b - a) * (double(k) / n));
+    return path;
+}
+
+/// The 1 m floor of 200 jittered triangles (some obtuse) turned by 17°, and one of its interior
+/// vertices (of index 5 + 11·5, the grid's middle).
+struct JitteredFloor {
+    MeshObstacle mesh{flat_floor(10, 0.2, 1.0, 17.0 * degree, Eigen::Vector2d(-0.43, -0.38))};
+    Eigen::Vector3d middle = mesh.surface().V.row(5 + 11 * 5).transpose();
+};
+
+}  // namespace
+
+TEST_CASE("flat mesh: over a flat edge and a flat vertex a point feels the plane's one barrier, continuous and with "
+          "derivatives that central differences confirm")
+{
+    const JitteredFloor floor;
+    const HalfSpace plane(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ());
+    const TriMesh& s = floor.mesh.surface();
+    const double height = 4e-4;
+    const Eigen::Vector3d up = height * Eigen::Vector3d::UnitZ();
+    // Paths across an edge at the middle vertex (through its midpoint, then exactly through its
+    // end), through the vertex and passing it by 10⁻⁵ m; each from 2 mm before to 2 mm past.
+    std::vector<std::vector<Eigen::Vector3d>> paths;
+    for (Eigen::Index f = 0; f < s.F.rows(); ++f)
+        for (int i = 0; i < 3; ++i)
+            if (s.F(f, i) == 5 + 11 * 5 && paths.size() < 6) {
+                const Eigen::Vector3d a = floor.middle, b = s.V.row(s.F(f, (i + 1) % 3)).transpose();
+                const Eigen::Vector3d across = Eigen::Vector3d::UnitZ().cross(b - a).normalized();
+                const Eigen::Vector3d mid = 0.5 * (a + b) + up;
+                paths.push_back(segment_path(mid - 2e-3 * across, mid + 2e-3 * across, 4000));
+                paths.push_back(segment_path(a + up - 2e-3 * across, a + up + 2e-3 * across, 4000));
+                const Eigen::Vector3d by = 1e-5 * (b - a).normalized();
+                paths.push_back(segment_path(a + up + by - 2e-3 * across, a + up + by + 2e-3 * across, 4000));
+            }
+    REQUIRE(paths.size() == 6);
+    for (const std::vector<Eigen::Vector3d>& path : paths) {
+        for (const Eigen::Vector3d& p : path) {
+            const PointBarrier mesh = point_barrier(floor.mesh, p), half = point_barrier(plane, p);
+            INFO("at " << p.transpose() << ": " << mesh.pieces << " pieces");
+            REQUIRE(mesh.pieces == 1);
+            REQUIRE(std::abs(mesh.energy - half.energy) <= 1e-12 * half.energy);
+            REQUIRE((mesh.gradient - half.gradient).norm() <= 1e-12 * half.gradient.norm());
+        }
+        CHECK(worst_jump(floor.mesh, path) <= 1.01);
+    }
+
+    // Central differences of the pieces' sum at points near the flat edges and vertices, some over
+    // the floor and some off its border, within d̂ of it.
+    int checked = 0;
+    for (unsigned seed = 1; seed <= 400; ++seed) {
+        const Eigen::Index f = static_cast<Eigen::Index>(seed * 7919u % s.F.rows());
+        const Eigen::Vector3d a = s.V.row(s.F(f, 0)), b = s.V.row(s.F(f, 1));
+        const double t = (seed % 3 == 0) ? 0.0 : 0.37 * (seed % 5) / 4.0;  // a corner or along the edge
+        const Eigen::Vector3d p = a + t * (b - a) + 1e-3 * Eigen::Vector3d(std::cos(seed * 2.1), std::sin(seed * 2.1), 0.0) * 0.6 +
+                                  Eigen::Vector3d(0.0, 0.0, 3e-4 + 1e-4 * (seed % 4));
+        const PointBarrier at = point_barrier(floor.mesh, p);
+        if (at.pieces == 0)
+            continue;
+        const double h = 1e-8;
+        Eigen::Vector3d energy_fd;
+        Eigen::Matrix3d hessian_fd;
+        for (int i = 0; i < 3; ++i) {
+            const Eigen::Vector3d e = h * Eigen::Vector3d::Unit(i);
+            const PointBarrier plus = point_barrier(floor.mesh, p + e), minus = point_barrier(floor.mesh, p - e);
+            energy_fd[i] = (plus.energy - minus.energy) / (2.0 * h);
+            hessian_fd.col(i) = (plus.gradient - minus.gradient) / (2.0 * h);
+        }
+        INFO("seed " << seed << " at " << p.transpose() << ", " << at.pieces << " pieces");
+        CHECK((at.gradient - energy_fd).norm() <= 1e-6 * at.gradient.norm());
+        CHECK((at.hessian - hessian_fd).norm() <= 1e-5 * (1.0 + at.hessian.norm()));
+        ++checked;
+    }
+    CHECK(checked > 300);
+}
+
+TEST_CASE("flat mesh: round a corner of the floor's border and along its edges the barriers' sum stays continuous")
+{
+    const JitteredFloor floor;
+    const TriMesh& s = floor.mesh.surface();
+    // A circle of radius 0.5 mm, 0.2 mm up, round each corner of the square (one triangle there, or
+    // two meeting at a flat edge), and one round a border vertex between two corners.
+    for (const int vertex : {0, 10, 120, 110, 5}) {
+        const Eigen::Vector3d centre = s.V.row(vertex).transpose() + 2e-4 * Eigen::Vector3d::UnitZ();
+        std::vector<Eigen::Vector3d> circle;
+        for (int k = 0; k <= 20000; ++k) {
+            const double phi = 2.0 * std::numbers::pi * k / 20000.0;
+            circle.push_back(centre + 5e-4 * Eigen::Vector3d(std::cos(phi), std::sin(phi), 0.0));
+        }
+        INFO("round vertex " << vertex);
+        CHECK(worst_jump(floor.mesh, circle) <= 1.01);
+    }
+}
+
+TEST_CASE("flat mesh: a block at rest on a floor of 2 or 200 triangles stays where it stands, as on the half-space")
+{
+    BlockSettings settings;
+    settings.time_step = 1.0 / 100.0;
+    const int steps = 200;  // 2 s
+    Eigen::VectorXd masses;  // per degree of freedom
+    const auto run = [&](const std::shared_ptr<const Obstacle>& floor) {
+        BlockSettings these = settings;
+        if (floor)
+            these.obstacles = {floor};
+        BlockScene block = block_scene(these);
+        masses = block.body->dof_masses();
+        std::vector<Eigen::VectorXd> states;
+        for (int step = 0; step < steps; ++step) {
+            block.step();
+            states.push_back(block.state.u);
+        }
+        return states;
+    };
+    const std::vector<Eigen::VectorXd> half = run(nullptr);
+    // Two triangles whose diagonal passes 0.36 mm beside the block's corner (0, 0); 200 jittered ones
+    // turned by 17° (some of their edges and corners under the block's).
+    const double diagonal = 50.0 * degree;
+    const std::vector<std::shared_ptr<const Obstacle>> floors{
+        std::make_shared<MeshObstacle>(flat_floor(1, 0.0, 1.2, diagonal - 45.0 * degree,
+                                                  Eigen::Vector2d(3e-4, -2e-4) - 0.6 * Eigen::Vector2d(std::cos(diagonal), std::sin(diagonal)))),
+        std::make_shared<MeshObstacle>(JitteredFloor().mesh)};
+    for (const auto& floor : floors) {
+        const std::vector<Eigen::VectorXd> states = run(floor);
+        // Horizontally: each vertex from where the half-space's run has it (the block spreads a little
+        // under its weight, as Poisson says, on both), and the centre of mass from its start (no
+        // horizontal force, no horizontal momentum).
+        double apart = 0.0, drift = 0.0;
+        for (int step = 0; step < steps; ++step) {
+            Eigen::Vector2d moment = Eigen::Vector2d::Zero();
+            for (Eigen::Index v = 0; v < states[step].size() / 3; ++v) {
+                apart = std::max(apart, (states[step] - half[step]).segment<2>(3 * v).norm());
+                moment += masses[3 * v] * states[step].segment<2>(3 * v);
+            }
+            drift = std::max(drift, moment.norm() / (masses.sum() / 3.0));
+        }
+        INFO(floor->name() << " of " << dynamic_cast<const MeshObstacle&>(*floor).surface().F.rows()
+                           << " triangles: the vertices at most " << apart << " m from the half-space's, the centre "
+                           << "of mass " << drift << " m from the start");
+        CHECK(apart <= 1e-9);
+        CHECK(drift <= 1e-9);
+    }
+}
+
+TEST_CASE("flat mesh: a block sticking to a tilted floor of 1 m or 10 m of triangles creeps as on the half-space")
+{
+    BlockSettings settings;
+    settings.slope = 20.0 * degree;
+    settings.friction = 0.5;
+    settings.height = 0.5 * settings.contact.activation_distance;
+    const int steps = 40;
+    const double half = test::slope_creep(settings, steps).last;
+    for (const auto& [side, cells] : std::vector<std::pair<double, int>>{{1.0, 10}, {10.0, 40}}) {
+        BlockSettings on_mesh = settings;
+        on_mesh.obstacles = {std::make_shared<MeshObstacle>(
+            flat_floor(cells, 0.2, side, 17.0 * degree, Eigen::Vector2d(-0.43, -0.38) * side), settings.friction)};
+        const double creep = test::slope_creep(on_mesh, steps).last;
+        INFO(side << " m of " << 2 * cells * cells << " triangles: creep " << creep << " m a step, on the half-space "
+                  << half << " m, closed form " << test::expected_creep(settings) << " m");
+        CHECK(std::abs(creep - half) <= 0.01 * half);
+    }
+}
