@@ -29,15 +29,26 @@ namespace {
 constexpr double degree = std::numbers::pi / 180.0;
 
 /// The plane z = 0 as a mesh: square_mesh(cells, jitter) scaled to side × side, turned by `angle`
-/// about z and its corner (0, 0) moved to `corner` [m].
-TriMesh flat_floor(int cells, double jitter, double side, double angle, const Eigen::Vector2d& corner)
+/// about z and moved so that its vertex `vertex` stands at `at` [m].
+TriMesh flat_floor(int cells, double jitter, double side, double angle, int vertex, const Eigen::Vector2d& at)
 {
     TriMesh floor = square_mesh(cells, jitter);
-    const Eigen::Matrix2d turn = Eigen::Rotation2Dd(angle).toRotationMatrix();
+    const Eigen::Matrix2d turn = side * Eigen::Rotation2Dd(angle).toRotationMatrix();
+    const Eigen::Vector2d shift = at - turn * floor.V.row(vertex).head<2>().transpose();
     for (Eigen::Index v = 0; v < floor.V.rows(); ++v)
-        floor.V.row(v).head<2>() = (turn * (side * floor.V.row(v).head<2>().transpose()) + corner).transpose();
+        floor.V.row(v).head<2>() = (turn * floor.V.row(v).head<2>().transpose() + shift).transpose();
     return floor;
 }
+
+/// The middle vertex of square_mesh(cells) (cells even).
+int middle_vertex(int cells)
+{
+    return cells / 2 * (cells + 2);
+}
+
+/// Where the flat floors put a vertex: 0.36 mm beside the corner (0.1, 0.1) of the block's base
+/// (BlockSettings' 0.1 m cube at the corner (0, 0)), within d̂ of it [m].
+const Eigen::Vector2d beside_block(0.1 + 3e-4, 0.1 - 2e-4);
 
 /// The barrier κ Σ b(dᵢ) over the pieces a point p sees within d̂, with its gradient and Hessian
 /// from the pieces' (Σ κ b'ᵢ gᵢ, Σ κ (b''ᵢ gᵢ gᵢᵀ + b'ᵢ Hᵢ)), and how many pieces there are.
@@ -90,11 +101,11 @@ std::vector<Eigen::Vector3d> segment_path(const Eigen::Vector3d& a, const Eigen:
     return path;
 }
 
-/// The 1 m floor of 200 jittered triangles (some obtuse) turned by 17°, and one of its interior
-/// vertices (of index 5 + 11·5, the grid's middle).
+/// The 1 m floor of 200 jittered triangles (some obtuse) turned by 17°, its middle vertex beside
+/// the block's corner.
 struct JitteredFloor {
-    MeshObstacle mesh{flat_floor(10, 0.2, 1.0, 17.0 * degree, Eigen::Vector2d(-0.43, -0.38))};
-    Eigen::Vector3d middle = mesh.surface().V.row(5 + 11 * 5).transpose();
+    MeshObstacle mesh{flat_floor(10, 0.2, 1.0, 17.0 * degree, middle_vertex(10), beside_block)};
+    Eigen::Vector3d middle = mesh.surface().V.row(middle_vertex(10)).transpose();
 };
 
 }  // namespace
@@ -112,7 +123,7 @@ TEST_CASE("flat mesh: over a flat edge and a flat vertex a point feels the plane
     std::vector<std::vector<Eigen::Vector3d>> paths;
     for (Eigen::Index f = 0; f < s.F.rows(); ++f)
         for (int i = 0; i < 3; ++i)
-            if (s.F(f, i) == 5 + 11 * 5 && paths.size() < 6) {
+            if (s.F(f, i) == middle_vertex(10) && paths.size() < 6) {
                 const Eigen::Vector3d a = floor.middle, b = s.V.row(s.F(f, (i + 1) % 3)).transpose();
                 const Eigen::Vector3d across = Eigen::Vector3d::UnitZ().cross(b - a).normalized();
                 const Eigen::Vector3d mid = 0.5 * (a + b) + up;
@@ -168,7 +179,7 @@ TEST_CASE("flat mesh: round a corner of the floor's border and along its edges t
     const TriMesh& s = floor.mesh.surface();
     // A circle of radius 0.5 mm, 0.2 mm up, round each corner of the square (one triangle there, or
     // two meeting at a flat edge), and one round a border vertex between two corners.
-    for (const int vertex : {0, 10, 120, 110, 5}) {
+    for (const int vertex : {0, 10, 120, 110, 5}) {  // square_mesh(10)'s corners and a middle of a side
         const Eigen::Vector3d centre = s.V.row(vertex).transpose() + 2e-4 * Eigen::Vector3d::UnitZ();
         std::vector<Eigen::Vector3d> circle;
         for (int k = 0; k <= 20000; ++k) {
@@ -200,12 +211,12 @@ TEST_CASE("flat mesh: a block at rest on a floor of 2 or 200 triangles stays whe
         return states;
     };
     const std::vector<Eigen::VectorXd> half = run(nullptr);
-    // Two triangles whose diagonal passes 0.36 mm beside the block's corner (0, 0); 200 jittered ones
-    // turned by 17° (some of their edges and corners under the block's).
+    // Two triangles whose diagonal, at 50°, passes 0.36 mm beside the block's corner (0.1, 0.1); 200
+    // jittered ones turned by 17° with a vertex there.
     const double diagonal = 50.0 * degree;
     const std::vector<std::shared_ptr<const Obstacle>> floors{
-        std::make_shared<MeshObstacle>(flat_floor(1, 0.0, 1.2, diagonal - 45.0 * degree,
-                                                  Eigen::Vector2d(3e-4, -2e-4) - 0.6 * Eigen::Vector2d(std::cos(diagonal), std::sin(diagonal)))),
+        std::make_shared<MeshObstacle>(flat_floor(1, 0.0, 1.2, diagonal - 45.0 * degree, 0,
+                                                  beside_block - 0.8 * Eigen::Vector2d(std::cos(diagonal), std::sin(diagonal)))),
         std::make_shared<MeshObstacle>(JitteredFloor().mesh)};
     for (const auto& floor : floors) {
         const std::vector<Eigen::VectorXd> states = run(floor);
@@ -240,7 +251,7 @@ TEST_CASE("flat mesh: a block sticking to a tilted floor of 1 m or 10 m of trian
     for (const auto& [side, cells] : std::vector<std::pair<double, int>>{{1.0, 10}, {10.0, 40}}) {
         BlockSettings on_mesh = settings;
         on_mesh.obstacles = {std::make_shared<MeshObstacle>(
-            flat_floor(cells, 0.2, side, 17.0 * degree, Eigen::Vector2d(-0.43, -0.38) * side), settings.friction)};
+            flat_floor(cells, 0.2, side, 17.0 * degree, middle_vertex(cells), beside_block), settings.friction)};
         const double creep = test::slope_creep(on_mesh, steps).last;
         INFO(side << " m of " << 2 * cells * cells << " triangles: creep " << creep << " m a step, on the half-space "
                   << half << " m, closed form " << test::expected_creep(settings) << " m");
