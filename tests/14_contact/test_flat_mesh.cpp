@@ -9,7 +9,9 @@
 #include "14_contact/obstacles.hpp"
 #include "slope_creep.hpp"
 
+#include "common/files.hpp"
 #include "common/mesh.hpp"
+#include "common/mesh_io.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -191,6 +193,34 @@ TEST_CASE("flat mesh: round a corner of the floor's border and along its edges t
     }
 }
 
+TEST_CASE("flat mesh: in the bowl, whose quads are split into coplanar pairs between creases, the barriers' sum stays "
+          "continuous round every vertex")
+{
+    const MeshObstacle bowl(io::read_tri_mesh(data_path("bowl.obj")));
+    const TriMesh& s = bowl.surface();
+    Eigen::MatrixX3d normals = Eigen::MatrixX3d::Zero(s.V.rows(), 3);  // area-weighted, at the vertices
+    for (Eigen::Index f = 0; f < s.F.rows(); ++f) {
+        const Eigen::Vector3d a = s.V.row(s.F(f, 0)), b = s.V.row(s.F(f, 1)), c = s.V.row(s.F(f, 2));
+        for (int k = 0; k < 3; ++k)
+            normals.row(s.F(f, k)) += (b - a).cross(c - a).transpose();
+    }
+    double worst = 0.0;
+    for (Eigen::Index v = 0; v < s.V.rows(); v += 7) {
+        const Eigen::Vector3d n = normals.row(v).normalized();
+        const Eigen::Vector3d t1 = n.unitOrthogonal(), t2 = n.cross(t1);
+        for (const double side : {2e-4, -2e-4}) {  // inside the bowl and under it
+            std::vector<Eigen::Vector3d> circle;
+            for (int k = 0; k <= 4000; ++k) {
+                const double phi = 2.0 * std::numbers::pi * k / 4000.0;
+                circle.push_back(s.V.row(v).transpose() + side * n + 5e-4 * (std::cos(phi) * t1 + std::sin(phi) * t2));
+            }
+            worst = std::max(worst, worst_jump(bowl, circle));
+        }
+    }
+    INFO("the largest jump between neighbouring samples over what the gradient allows: " << worst);
+    CHECK(worst <= 1.01);
+}
+
 TEST_CASE("flat mesh: a block at rest on a floor of 2 or 200 triangles stays where it stands, as on the half-space")
 {
     BlockSettings settings;
@@ -258,3 +288,4 @@ TEST_CASE("flat mesh: a block sticking to a tilted floor of 1 m or 10 m of trian
         CHECK(std::abs(creep - half) <= 0.01 * half);
     }
 }
+
