@@ -125,9 +125,10 @@ private:
     DistancePiece piece(int f, const TrianglePoint& closest, const Eigen::Vector3d& p) const;
     /// The closest point of triangle f to p.
     TrianglePoint closest_on(int f, const Eigen::Vector3d& p) const;
-    /// Whether triangle f's piece at p, of closest point q, is left out: q lies (within same_point_)
-    /// on an edge of f shared with a coplanar triangle g, or at a corner of f whose flat fan holds g,
-    /// and g's closest point to p is nearer (|p − q_g| ≤ |p − q|, q_g ≠ q), or the same and g < f.
+    /// Whether triangle f's piece at p, of closest point q, is left out: q lies on (within same_point_,
+    /// or, where flat triangles meet at a small angle, 2 flat_mesh_edge_sine |p − q|) an edge of f
+    /// shared with a flat neighbour g, or at a corner of f whose flat fan holds g, and g's closest
+    /// point to p is nearer (|p − q_g| < |p − q|), or the same point or as near and g < f.
     bool shadowed(int f, const Eigen::Vector3d& closest, const Eigen::Vector3d& p) const;
 
     TriMesh surface_;

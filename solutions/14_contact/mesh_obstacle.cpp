@@ -279,21 +279,26 @@ Eigen::Matrix3d MeshObstacle::local_hessian(const Eigen::Vector3d& p) const
 bool MeshObstacle::shadowed(int f, const Eigen::Vector3d& closest, const Eigen::Vector3d& p) const
 {
     const double distance = (p - closest).norm();
-    const auto beats = [&](int other) {  // a nearer point of other, or the same point and a lower number
+    const auto beats = [&](int other) {  // a nearer point of other, or as near (the same point) and a lower number
         const Eigen::Vector3d point = closest_on(other, p).point;
-        if ((point - closest).norm() <= same_point_)
+        const double other_distance = (p - point).norm();
+        if ((point - closest).norm() <= same_point_ || other_distance == distance)
             return other < f;
-        return (p - point).norm() <= distance;
+        return other_distance < distance;
     };
+    // A neighbour can be nearer only when q is on (or, for a face piece, near) the edge or corner they
+    // share: in a plane only through q itself (same_point_), over two triangles that pass as flat at
+    // an angle of sine σ ≤ flat_mesh_edge_sine, where their face regions overlap, within σ d.
+    const double near = same_point_ + 2.0 * flat_mesh_edge_sine * distance;
     for (int k = 0; k < 3; ++k) {
         const Eigen::Vector3d corner = surface_.V.row(surface_.F(f, k)), next = surface_.V.row(surface_.F(f, (k + 1) % 3));
-        if ((closest - corner).norm() <= same_point_) {
+        if ((closest - corner).norm() <= near) {
             for (int other : flat_fan_[3 * f + k])
                 if (beats(other))
                     return true;
         }
         const int across = flat_neighbour_[3 * f + k];
-        if (across >= 0 && segment_distance(closest, corner, next) <= same_point_ && beats(across))
+        if (across >= 0 && segment_distance(closest, corner, next) <= near && beats(across))
             return true;
     }
     return false;

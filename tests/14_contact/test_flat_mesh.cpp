@@ -193,6 +193,28 @@ TEST_CASE("flat mesh: round a corner of the floor's border and along its edges t
     }
 }
 
+TEST_CASE("flat mesh: two triangles folded by less than the flat test's angle, either way, keep the sum continuous "
+          "across their edge")
+{
+    for (const double fold : {5e-4, -5e-4}) {  // the sine of the angle: a valley (seen from +z) and a ridge
+        TriMesh folded;
+        folded.V.resize(4, 3);
+        folded.V << 0.0, -0.5, 0.0,  //
+            0.0, 0.5, 0.0,           //
+            -0.5, 0.0, 0.5 * fold,   //
+            0.5, 0.0, 0.5 * fold;
+        folded.F.resize(2, 3);
+        folded.F << 0, 1, 2,  //
+            1, 0, 3;
+        const MeshObstacle mesh(folded);
+        REQUIRE(mesh.local_features().edges.rows() == 4);  // the border only: the fold passes as flat
+        const Eigen::Vector3d up(0.0, 0.0, 4e-4);
+        INFO("fold " << fold);
+        CHECK(worst_jump(mesh, segment_path(up - Eigen::Vector3d(2e-3, 0.0, 0.0), up + Eigen::Vector3d(2e-3, 0.0, 0.0),
+                                            40000)) <= 1.01);
+    }
+}
+
 TEST_CASE("flat mesh: in the bowl, whose quads are split into coplanar pairs between creases, the barriers' sum stays "
           "continuous round every vertex")
 {
