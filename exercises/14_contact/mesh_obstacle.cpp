@@ -288,9 +288,11 @@ bool MeshObstacle::shadowed(int f, const Eigen::Vector3d& closest, const Eigen::
             return other < f;
         return other_distance < distance;
     };
-    // A neighbour can be nearer only when q is on (or, for a face piece, near) the edge or corner they
-    // share: in a plane only through q itself (same_point_), over two triangles that pass as flat at
-    // an angle of sine σ ≤ flat_mesh_edge_sine, where their face regions overlap, within σ d.
+    // The neighbours compared: across the flat edges q lies on and in the flat fans of the corners q
+    // is at. An edge or vertex piece's q lies there exactly; a face piece's q is matched in a plane
+    // only by the same point (within same_point_ of the edge or corner), and over two triangles that
+    // pass as flat at an angle of sine σ ≤ flat_mesh_edge_sine, in a valley, where their face regions
+    // overlap, within σ d of it (2σd: a margin).
     const double near = same_point_ + 2.0 * flat_mesh_edge_sine * distance;
     for (int k = 0; k < 3; ++k) {
         const Eigen::Vector3d corner = surface_.V.row(surface_.F(f, k)), next = surface_.V.row(surface_.F(f, (k + 1) % 3));

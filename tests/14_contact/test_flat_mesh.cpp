@@ -1,7 +1,8 @@
 // Chapter 14: a flat region of a mesh obstacle holds a body as a plane does — over it a point feels
 // one barrier, the plane's, with no lateral push from the triangles next to the one it stands over;
-// the barriers' sum stays continuous across flat edges, over flat corners and round the region's
-// border; a block at rest on a flat mesh floor stays where it stands, as on the half-space, and one
+// the barriers' sum stays continuous across flat edges, over flat corners, round the region's
+// border, across two triangles folded by less than the flat test's angle and round every vertex of
+// the bowl (its quads split in coplanar pairs); a block at rest on a flat mesh floor stays where it stands, as on the half-space, and one
 // that sticks to a tilted one creeps as on the half-space. docs/14_contact.md#mesh-obstacles
 #include "14_contact/barrier.hpp"
 #include "14_contact/contact_scenes.hpp"
