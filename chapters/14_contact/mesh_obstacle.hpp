@@ -71,7 +71,10 @@ public:
     /// By the feature of q (header): 0, (I − e eᵀ − g gᵀ)/d or (I − g gᵀ)/d.
     Eigen::Matrix3d local_hessian(const Eigen::Vector3d& p) const override;
     /// One piece per triangle within reach of p (by the tree): its distance |p − q_f|, (p − q_f)/d and
-    /// the Hessian of q_f's feature. Summed, their barriers are smooth across the mesh's creases.
+    /// the Hessian of q_f's feature — but for a piece whose q_f lies on a flat edge or a corner of a
+    /// flat fan, which counts only when no triangle of that edge or fan has a nearer point (and, of
+    /// triangles whose points coincide, the lowest-numbered). Summed, their barriers are smooth
+    /// across the mesh's creases, and over a flat region p feels one plane's barrier, no lateral push.
     void local_pieces(const Eigen::Vector3d& p, double reach, std::vector<DistancePiece>& pieces) const override;
     /// The first s in [0, 2] where p + s·dp meets a triangle (Möller–Trumbore: the plane's root s with
     /// barycentric u, v ≥ −10⁻⁹, u + v ≤ 1 + 10⁻⁹), +∞ when none does; a path parallel to a
@@ -122,10 +125,22 @@ private:
     DistancePiece piece(int f, const TrianglePoint& closest, const Eigen::Vector3d& p) const;
     /// The closest point of triangle f to p.
     TrianglePoint closest_on(int f, const Eigen::Vector3d& p) const;
+    /// Whether triangle f's piece at p, of closest point q, is left out: q lies on (within same_point_,
+    /// or, where flat triangles meet at a small angle, 2 flat_mesh_edge_sine |p − q|) an edge of f
+    /// shared with a flat neighbour g, or at a corner of f whose flat fan holds g, and g's closest
+    /// point to p is nearer (|p − q_g| < |p − q|), or the same point or as near and g < f.
+    bool shadowed(int f, const Eigen::Vector3d& closest, const Eigen::Vector3d& p) const;
 
     TriMesh surface_;
     std::vector<Eigen::Matrix<double, 2, 3>> boxes_;  // per triangle, rows min and max
     skin::BoxHierarchy tree_;
+    /// Per triangle f and edge i (from corner i to corner i + 1), at 3f + i: the triangle across the
+    /// edge when the edge is flat (two triangles, coplanar by flat_mesh_edge_sine), else −1.
+    std::vector<int> flat_neighbour_;
+    /// Per triangle f and corner k, at 3f + k: the other triangles of the corner's flat fan, those
+    /// reached from f by turning about the corner across flat edges.
+    std::vector<std::vector<int>> flat_fan_;
+    double same_point_ = 0.0;  // two closest points this near are one [m]: 10⁻⁷ of the mesh's box diagonal
 };
 
 /// The unsigned distance of a mesh obstacle sampled at the nodes of a regular grid (spacing h at

@@ -15,6 +15,8 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <utility>
+#include <vector>
 
 namespace fem::contact {
 namespace {
@@ -25,6 +27,46 @@ constexpr double infinity = std::numeric_limits<double>::infinity();
 double box_distance(const Eigen::Vector3d& low, const Eigen::Vector3d& high, const Eigen::Vector3d& p)
 {
     return (low - p).cwiseMax(p - high).cwiseMax(0.0).norm();
+}
+
+/// Each edge of the mesh (as its sorted corner pair) with the triangles on it, each signed by the
+/// direction it runs the edge in (+f + 1 from the lower corner to the higher, −f − 1 back).
+std::map<std::pair<int, int>, std::vector<int>> edge_sides(const TriMesh& surface)
+{
+    std::map<std::pair<int, int>, std::vector<int>> sides;
+    for (int f = 0; f < static_cast<int>(surface.F.rows()); ++f)
+        for (int i = 0; i < 3; ++i) {
+            const int a = surface.F(f, i), b = surface.F(f, (i + 1) % 3);
+            sides[{std::min(a, b), std::max(a, b)}].push_back(a < b ? f + 1 : -f - 1);
+        }
+    return sides;
+}
+
+/// Whether an edge with these signed triangles (edge_sides) is flat: two triangles whose unit
+/// normals n₁, n₂ (the second flipped when both run the edge the same way, that is when one of the
+/// two is flipped) have n₁·n₂ ≥ 0 and |n₁ × n₂| ≤ flat_mesh_edge_sine.
+bool flat_edge(const TriMesh& surface, const std::vector<int>& faces)
+{
+    if (faces.size() != 2)
+        return false;  // a border edge, or one shared by three or more triangles
+    const auto normal = [&](int f) {
+        const Eigen::Vector3d a = surface.V.row(surface.F(f, 0)), b = surface.V.row(surface.F(f, 1)),
+                              c = surface.V.row(surface.F(f, 2));
+        return Eigen::Vector3d((b - a).cross(c - a).normalized());
+    };
+    // Oriented alike, two neighbours run their edge in opposite directions; else one is flipped.
+    const Eigen::Vector3d n0 = normal(std::abs(faces[0]) - 1);
+    const Eigen::Vector3d n1 = (faces[0] > 0) == (faces[1] > 0) ? Eigen::Vector3d(-normal(std::abs(faces[1]) - 1))
+                                                                 : normal(std::abs(faces[1]) - 1);
+    return n0.dot(n1) >= 0.0 && n0.cross(n1).norm() <= flat_mesh_edge_sine;
+}
+
+/// The distance from x to the segment from a to b.
+double segment_distance(const Eigen::Vector3d& x, const Eigen::Vector3d& a, const Eigen::Vector3d& b)
+{
+    const Eigen::Vector3d e = b - a;
+    const double t = std::clamp((x - a).dot(e) / e.squaredNorm(), 0.0, 1.0);
+    return (x - a - t * e).norm();
 }
 
 }  // namespace
@@ -68,6 +110,40 @@ MeshObstacle::MeshObstacle(TriMesh surface, double friction, const Eigen::Vector
         }
     }
     tree_ = skin::box_hierarchy(boxes_, 4);
+    same_point_ = 1e-7 * (surface_.V.colwise().maxCoeff() - surface_.V.colwise().minCoeff()).norm();
+
+    // The neighbour across each flat edge, then each corner's flat fan: the triangles reached from
+    // the corner's triangle by turning about the corner across flat edges.
+    const int triangles = static_cast<int>(surface_.F.rows());
+    flat_neighbour_.assign(3 * static_cast<std::size_t>(triangles), -1);
+    for (const auto& [edge, faces] : edge_sides(surface_)) {
+        if (!flat_edge(surface_, faces))
+            continue;
+        for (int side = 0; side < 2; ++side) {
+            const int f = std::abs(faces[side]) - 1, other = std::abs(faces[1 - side]) - 1;
+            for (int i = 0; i < 3; ++i) {
+                const int a = surface_.F(f, i), b = surface_.F(f, (i + 1) % 3);
+                if (std::min(a, b) == edge.first && std::max(a, b) == edge.second)
+                    flat_neighbour_[3 * f + i] = other;
+            }
+        }
+    }
+    flat_fan_.assign(3 * static_cast<std::size_t>(triangles), {});
+    for (int f = 0; f < triangles; ++f)
+        for (int k = 0; k < 3; ++k) {
+            const int vertex = surface_.F(f, k);
+            std::vector<int> fan{f};
+            for (std::size_t next = 0; next < fan.size(); ++next) {
+                const int g = fan[next];
+                const int corner = surface_.F(g, 0) == vertex ? 0 : surface_.F(g, 1) == vertex ? 1 : 2;
+                for (int edge : {corner, (corner + 2) % 3}) {  // g's two edges at the vertex
+                    const int across = flat_neighbour_[3 * g + edge];
+                    if (across >= 0 && std::find(fan.begin(), fan.end(), across) == fan.end())
+                        fan.push_back(across);
+                }
+            }
+            flat_fan_[3 * f + k].assign(fan.begin() + 1, fan.end());
+        }
 }
 
 TrianglePoint MeshObstacle::closest_on(int f, const Eigen::Vector3d& p) const
@@ -127,32 +203,10 @@ std::vector<int> MeshObstacle::triangles_meeting(const Eigen::Vector3d& low, con
 
 ObstacleFeatures MeshObstacle::local_features() const
 {
-    // Each edge (as its sorted corner pair) with the triangles on it, each signed by the direction it
-    // runs the edge in (+f + 1 from the lower corner to the higher, −f − 1 back).
-    std::map<std::pair<int, int>, std::vector<int>> sides;
-    for (int f = 0; f < static_cast<int>(surface_.F.rows()); ++f)
-        for (int i = 0; i < 3; ++i) {
-            const int a = surface_.F(f, i), b = surface_.F(f, (i + 1) % 3);
-            sides[{std::min(a, b), std::max(a, b)}].push_back(a < b ? f + 1 : -f - 1);
-        }
-    const auto normal = [&](int f) {
-        const Eigen::Vector3d a = surface_.V.row(surface_.F(f, 0)), b = surface_.V.row(surface_.F(f, 1)),
-                              c = surface_.V.row(surface_.F(f, 2));
-        return Eigen::Vector3d((b - a).cross(c - a).normalized());
-    };
     std::vector<std::pair<int, int>> sharp;
-    for (const auto& [edge, faces] : sides) {
-        bool is_sharp = faces.size() != 2;
-        if (!is_sharp) {
-            // Oriented alike, two neighbours run their edge in opposite directions; else one is flipped.
-            const Eigen::Vector3d n0 = normal(std::abs(faces[0]) - 1);
-            const Eigen::Vector3d n1 = (faces[0] > 0) == (faces[1] > 0) ? Eigen::Vector3d(-normal(std::abs(faces[1]) - 1))
-                                                                         : normal(std::abs(faces[1]) - 1);
-            is_sharp = n0.dot(n1) < 0.0 || n0.cross(n1).norm() > flat_mesh_edge_sine;
-        }
-        if (is_sharp)
+    for (const auto& [edge, faces] : edge_sides(surface_))
+        if (!flat_edge(surface_, faces))
             sharp.push_back(edge);
-    }
     ObstacleFeatures features;
     features.edges.resize(static_cast<Eigen::Index>(sharp.size()), 2);
     std::map<int, int> corner_of;  // mesh vertex → corner row
@@ -224,11 +278,41 @@ Eigen::Matrix3d MeshObstacle::local_hessian(const Eigen::Vector3d& p) const
     return piece(n.triangle, n.closest, p).hessian;
 }
 
+bool MeshObstacle::shadowed(int f, const Eigen::Vector3d& closest, const Eigen::Vector3d& p) const
+{
+    const double distance = (p - closest).norm();
+    const auto beats = [&](int other) {  // a nearer point of other, or as near (the same point) and a lower number
+        const Eigen::Vector3d point = closest_on(other, p).point;
+        const double other_distance = (p - point).norm();
+        if ((point - closest).norm() <= same_point_ || other_distance == distance)
+            return other < f;
+        return other_distance < distance;
+    };
+    // The neighbours compared: across the flat edges q lies on and in the flat fans of the corners q
+    // is at. An edge or vertex piece's q lies there exactly; a face piece's q is matched in a plane
+    // only by the same point (within same_point_ of the edge or corner), and over two triangles that
+    // pass as flat at an angle of sine σ ≤ flat_mesh_edge_sine, in a valley, where their face regions
+    // overlap, within σ d of it (2σd: a margin).
+    const double near = same_point_ + 2.0 * flat_mesh_edge_sine * distance;
+    for (int k = 0; k < 3; ++k) {
+        const Eigen::Vector3d corner = surface_.V.row(surface_.F(f, k)), next = surface_.V.row(surface_.F(f, (k + 1) % 3));
+        if ((closest - corner).norm() <= near) {
+            for (int other : flat_fan_[3 * f + k])
+                if (beats(other))
+                    return true;
+        }
+        const int across = flat_neighbour_[3 * f + k];
+        if (across >= 0 && segment_distance(closest, corner, next) <= near && beats(across))
+            return true;
+    }
+    return false;
+}
+
 void MeshObstacle::local_pieces(const Eigen::Vector3d& p, double reach, std::vector<DistancePiece>& pieces) const
 {
     for (int f : triangles_meeting(p.array() - reach, p.array() + reach)) {
         const TrianglePoint closest = closest_on(f, p);
-        if ((p - closest.point).norm() < reach)
+        if ((p - closest.point).norm() < reach && !shadowed(f, closest.point, p))
             pieces.push_back(piece(f, closest, p));
     }
 }
