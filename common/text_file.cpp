@@ -54,6 +54,37 @@ TextFile::~TextFile()
         ::munmap(const_cast<char*>(text_), size_);
 }
 
+bool TextFile::next_line()
+{
+    tokens_.clear();
+    while (next_ < size_) {
+        const char* begin = text_ + next_;
+        const std::size_t left = size_ - next_;
+        const auto* newline = static_cast<const char*>(std::memchr(begin, '\n', left));
+        const std::size_t length = newline ? static_cast<std::size_t>(newline - begin) : left;
+        next_ += newline ? length + 1 : length;
+        ++line_;
+        std::string_view rest(begin, length);
+        if (comment_ != '\0')
+            rest = rest.substr(0, rest.find(comment_));
+        std::size_t at = 0;
+        while (true) {
+            while (at < rest.size() && is_space(rest[at]))
+                ++at;
+            if (at == rest.size())
+                break;
+            std::size_t end = at;
+            while (end < rest.size() && !is_space(rest[end]))
+                ++end;
+            tokens_.push_back(rest.substr(at, end - at));
+            at = end;
+        }
+        if (!tokens_.empty())
+            return true;
+    }
+    return false;
+}
+
 void TextFile::fail(const std::string& what) const
 {
     std::string shown;
@@ -65,6 +96,11 @@ void TextFile::fail(const std::string& what) const
             shown += c;
     }
     throw Error(str(place(), ": ", shown));
+}
+
+void TextFile::fail_to_parse(std::string_view token, std::string_view what, const char* kind) const
+{
+    fail(str("expected ", what, " (", kind, "), got '", token, "'"));
 }
 
 }  // namespace fem::io::detail

@@ -41,36 +41,7 @@ public:
     ~TextFile();
 
     /// Moves to the next line that holds a token; false at the end of the file.
-    bool next_line()
-    {
-        tokens_.clear();
-        while (next_ < size_) {
-            const char* begin = text_ + next_;
-            const std::size_t left = size_ - next_;
-            const auto* newline = static_cast<const char*>(std::memchr(begin, '\n', left));
-            const std::size_t length = newline ? static_cast<std::size_t>(newline - begin) : left;
-            next_ += newline ? length + 1 : length;
-            ++line_;
-            std::string_view rest(begin, length);
-            if (comment_ != '\0')
-                rest = rest.substr(0, rest.find(comment_));
-            std::size_t at = 0;
-            while (true) {
-                while (at < rest.size() && is_space(rest[at]))
-                    ++at;
-                if (at == rest.size())
-                    break;
-                std::size_t end = at;
-                while (end < rest.size() && !is_space(rest[end]))
-                    ++end;
-                tokens_.push_back(rest.substr(at, end - at));
-                at = end;
-            }
-            if (!tokens_.empty())
-                return true;
-        }
-        return false;
-    }
+    bool next_line();
 
     /// Copies the next `count` bytes after the current line (binary data after a text header) into
     /// bytes; false, copying nothing, if fewer are left.
@@ -93,6 +64,8 @@ public:
     /// printed) are written as \xNN.
     [[noreturn]] void fail(const std::string& what) const;
 
+    /// The number a token spells (an optional '+' first); fail() with "expected <what> (a number),
+    /// got '<token>'" otherwise.
     double number(std::string_view token, std::string_view what) const
     {
         if (!token.empty() && token.front() == '+')
@@ -100,10 +73,12 @@ public:
         double value = 0.0;
         const auto [end, error] = std::from_chars(token.data(), token.data() + token.size(), value);
         if (error != std::errc() || end != token.data() + token.size())
-            fail(str("expected ", what, " (a number), got '", token, "'"));
+            fail_to_parse(token, what, "a number");
         return value;
     }
 
+    /// The integer a token spells (an optional '+' first); fail() with "expected <what> (an
+    /// integer), got '<token>'" otherwise.
     long long integer(std::string_view token, std::string_view what) const
     {
         if (!token.empty() && token.front() == '+')
@@ -111,11 +86,15 @@ public:
         long long value = 0;
         const auto [end, error] = std::from_chars(token.data(), token.data() + token.size(), value);
         if (error != std::errc() || end != token.data() + token.size())
-            fail(str("expected ", what, " (an integer), got '", token, "'"));
+            fail_to_parse(token, what, "an integer");
         return value;
     }
 
 private:
+    /// fail() with "expected <what> (<kind>), got '<token>'": out of line, so that the message's
+    /// building stays out of number() and integer(), which the readers inline in their loops.
+    [[noreturn]] void fail_to_parse(std::string_view token, std::string_view what, const char* kind) const;
+
     std::string name_;
     char comment_;
     const char* text_ = nullptr;  // the whole file, mapped (nullptr when it is empty)
