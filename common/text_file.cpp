@@ -1,6 +1,7 @@
 // The memory-mapped text file of the mesh readers (common/text_file.hpp, internal to common/): the
-// readable-file check, the mapping of the file (mmap, read-only) and its release, and the error
-// that names the file and the line. docs/engineering.md#reading-meshes
+// readable-file check, the mapping of the file (mmap, read-only) and its release, the walk to the
+// next line's tokens, and the errors that name the file and the line.
+// docs/engineering.md#reading-meshes
 #include "common/text_file.hpp"
 
 #include <fcntl.h>
@@ -13,6 +14,13 @@
 namespace fem::io::detail {
 
 namespace fs = std::filesystem;
+
+namespace {
+
+/// isspace() of the "C" locale: ' ', '\t', '\n', '\v', '\f', '\r'.
+constexpr bool is_space(char c) { return c == ' ' || (c >= '\t' && c <= '\r'); }
+
+}  // namespace
 
 void require_readable_file(const fs::path& path)
 {

@@ -4,8 +4,8 @@
 // whitespace-separated tokens, its numbers parsed where they lie by std::from_chars, every error
 // naming the file and the line. The readers of .obj, ASCII .stl and .ply and TetGen's .node/.ele
 // use it; why it is hand-written and how fast it reads: docs/engineering.md#reading-meshes
-// (tools/mesh_io_speed.cpp measures it). Its hot members (next_line, number, integer) stay here,
-// inline, so that each reader's loop compiles with them.
+// (tools/mesh_io_speed.cpp measures it). number() and integer() stay here, inline, so that each
+// reader's loop compiles with them; their error messages are built out of line (text_file.cpp).
 
 #include "common/error.hpp"
 
@@ -24,9 +24,6 @@ namespace fem::io::detail {
 /// fem::Error unless path names an existing regular file ("no such file", "not a regular file"):
 /// every mesh reader's first check.
 void require_readable_file(const std::filesystem::path& path);
-
-/// isspace() of the "C" locale: ' ', '\t', '\n', '\v', '\f', '\r'.
-constexpr bool is_space(char c) { return c == ' ' || (c >= '\t' && c <= '\r'); }
 
 /// A text file mapped into memory (mmap, read-only), then walked line by line in one pass: a line's
 /// tokens are views into that memory (no copy of the file, no allocation per line), numbers are
