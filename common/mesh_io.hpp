@@ -41,8 +41,9 @@ namespace fem::io {
 /// fails validate(). docs/03_triangle_gradients.md#meshes-from-files
 TriMesh read_tri_mesh(const std::filesystem::path& path);
 
-/// Writes a triangle surface by its extension: .obj (vtkOBJWriter), .stl (binary, vtkSTLWriter),
-/// .ply (binary, vtkPLYWriter) or .vtu (fem::io::write_vtu). Validates the mesh first.
+/// Writes a triangle surface by its extension: .obj (17 significant digits), .stl (binary, 32-bit
+/// floats) or .ply (binary little-endian, 32-bit floats), each written by common/mesh_io_<format>.cpp,
+/// not by VTK; or .vtu (fem::io::write_vtu). Validates the mesh first.
 void write_tri_mesh(const std::filesystem::path& path, const TriMesh& mesh);
 
 /// Reads a tetrahedral mesh: TetGen's .node/.ele pair (path names either file, or their common

@@ -1,3 +1,7 @@
+// Internal to common/: the checks of a .vtu file's layout before VTK's XML reader sees it
+// (common/vtu_check.hpp): a small XML tag reader, the <DataArray> values in ASCII, base64 or
+// appended form, zlib-compressed blocks within zlib's largest ratio, and the counts and cell offsets
+// checked against what the file holds. docs/engineering.md#fuzzing-the-readers
 #include "common/vtu_check.hpp"
 
 #include "common/error.hpp"

@@ -1,3 +1,7 @@
+// Chapter 10: the time integrators and the time loop: the θ-method's step matrix and right-hand
+// side (and its reduced, pattern-reusing step matrix), the implicit step, symplectic Euler, the
+// energies, the integrators by name, the step hook and Simulation's loop.
+// docs/10_linear_dynamics.md#the-implicit-step
 #include "10_linear_dynamics/time_integration.hpp"
 
 #include "common/error.hpp"
