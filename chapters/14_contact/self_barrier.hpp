@@ -82,7 +82,7 @@ public:
     /// The smallest distance of any pair within reach [m] at u (3n): +∞ when none is, 0 when a pair touches.
     double smallest_distance(const Eigen::VectorXd& u, double reach) const;
     /// The earliest time of impact s ∈ [0, 1] of any pair when the surface moves from u to u + du (3n
-    /// each), x + s du: the candidates of tree_candidates over the motion (no inflation), each pair's
+    /// each), x + s du: the candidates of tree_candidates over the motion whose swept boxes meet (no inflation), each pair's
     /// line_search_time_of_impact (a lower bound of its first contact); +∞ when none meets. Keeps the
     /// motion's candidates within d̂ for the energy, gradient and Hessian that follow (header).
     /// fem::Error on sizes.
