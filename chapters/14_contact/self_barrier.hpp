@@ -15,6 +15,14 @@
 // 0 at rest (a triangle holds its own corners, two edges of one triangle meet). The pairs within d̂
 // are found by the broad phase (broad_phase.hpp, chapter 13's tree); the time of impact of a motion
 // by the tree over swept boxes and line_search_time_of_impact (pair_barrier.hpp) per candidate.
+//
+// One broad phase a Newton iteration: time_of_impact(u, du), which the line search asks first, keeps
+// the candidates of the motion's swept boxes grown by d̂ + 2δ (δ = motion_margin d̂), and every later
+// energy, gradient or Hessian at an x whose surface vertices each lie within δ of their own swept
+// box (every line-search trial x + α du, α ∈ [0, 1], and the next iterate) takes its pairs from them
+// instead of a tree of its own. Exact: a pair within d̂ at such an x has its vertices' boxes within
+// d̂ of each other in every axis, so its swept boxes, grown by d̂ + 2δ, meet. At any other x the
+// tree is built there, as before.
 
 #include "14_contact/broad_phase.hpp"
 #include "14_contact/ccd.hpp"
@@ -28,6 +36,10 @@
 #include <vector>
 
 namespace fem::contact {
+
+/// δ of the header as a fraction of d̂: how far outside its swept box a vertex may be (the round-off
+/// of x + α du against x and x + du, ~10⁻¹⁶ m) for a motion's candidates to hold there.
+inline constexpr double motion_margin = 1e-3;
 
 /// One pair of surface primitives within reach: its kind, its 4 mesh vertices (p, a, b, c or ea0,
 /// ea1, eb0, eb1), its distance d [m], its mollifier m (1 for a point and a triangle) and κ-free
@@ -70,10 +82,15 @@ public:
     /// The smallest distance of any pair within reach [m] at u (3n): +∞ when none is, 0 when a pair touches.
     double smallest_distance(const Eigen::VectorXd& u, double reach) const;
     /// The earliest time of impact s ∈ [0, 1] of any pair when the surface moves from u to u + du (3n
-    /// each), x + s du: the candidates of tree_candidates over the motion (no inflation), each pair's
-    /// line_search_time_of_impact (a lower bound of its first contact); +∞ when none meets.
+    /// each), x + s du: the candidates of tree_candidates over the motion whose swept boxes meet (no inflation), each pair's
+    /// line_search_time_of_impact (a lower bound of its first contact); +∞ when none meets. Keeps the
+    /// motion's candidates within d̂ for the energy, gradient and Hessian that follow (header).
     /// fem::Error on sizes.
     double time_of_impact(const Eigen::VectorXd& u, const Eigen::VectorXd& du) const;
+    /// How many trees the broad phase has built since construction (each call of energy, gradient,
+    /// Hessian, pairs or smallest_distance whose x lies outside the last motion's boxes, and each
+    /// time_of_impact): what the motion's candidates save.
+    long long broad_phases() const { return broad_phases_; }
 
 private:
     /// Calls visit(pair) for every pair within reach at u; with_derivatives: with the barrier's
@@ -85,6 +102,18 @@ private:
 
     /// candidates without the pairs inside one body that does not hold itself off.
     CandidatePairs kept(CandidatePairs candidates) const;
+    /// The candidates within reach at x (#V×3): the last motion's when reach ≤ d̂ and every surface
+    /// vertex of x lies within δ of its swept box, else tree_candidates at x, kept in fresh.
+    const CandidatePairs& candidates_at(const MatrixX3d& x, double reach, CandidatePairs& fresh) const;
+
+    /// The last time_of_impact's motion: each vertex's swept box (low, high: #V×3) and the candidates
+    /// of those boxes grown by d̂ + 2δ (empty boxes: none yet). A cache: it changes no answer.
+    struct MotionCandidates {
+        MatrixX3d low, high;
+        CandidatePairs pairs;
+    };
+    mutable MotionCandidates motion_;
+    mutable long long broad_phases_ = 0;
 
     MatrixX3d rest_;
     double activation_distance_;

@@ -37,10 +37,12 @@ public:
     explicit TimedSolver(std::unique_ptr<cg::LinearSolver> inner) : LinearSolver(inner->name()), inner_(std::move(inner)) {}
     bool is_direct() const override { return inner_->is_direct(); }
     double seconds = 0.0;
+    int orderings = 0;  ///< prepares with a new pattern (a new fill-reducing ordering and symbolic analysis)
 
 private:
-    void do_prepare(const Eigen::SparseMatrix<double>& A, bool /*same_pattern*/) override
+    void do_prepare(const Eigen::SparseMatrix<double>& A, bool same_pattern) override
     {
+        orderings += same_pattern ? 0 : 1;
         inner_->prepare(A);
         seconds += inner_->stats().prepare_seconds;
     }
@@ -100,7 +102,8 @@ private:
 
 /// What one run of the two bunnies measured.
 struct BunnyRun {
-    int steps = 0, newton_iterations = 0;
+    int steps = 0, newton_iterations = 0, orderings = 0;
+    long long broad_phases = 0;  ///< trees the self-contact barrier built (SelfContactBarrier::broad_phases)
     double seconds = 0.0, solve_seconds = 0.0, barrier_seconds = 0.0, collision_seconds = 0.0;
     double momentum_drift = 0.0;  ///< the largest |Σ m v| over the run, relative to Σ m |v₀|
     bool intersection_free = true;
@@ -198,6 +201,8 @@ void bodies_study(const RunContext& run)
             }
         }
         result.solve_seconds = solver ? solver->seconds : 0.0;
+        result.orderings = solver ? solver->orderings : 0;
+        result.broad_phases = contact ? contact->self_barrier()->broad_phases() : 0;
         if (timed) {
             result.barrier_seconds = timed->barrier_seconds;
             result.collision_seconds = timed->collision_seconds;
@@ -209,6 +214,7 @@ void bodies_study(const RunContext& run)
     Table table(str(run.quick ? "Two blocks (2 x 64 vertices)" : "Two coarse bunnies (2 x 2,199 vertices)",
                     " thrown at each other at 1 m/s, spinning: per step, with self-contact and without"),
                 {{"run", Format::text}, {"steps", Format::integer}, {"Newton iterations", Format::integer},
+                 {"new matrix patterns", Format::integer}, {"broad phases", Format::integer},
                  {"time per step [ms]", Format::fixed, 1}, {"linear solves [ms]", Format::fixed, 1},
                  {"barrier and broad phase [ms]", Format::fixed, 1}, {"collision check [ms]", Format::fixed, 1},
                  {"step time / without contact [measured]", Format::fixed, 2},
@@ -216,7 +222,8 @@ void bodies_study(const RunContext& run)
                  {"intersection-free", Format::text}});
     const auto row = [&](const char* name, const BunnyRun& r) {
         const double per = 1e3 / r.steps;
-        table.add_row({std::string(name), double(r.steps), double(r.newton_iterations), per * r.seconds,
+        table.add_row({std::string(name), double(r.steps), double(r.newton_iterations), double(r.orderings),
+                       double(r.broad_phases), per * r.seconds,
                        per * r.solve_seconds, per * r.barrier_seconds, per * r.collision_seconds,
                        r.seconds / free_run.seconds, r.momentum_drift,
                        std::string(&r == &free_run ? "(passes through)" : r.intersection_free ? "yes" : "NO")});

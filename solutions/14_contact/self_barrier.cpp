@@ -66,6 +66,22 @@ MatrixX3d SelfContactBarrier::moved(const MatrixX3d& x, const Eigen::VectorXd& u
     return moved;
 }
 
+const CandidatePairs& SelfContactBarrier::candidates_at(const MatrixX3d& x, double reach, CandidatePairs& fresh) const
+{
+    if (reach <= activation_distance_ && motion_.low.rows() == x.rows()) {
+        const double margin = motion_margin * activation_distance_;
+        const bool inside = std::all_of(surface_.vertices.begin(), surface_.vertices.end(), [&](int v) {
+            return (x.row(v).array() >= motion_.low.row(v).array() - margin).all() &&
+                   (x.row(v).array() <= motion_.high.row(v).array() + margin).all();
+        });
+        if (inside)
+            return motion_.pairs;
+    }
+    ++broad_phases_;
+    fresh = kept(tree_candidates(surface_, x, x, reach));
+    return fresh;
+}
+
 template <class Visit>
 bool SelfContactBarrier::for_each_pair(const Eigen::VectorXd& u, double reach, bool with_derivatives,
                                        Visit visit) const
@@ -73,7 +89,8 @@ bool SelfContactBarrier::for_each_pair(const Eigen::VectorXd& u, double reach, b
     const MatrixX3d x = moved(rest_, u, "the displacement u");
     const auto at = [&](int v) -> Eigen::Vector3d { return x.row(v).transpose(); };
     const auto rest = [&](int v) -> Eigen::Vector3d { return rest_.row(v).transpose(); };
-    const CandidatePairs candidates = kept(tree_candidates(surface_, x, x, reach));
+    CandidatePairs fresh;
+    const CandidatePairs& candidates = candidates_at(x, reach, fresh);
     SurfacePair pair;
     const auto offer = [&](const PrimitiveFunction& squared, const PrimitiveFunction& mollifier) {
         if (!(squared.value < reach * reach))
@@ -165,10 +182,27 @@ double SelfContactBarrier::time_of_impact(const Eigen::VectorXd& u, const Eigen:
 {
     const MatrixX3d x0 = moved(rest_, u, "the displacement u");
     const MatrixX3d x1 = moved(x0, du, "the step du");
-    const CandidatePairs candidates = kept(tree_candidates(surface_, x0, x1, 0.0));
+    // The motion's candidates within d̂ + 2δ, kept for the evaluations that follow (header); the
+    // time of impact needs only those whose swept boxes meet.
+    motion_ = {};
+    ++broad_phases_;
+    CandidatePairs candidates =
+        kept(tree_candidates(surface_, x0, x1, activation_distance_ * (1.0 + 2.0 * motion_margin)));
+    const MatrixX3d low = x0.cwiseMin(x1), high = x0.cwiseMax(x1);
     double earliest = infinity;
     PrimitiveMotion motion;
     const auto add = [&](PrimitivePair kind, const int (&v)[4]) {
+        const int split = kind == PrimitivePair::point_triangle ? 1 : 2;  // the first primitive's vertices
+        Eigen::RowVector3d first_low = low.row(v[0]), first_high = high.row(v[0]);
+        Eigen::RowVector3d second_low = low.row(v[split]), second_high = high.row(v[split]);
+        for (int k = 1; k < 4; ++k) {
+            Eigen::RowVector3d& side_low = k < split ? first_low : second_low;
+            Eigen::RowVector3d& side_high = k < split ? first_high : second_high;
+            side_low = side_low.cwiseMin(low.row(v[k]));
+            side_high = side_high.cwiseMax(high.row(v[k]));
+        }
+        if ((first_low.array() > second_high.array()).any() || (second_low.array() > first_high.array()).any())
+            return;  // swept boxes apart: no impact
         for (int k = 0; k < 4; ++k) {
             motion.start.col(k) = x0.row(v[k]).transpose();
             motion.end.col(k) = x1.row(v[k]).transpose();
@@ -182,6 +216,7 @@ double SelfContactBarrier::time_of_impact(const Eigen::VectorXd& u, const Eigen:
     for (const auto& [first, second] : candidates.edge_edge)
         add(PrimitivePair::edge_edge, {surface_.edges(first, 0), surface_.edges(first, 1), surface_.edges(second, 0),
                                        surface_.edges(second, 1)});
+    motion_ = {low, high, std::move(candidates)};
     return earliest;
 }
 

@@ -383,3 +383,64 @@ TEST_CASE("self-contact per body: two bodies always hold each other off, a body 
     options.body_self_contact = {true};
     CHECK_THROWS_WITH(ContactPotential(body, none, options), Catch::Contains("no self-contact setting"));
 }
+
+TEST_CASE("self-contact's motion candidates: the pairs within d-hat at every point of the motion, as brute force "
+          "finds them, from one broad phase",
+          "[self][ex14.9]")
+{
+    // Two blocks of 2³ cells 1.5 mm apart, each vertex moved at random (so that the pairs within d̂
+    // change along the motion, and some cross); time_of_impact keeps the motion's candidates, and
+    // pairs() at x + α du must then find, without a tree of its own, every pair brute force finds.
+    const TetMesh mesh = two_bodies(box_at(Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(0.01), 2),
+                                    box_at(Eigen::Vector3d(0.0115, 0.002, -0.003), Eigen::Vector3d::Constant(0.01), 2));
+    const double reach = 1e-3;
+    const SelfContactBarrier barrier(mesh, reach);
+    const SurfacePrimitives& surface = barrier.surface();
+    const Eigen::Index n = 3 * mesh.V.rows();
+    using Key = std::array<int, 5>;  // kind, 4 vertices
+    const auto brute_force = [&](const Eigen::VectorXd& u) {
+        const MatrixX3d x = mesh.V + u.reshaped<Eigen::RowMajor>(mesh.V.rows(), 3);
+        const CandidatePairs candidates = brute_force_candidates(surface, x, x, reach);
+        const auto at = [&](int v) -> Eigen::Vector3d { return x.row(v).transpose(); };
+        std::vector<Key> within;
+        for (const auto& [p, t] : candidates.point_triangle) {
+            const int a = surface.triangles(t, 0), b = surface.triangles(t, 1), c = surface.triangles(t, 2);
+            if (point_triangle_squared_distance(at(p), at(a), at(b), at(c),
+                                                point_triangle_type(at(p), at(a), at(b), at(c))).value < reach * reach)
+                within.push_back({int(PrimitivePair::point_triangle), p, a, b, c});
+        }
+        for (const auto& [e, f] : candidates.edge_edge) {
+            const int a0 = surface.edges(e, 0), a1 = surface.edges(e, 1), b0 = surface.edges(f, 0), b1 = surface.edges(f, 1);
+            if (edge_edge_squared_distance(at(a0), at(a1), at(b0), at(b1),
+                                           edge_edge_type(at(a0), at(a1), at(b0), at(b1))).value < reach * reach)
+                within.push_back({int(PrimitivePair::edge_edge), a0, a1, b0, b1});
+        }
+        std::sort(within.begin(), within.end());
+        return within;
+    };
+    const auto found = [&](const Eigen::VectorXd& u) {
+        std::vector<Key> within;
+        for (const SurfacePair& pair : barrier.pairs(u, false))
+            within.push_back({int(pair.kind), pair.vertices[0], pair.vertices[1], pair.vertices[2], pair.vertices[3]});
+        std::sort(within.begin(), within.end());
+        return within;
+    };
+    std::size_t most = 0;
+    for (unsigned seed : {1u, 2u, 3u, 4u, 5u}) {
+        const Eigen::VectorXd u = 3e-4 * random_vector(n, seed), du = 2e-3 * random_vector(n, seed + 100);
+        barrier.time_of_impact(u, du);
+        const long long trees = barrier.broad_phases();
+        for (double alpha : {0.0, 0.1, 0.25, 0.4, 0.5, 0.6, 0.75, 0.9, 1.0}) {
+            INFO("seed " << seed << ", alpha " << alpha);
+            const std::vector<Key> expected = brute_force(u + alpha * du);
+            CHECK(found(u + alpha * du) == expected);
+            most = std::max(most, expected.size());
+        }
+        CHECK(barrier.broad_phases() == trees);  // every point above from the motion's candidates
+        // Off the motion (twice the step): a tree of its own, the same answer as brute force.
+        const Eigen::VectorXd beyond = u + 2.0 * du;
+        CHECK(found(beyond) == brute_force(beyond));
+        CHECK(barrier.broad_phases() == trees + 1);
+    }
+    CHECK(most > 10);  // the motions bring many pairs within d̂
+}
