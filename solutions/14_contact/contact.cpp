@@ -1,3 +1,7 @@
+// Chapter 14: the contact potential of one body against its obstacles (and, with self-contact, its
+// own surface) — the barriers, lagged friction and the obstacles' motion as one term of chapter 12's
+// Newton step (value, gradient, Hessian, the largest safe step) — and contact_step, the backward Euler
+// step that runs it. docs/14_contact.md#the-contact-potential
 #include "14_contact/contact.hpp"
 
 #include "14_contact/barrier.hpp"
