@@ -114,7 +114,7 @@ struct JitteredFloor {
 }  // namespace
 
 TEST_CASE("flat mesh: over a flat edge and a flat vertex a point feels the plane's one barrier, continuous and with "
-          "derivatives that central differences confirm")
+          "derivatives that central differences confirm", "[ex14.5]")
 {
     const JitteredFloor floor;
     const HalfSpace plane(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ());
@@ -176,7 +176,8 @@ TEST_CASE("flat mesh: over a flat edge and a flat vertex a point feels the plane
     CHECK(checked > 300);
 }
 
-TEST_CASE("flat mesh: round a corner of the floor's border and along its edges the barriers' sum stays continuous")
+TEST_CASE("flat mesh: round a corner of the floor's border and along its edges the barriers' sum stays continuous",
+          "[ex14.5]")
 {
     const JitteredFloor floor;
     const TriMesh& s = floor.mesh.surface();
@@ -195,7 +196,7 @@ TEST_CASE("flat mesh: round a corner of the floor's border and along its edges t
 }
 
 TEST_CASE("flat mesh: two triangles folded by less than the flat test's angle, either way, keep the sum continuous "
-          "across their edge")
+          "across their edge", "[ex14.5]")
 {
     for (const double fold : {5e-4, -5e-4}) {  // the sine of the angle: a valley (seen from +z) and a ridge
         TriMesh folded;
@@ -217,7 +218,7 @@ TEST_CASE("flat mesh: two triangles folded by less than the flat test's angle, e
 }
 
 TEST_CASE("flat mesh: in the bowl, whose quads are split into coplanar pairs between creases, the barriers' sum stays "
-          "continuous round every vertex")
+          "continuous round every vertex", "[ex14.5]")
 {
     const MeshObstacle bowl(io::read_tri_mesh(data_path("bowl.obj")));
     const TriMesh& s = bowl.surface();
@@ -244,7 +245,8 @@ TEST_CASE("flat mesh: in the bowl, whose quads are split into coplanar pairs bet
     CHECK(worst <= 1.01);
 }
 
-TEST_CASE("flat mesh: a block at rest on a floor of 2 or 200 triangles stays where it stands, as on the half-space")
+TEST_CASE("flat mesh: a block at rest on a floor of 2 or 200 triangles stays where it stands, as on the half-space",
+          "[ex14.8]")
 {
     BlockSettings settings;
     settings.time_step = 1.0 / 100.0;
@@ -293,7 +295,8 @@ TEST_CASE("flat mesh: a block at rest on a floor of 2 or 200 triangles stays whe
     }
 }
 
-TEST_CASE("flat mesh: a block sticking to a tilted floor of 1 m or 10 m of triangles creeps as on the half-space")
+TEST_CASE("flat mesh: a block sticking to a tilted floor of 1 m or 10 m of triangles creeps as on the half-space",
+          "[ex14.8]")
 {
     BlockSettings settings;
     settings.slope = 20.0 * degree;
