@@ -25,6 +25,7 @@
 #include <Eigen/Core>
 
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace fem::contact {
@@ -128,8 +129,10 @@ private:
     /// Whether triangle f's piece at p, of closest point q, is left out: q lies on (within same_point_,
     /// or, where flat triangles meet at a small angle, 2 flat_mesh_edge_sine |p − q|) an edge of f
     /// shared with a flat neighbour g, or at a corner of f whose flat fan holds g, and g's closest
-    /// point to p is nearer (|p − q_g| < |p − q|), or the same point or as near and g < f.
-    bool shadowed(int f, const Eigen::Vector3d& closest, const Eigen::Vector3d& p) const;
+    /// point to p is nearer (|p − q_g| < |p − q|), or the same point or as near and g < f. known: the
+    /// closest points to p already computed (triangle, point); g's is taken from there when it is.
+    bool shadowed(int f, const Eigen::Vector3d& closest, const Eigen::Vector3d& p,
+                  const std::vector<std::pair<int, TrianglePoint>>& known) const;
 
     TriMesh surface_;
     std::vector<Eigen::Matrix<double, 2, 3>> boxes_;  // per triangle, rows min and max

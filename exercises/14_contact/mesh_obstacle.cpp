@@ -278,11 +278,18 @@ Eigen::Matrix3d MeshObstacle::local_hessian(const Eigen::Vector3d& p) const
     return piece(n.triangle, n.closest, p).hessian;
 }
 
-bool MeshObstacle::shadowed(int f, const Eigen::Vector3d& closest, const Eigen::Vector3d& p) const
+bool MeshObstacle::shadowed(int f, const Eigen::Vector3d& closest, const Eigen::Vector3d& p,
+                            const std::vector<std::pair<int, TrianglePoint>>& known) const
 {
     const double distance = (p - closest).norm();
+    const auto point_of = [&](int other) {  // other's closest point: from known when it is there
+        for (const auto& [g, point] : known)
+            if (g == other)
+                return point.point;
+        return closest_on(other, p).point;
+    };
     const auto beats = [&](int other) {  // a nearer point of other, or as near (the same point) and a lower number
-        const Eigen::Vector3d point = closest_on(other, p).point;
+        const Eigen::Vector3d point = point_of(other);
         const double other_distance = (p - point).norm();
         if ((point - closest).norm() <= same_point_ || other_distance == distance)
             return other < f;
@@ -310,11 +317,14 @@ bool MeshObstacle::shadowed(int f, const Eigen::Vector3d& closest, const Eigen::
 
 void MeshObstacle::local_pieces(const Eigen::Vector3d& p, double reach, std::vector<DistancePiece>& pieces) const
 {
-    for (int f : triangles_meeting(p.array() - reach, p.array() + reach)) {
-        const TrianglePoint closest = closest_on(f, p);
-        if ((p - closest.point).norm() < reach && !shadowed(f, closest.point, p))
-            pieces.push_back(piece(f, closest, p));
-    }
+    // Each triangle's closest point once: the shadow test compares a triangle with its flat
+    // neighbours, which are mostly among these.
+    std::vector<std::pair<int, TrianglePoint>> closest;
+    for (int f : triangles_meeting(p.array() - reach, p.array() + reach))
+        closest.emplace_back(f, closest_on(f, p));
+    for (const auto& [f, point] : closest)
+        if ((p - point.point).norm() < reach && !shadowed(f, point.point, p, closest))
+            pieces.push_back(piece(f, point, p));
 }
 
 double MeshObstacle::local_time_of_impact(const Eigen::Vector3d& p, const Eigen::Vector3d& dp) const
