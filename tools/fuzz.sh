@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
-# Fuzzes the course's file readers and the scene reader: builds the fuzz preset (clang, libFuzzer +
-# ASan + UBSan; common/, fuzz/ and the solution files the scene reader reaches) and runs each
-# reader's target from its seed corpus (fuzz/corpus/<target>/) for a bounded time, as many targets
-# at once as there are cores. Exits 1 if any target found something, naming the input that caused it.
-# New inputs that reach new code are kept in build/fuzz/corpus/<target>/ for the next run.
+# Fuzzes the course's file readers and the scene reader: builds the fuzzers of the asan preset (clang,
+# libFuzzer + ASan + UBSan; the same build as the sanitizer stage's tests, fuzz/CMakeLists.txt) and
+# runs each reader's target from its seed corpus (fuzz/corpus/<target>/) for a bounded time, as many
+# targets at once as there are cores. Exits 1 if any target found something, naming the input that
+# caused it. New inputs that reach new code are kept in build/fuzz/corpus/<target>/ for the next run
+# (build/fuzz/ holds the runs' corpus, findings and logs; the fuzzers are build/asan/bin/fuzz_*).
 #
 #   tools/fuzz.sh                         every target, 15 s each (the CI stage of tools/test.sh)
 #   tools/fuzz.sh --seconds 3600 ply      one target for an hour
@@ -38,8 +39,8 @@ for format in "${formats[@]}"; do
     [ -d "fuzz/corpus/$format" ] || { echo "error: no fuzz target '$format'; allowed: $(ls fuzz/corpus | xargs)" >&2; exit 1; }
 done
 
-cmake --preset fuzz -DFEM_WERROR=ON >/dev/null
-cmake --build --preset fuzz -j "$JOBS"
+cmake --preset asan -DFEM_WERROR=ON >/dev/null
+cmake --build --preset asan --target fem_fuzzers -j "$JOBS"
 
 # One target per core at a time (JOBS, tools/common.sh): each is one libFuzzer process on one thread,
 # so each still runs its full time on a core of its own.
@@ -47,7 +48,7 @@ fuzz_target() {
     local format="$1" work="build/fuzz/corpus/$1" findings="build/fuzz/findings/$1" log="build/fuzz/fuzz_$1.log"
     local start=$SECONDS status=0
     mkdir -p "$work" "$findings"
-    "build/fuzz/bin/fuzz_$format" -max_total_time="$seconds" -runs="$runs" -timeout=10 \
+    "build/asan/bin/fuzz_$format" -max_total_time="$seconds" -runs="$runs" -timeout=10 \
         -rss_limit_mb=2048 -malloc_limit_mb=512 -detect_leaks=0 -max_len=8192 -print_final_stats=1 \
         -artifact_prefix="$findings/" "$work" "fuzz/corpus/$format" >"$log" 2>&1 || status=$?
     echo "$status $((SECONDS - start))" >"build/fuzz/result_$format"

@@ -18,7 +18,8 @@ packages=(
   libjs-three                             # three.js r111, inlined into the scenes' web pages (--html)
   chromium                                # the web page's browser test (headless; optional)
   time                                    # GNU time: the course's peak memory (docs/engineering.md)
-  clang-14 libclang-rt-14-dev             # the readers' fuzz targets (libFuzzer; tools/fuzz.sh)
+  clang-14 libclang-rt-14-dev             # the sanitizer build and the readers' fuzz targets (libFuzzer)
+  libomp-14-dev                           # OpenMP for clang (the sanitizer build)
 )
 
 missing=()

@@ -6,12 +6,13 @@
 #   2. exercises every chapter compiles from exercises/ (the stubs students start from)
 #   3. asan      under AddressSanitizer + UndefinedBehaviorSanitizer (and float-cast-overflow):
 #                the unit tests (but those tagged [slow], which stage 4 runs), and each
-#                executable's --quick run, bad command lines and the output-folder rule
+#                executable's --quick run, bad command lines and the output-folder rule; built with
+#                clang 14, which also builds stage 5's fuzzers in the same tree
 #   4. release   (the rest of build/release) every test passes on the reference solutions: unit
 #                tests, the layout and exercise-sync checks, each executable's --quick run against
 #                stored numbers, and each chapter's docs against its executable
 #   5. fuzz      every file reader's libFuzzer target runs 15 s from its seed corpus without a
-#                finding (tools/fuzz.sh; clang, ASan + UBSan)
+#                finding (tools/fuzz.sh; built by stage 3)
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 cd "$FEM_ROOT"

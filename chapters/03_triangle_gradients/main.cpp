@@ -98,8 +98,8 @@ void mesh_study(const RunContext& run, const Settings& settings)
     for (const auto& [name, mesh] : meshes) {
         const TriQuality quality = mesh_quality(mesh);
         SparseMatrix L, L_cot;
-        const double fem_seconds = best_time([&] { L = fem_laplacian(mesh.V, mesh.F); }, 0.1, 20);
-        const double cot_seconds = best_time([&] { L_cot = cotangent_laplacian(mesh.V, mesh.F); }, 0.1, 20);
+        const double fem_seconds = best_time([&, &mesh = mesh] { L = fem_laplacian(mesh.V, mesh.F); }, 0.1, 20);
+        const double cot_seconds = best_time([&, &mesh = mesh] { L_cot = cotangent_laplacian(mesh.V, mesh.F); }, 0.1, 20);
         const double scale = L.diagonal().cwiseAbs().maxCoeff();
         const double difference = SparseMatrix(L - L_cot).coeffs().cwiseAbs().maxCoeff() / scale;
         const double row_sums = (L * Eigen::VectorXd::Ones(L.cols())).cwiseAbs().maxCoeff() / scale;

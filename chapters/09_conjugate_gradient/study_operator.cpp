@@ -40,7 +40,7 @@ void operator_study(const RunContext& run, const Settings& settings)
         operators.front().second->apply(x, reference);
         for (const auto& [name, op] : operators) {
             Eigen::VectorXd y;
-            const double seconds = best_time([&] { op->apply(x, y); }, settings.seconds);
+            const double seconds = best_time([&, &op = op] { op->apply(x, y); }, settings.seconds);
             const double entries = name.find("lower") != std::string::npos
                                        ? double(sparse::lower_triangle(csr).nonzeros())
                                        : (name.find("matrix-free") != std::string::npos ? 0.0 : double(csr.nonzeros()));

@@ -193,12 +193,12 @@ void simulation_study(const RunContext& run, const Settings& settings)
                                       settings.seconds, 10);
         const MatrixX3d Q = carrier.body->positions(state.u);
         Skin skin;
-        const double build = best_time([&] { skin = build_skin(mesh, *surface); }, settings.seconds, 3);
+        const double build = best_time([&, &mesh = mesh, &surface = surface] { skin = build_skin(mesh, *surface); }, settings.seconds, 3);
         const Eigen::SparseMatrix<double, Eigen::RowMajor> W = sparse::to_eigen(skin.W);
         MatrixX3d x;
         const double hand = best_time([&] { x = skinned_positions(skin.W, Q); }, settings.seconds);
         const double eigen = best_time([&] { x = W * Q; }, settings.seconds);
-        const double normals = best_time([&] { (void)vertex_normals(surface->F, x); }, settings.seconds);
+        const double normals = best_time([&, &surface = surface] { (void)vertex_normals(surface->F, x); }, settings.seconds);
         frame.add_row({name, double(mesh.T.rows()), double(surface->V.rows()), double(skin.W.nonzeros()), build, hand, eigen,
                        normals, step, double(skin.outside.size()), skin.largest_outside_distance()});
     }

@@ -9,6 +9,7 @@ add_library(fem_scenes STATIC ${scene_sources})
 target_include_directories(fem_scenes PUBLIC ${FEM_ROOT}/chapters)
 target_link_libraries(fem_scenes PUBLIC fem_ch14_reference fem_ch13_reference fem_ch12_reference fem_ch11_reference fem_ch10_reference
                       PRIVATE tomlplusplus::tomlplusplus fem_flags)
+target_compile_options(fem_scenes PRIVATE ${FEM_FUZZ_FLAGS})  # the scene reader, fuzz_scene's ground
 
 add_executable(fem_scene ${FEM_ROOT}/chapters/scenes/main.cpp)
 target_link_libraries(fem_scene PRIVATE fem_scenes fem_flags)

@@ -12,7 +12,6 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
-#include <numbers>
 #include <utility>
 #include <vector>
 
@@ -25,7 +24,6 @@ using fem::test::entries_of;
 
 namespace {
 
-constexpr double pi = std::numbers::pi;
 constexpr Scheme implicit_schemes[] = {Scheme::implicit_euler, Scheme::crank_nicolson};
 
 /// The amplification factor of each scheme written out: z = cΔtλ.
