@@ -3,7 +3,8 @@ target_sources(${exe} PRIVATE
   ${FEM_ROOT}/chapters/14_contact/study_drop.cpp ${FEM_ROOT}/chapters/14_contact/study_slope.cpp
   ${FEM_ROOT}/chapters/14_contact/study_mesh.cpp ${FEM_ROOT}/chapters/14_contact/study_ccd.cpp
   ${FEM_ROOT}/chapters/14_contact/study_bowl.cpp ${FEM_ROOT}/chapters/14_contact/study_self.cpp
-  ${FEM_ROOT}/chapters/14_contact/study_bodies.cpp)
+  ${FEM_ROOT}/chapters/14_contact/study_bodies.cpp
+  ${FEM_ROOT}/chapters/14_contact/study_stack.cpp)
 
 # ctest ch14_ccd_queries: --ccd-queries alone (only the CCD study runs) on the project's copy of the
 # CCD benchmark's unit-test queries, its table against tests/14_contact/expected_ccd_queries.

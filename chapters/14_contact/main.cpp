@@ -20,7 +20,10 @@
 //      against the number of surface primitives;
 //   6. bodies against bodies, the cost: two coarse bunnies thrown at each other with self-contact,
 //      beside the same two without contact — per step the linear solves, the barrier with its broad
-//      phase and the collision check, momentum and the intersection check.
+//      phase and the collision check, momentum and the intersection check; Newton's tolerance
+//      loosened to 10⁻³, its iterations against the end state's offset;
+//   7. a stack at rest (three blocks, self-contact) against its closed form — the force between
+//      blocks against the weight above, the gaps against d̂ — swept over d̂ and Newton's tolerance.
 //
 // Sample runs:
 //   ch14_contact                                   full run
@@ -29,7 +32,8 @@
 //   ch14_contact --ccd-queries data/ccd-unit-tests/edge-edge/data_0_0.csv   CCD on one query file
 //
 // Writes (under out/14_contact): drop_table.csv, slope_table.csv, mesh_table.csv, bowl_table.csv,
-// ccd_queries_table.csv, self_broad_phase_table.csv, two_bunnies_table.csv, drop.pvd and bowl.pvd (frames drop/drop_NNNN.vtu, …), charts drop_height,
+// ccd_queries_table.csv, self_broad_phase_table.csv, two_bunnies_table.csv,
+// two_bunnies_tolerance_table.csv, stack_tolerance_table.csv, drop.pvd and bowl.pvd (frames drop/drop_NNNN.vtu, …), charts drop_height,
 // drop_force, slope_slide, slope_stick, slope_cost (.csv, .png, .svg) and the bowl's frames bowl_NNNN.png.
 // docs/14_contact.md
 
@@ -118,5 +122,6 @@ int main(int argc, char** argv)
         study::ccd_study(run, study::ccd_benchmark_files());
         study::self_contact_study(run);
         study::bodies_study(run);
+        study::stack_study(run);
     });
 }

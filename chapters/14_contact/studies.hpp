@@ -53,7 +53,13 @@ void bowl_study(const RunContext& run);
 void self_contact_study(const RunContext& run);
 /// Two coarse bunnies thrown at each other, with self-contact and without: per step the time in
 /// the linear solves, the barrier (with its broad phase) and the collision check, the momentum's
-/// drift, intersection-free or not; two_bunnies_table.csv (study_bodies.cpp).
+/// drift, intersection-free or not; two_bunnies_table.csv (study_bodies.cpp). Then the contact run
+/// with Newton's tolerance 10⁻³: its iterations and how far it ends from the default's;
+/// two_bunnies_tolerance_table.csv.
 void bodies_study(const RunContext& run);
+/// test_stack.cpp's three blocks settled on the floor for each d̂ and Newton tolerance: the force
+/// between blocks against the weight above, the gaps against d̂, the height against the tightest
+/// tolerance's, Newton iterations and time per step; stack_tolerance_table.csv (study_stack.cpp).
+void stack_study(const RunContext& run);
 
 }  // namespace fem::contact::study
