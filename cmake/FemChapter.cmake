@@ -77,6 +77,14 @@ function(fem_test_without_avx2 number test_exe)
   endif()
 endfunction()
 
+# fem_reference_code(target): target is reference code a student does not step through (common/,
+# a chapter's reference solution): without debug information when FEM_REFERENCE_DEBUG_INFO is OFF.
+function(fem_reference_code target)
+  if(NOT FEM_REFERENCE_DEBUG_INFO)
+    target_compile_options(${target} PRIVATE -g0)
+  endif()
+endfunction()
+
 function(fem_add_chapter number name)
   cmake_parse_arguments(PARSE_ARGV 2 CH "" "" "DEPENDS")
   set(id ${number}_${name})
@@ -134,8 +142,10 @@ function(fem_add_chapter number name)
     foreach(dep IN LISTS CH_DEPENDS)
       target_link_libraries(${lib}_reference PUBLIC fem_ch${dep}_reference)
     endforeach()
+    fem_reference_code(${lib}_reference)
   else()
     add_library(${lib}_reference ALIAS ${lib})
+    fem_reference_code(${lib})
   endif()
   add_dependencies(fem_chapter_libs ${lib})
 

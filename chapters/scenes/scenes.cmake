@@ -10,6 +10,7 @@ target_include_directories(fem_scenes PUBLIC ${FEM_ROOT}/chapters)
 target_link_libraries(fem_scenes PUBLIC fem_ch14_reference fem_ch13_reference fem_ch12_reference fem_ch11_reference fem_ch10_reference
                       PRIVATE tomlplusplus::tomlplusplus fem_flags)
 target_compile_options(fem_scenes PRIVATE ${FEM_FUZZ_FLAGS})  # the scene reader, fuzz_scene's ground
+fem_reference_code(fem_scenes)
 
 add_executable(fem_scene ${FEM_ROOT}/chapters/scenes/main.cpp)
 target_link_libraries(fem_scene PRIVATE fem_scenes fem_flags)
