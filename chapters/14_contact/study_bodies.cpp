@@ -8,6 +8,7 @@
 #include "14_contact/contact.hpp"
 #include "14_contact/intersections.hpp"
 #include "14_contact/studies.hpp"
+#include "14_contact/timed_contact.hpp"
 
 #include "12_hyperelastic_newton/force_models.hpp"
 #include "12_hyperelastic_newton/newton.hpp"
@@ -31,75 +32,6 @@
 
 namespace fem::contact::study {
 namespace {
-
-/// Chapter 09's solver (made by name), timed: the wall time of every prepare and solve summed.
-class TimedSolver final : public cg::LinearSolver {
-public:
-    explicit TimedSolver(std::unique_ptr<cg::LinearSolver> inner) : LinearSolver(inner->name()), inner_(std::move(inner)) {}
-    bool is_direct() const override { return inner_->is_direct(); }
-    double seconds = 0.0;
-    int orderings = 0;  ///< prepares with a new pattern (a new fill-reducing ordering and symbolic analysis)
-
-private:
-    void do_prepare(const Eigen::SparseMatrix<double>& A, bool same_pattern) override
-    {
-        orderings += same_pattern ? 0 : 1;
-        inner_->prepare(A);
-        seconds += inner_->stats().prepare_seconds;
-    }
-    int do_solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) override
-    {
-        inner_->solve(b, x);
-        seconds += inner_->stats().solve_seconds;
-        return inner_->stats().iterations;
-    }
-    std::unique_ptr<cg::LinearSolver> inner_;
-};
-
-/// call(), its wall time added to seconds.
-template <class Call>
-auto timed(double& seconds, Call call)
-{
-    const Timer timer;
-    auto result = call();
-    seconds += timer.seconds();
-    return result;
-}
-
-/// The contact potential, timed: its energy, gradient and Hessian (the barrier, each with its broad
-/// phase) and its largest safe step (the continuous collision check, with its own broad phase).
-class TimedContact final : public hyper::StepPotential {
-public:
-    explicit TimedContact(ContactPotential& contact) : contact_(contact) {}
-    void begin_step(dynamics::Body& body, const dynamics::State& state, double time_step) override
-    {
-        const Timer timer;
-        contact_.begin_step(body, state, time_step);
-        barrier_seconds += timer.seconds();
-    }
-    double energy(const Eigen::VectorXd& u) const override { return timed(barrier_seconds, [&] { return contact_.energy(u); }); }
-    Eigen::VectorXd gradient(const Eigen::VectorXd& u) const override
-    {
-        return timed(barrier_seconds, [&] { return contact_.gradient(u); });
-    }
-    dynamics::SparseMatrix hessian(const Eigen::VectorXd& u) const override
-    {
-        return timed(barrier_seconds, [&] { return contact_.hessian(u); });
-    }
-    double largest_safe_step(const Eigen::VectorXd& u, const Eigen::VectorXd& du) const override
-    {
-        return timed(collision_seconds, [&] { return contact_.largest_safe_step(u, du); });
-    }
-    Eigen::VectorXd start_velocity(const dynamics::Body& body, const dynamics::State& state,
-                                   double time_step) const override
-    {
-        return timed(collision_seconds, [&] { return contact_.start_velocity(body, state, time_step); });
-    }
-    mutable double barrier_seconds = 0.0, collision_seconds = 0.0;
-
-private:
-    ContactPotential& contact_;
-};
 
 /// What one run of the two bunnies measured.
 struct BunnyRun {
@@ -205,7 +137,7 @@ void bodies_study(const RunContext& run)
         }
         result.u = state.u;
         result.solve_seconds = solver ? solver->seconds : 0.0;
-        result.orderings = solver ? solver->orderings : 0;
+        result.orderings = solver ? solver->new_patterns : 0;
         result.broad_phases = contact ? contact->self_barrier()->broad_phases() : 0;
         if (timed) {
             result.barrier_seconds = timed->barrier_seconds;

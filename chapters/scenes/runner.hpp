@@ -14,6 +14,7 @@
 // divergence; the runner adds the body's name to its message. Frames (every 1/frame_rate s) merge
 // every body into one mesh; a skin (chapter 13) is one more observer of its body's frames.
 
+#include "scenes/contact_cost.hpp"
 #include "scenes/live_view.hpp"
 #include "scenes/model_auto.hpp"
 #include "scenes/scene_file.hpp"
@@ -56,6 +57,9 @@ struct RunResult {
     std::vector<std::vector<MatrixX3d>> frames;
     /// per body: chapter 10's record of every step (step 0 first): energies, work in, dissipation
     std::vector<std::vector<dynamics::StepRecord>> records;
+    /// every step (from step 1) of every group of bodies with contact, in the order taken: its
+    /// time split and pairs (contact_cost.hpp; contact_steps.csv and contact_cost.csv)
+    std::vector<ContactStepRecord> contact_records;
     int frame_count = 0;
 };
 
@@ -88,7 +92,8 @@ struct RunOptions {
 /// Runs a scene (header comment), writing (when options.run is set) the outputs the scene asks for:
 /// <name>.pvd with its .vtu frames, PNG frames <name>_NNNN.png, a video <name>.mp4/.gif (ffmpeg; a
 /// one-line notice without it), steps.csv and the charts energies, step_time and newton_iterations,
-/// and with output.html the web page <name>.html (web_page.hpp).
+/// and with output.html the web page <name>.html (web_page.hpp); with contact, contact_steps.csv and
+/// contact_cost.csv (contact_cost.hpp; the latter printed too).
 /// A stop signal (fem::stop_requested, common/interrupt.hpp) stops after the current step with every
 /// file so far valid. fem::Error when a step fails or the run diverges (naming body, step, time and
 /// model). docs/scenes.md#the-runner

@@ -13,10 +13,12 @@
 // cancel), so the line search could not tell a decrease from noise (the rule that refuses model
 // linear with obstacles, applied to auto's choice of the moment).
 
+#include "scenes/contact_cost.hpp"
 #include "scenes/model_auto.hpp"
 #include "scenes/scene_file.hpp"
 
 #include "14_contact/contact.hpp"
+#include "14_contact/timed_contact.hpp"
 
 #include "12_hyperelastic_newton/newton.hpp"
 
@@ -72,12 +74,28 @@ public:
     /// Whether the last step needed contact.
     bool last_contact() const { return last_contact_; }
     const contact::ContactPotential& potential() const { return *potential_; }
+    /// The last step's time in the barrier, the collision check and the linear solves, and its new
+    /// matrix patterns (contact_cost.hpp; chapter 14's TimedContact and TimedSolver around the
+    /// contact step's potential and solver): zeros when it was out of contact.
+    const ContactStepCost& last_cost() const { return last_cost_; }
+    /// The contact pairs at u (3n) at time t (contact_cost.hpp): the self-contact barrier's pairs
+    /// within d̂ by kind, and the surface vertices closer than d̂ to each obstacle (one pair per
+    /// vertex and obstacle). fem::Error on u's size.
+    ContactPairs pairs(const Eigen::VectorXd& u, double time) const;
+    /// The surface primitives of the body's mesh: its surface vertices, edges and triangles.
+    int surface_primitives() const;
 
 private:
     dynamics::Integrator& own_;
     std::vector<SceneForces*> levels_;
+    std::vector<std::shared_ptr<const contact::Obstacle>> obstacles_;
     std::unique_ptr<contact::ContactPotential> potential_;
+    contact::TimedContact timed_;              // potential_, timed; Newton's potential
+    contact::TimedSolver* solver_ = nullptr;  // Newton's solver, timed (owned by newton_)
     hyper::NewtonBackwardEuler newton_;
+    contact::SurfacePrimitives surface_;
+    MatrixX3d rest_;  // the body's rest positions (#V×3)
+    ContactStepCost last_cost_;
     int contact_steps_ = 0;
     bool last_contact_ = false;
 };

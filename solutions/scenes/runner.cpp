@@ -316,6 +316,27 @@ void step_group(GroupRun& g)
     }
 }
 
+/// The record of a group's last step when it has contact (else none): its split from its
+/// ContactIntegrator, its pairs at the step's end (counted outside the step's time).
+void record_contact(const GroupRun& g, std::vector<ContactStepRecord>& records)
+{
+    if (g.contact == nullptr)
+        return;
+    ContactStepRecord r;
+    const dynamics::State& state = g.simulation->state();
+    r.step = state.step;
+    r.time = state.time;
+    for (const BodyRun* m : g.members)
+        r.bodies += str(r.bodies.empty() ? "" : "+", m->spec->name);
+    r.surface_primitives = g.contact->surface_primitives();
+    r.contact = g.contact->last_contact();
+    r.seconds = g.simulation->last().seconds;
+    r.newton_iterations = g.simulation->last().newton_iterations;
+    r.cost = g.contact->last_cost();
+    r.pairs = g.contact->pairs(state.u, state.time);
+    records.push_back(std::move(r));
+}
+
 /// Sets each body's pull from request (stiffness 0: the body's default), printing a line when a
 /// pull starts, moves to another vertex or ends.
 void update_pulls(std::vector<BodyRun>& bodies, const PullRequest& request, double stiffness)
@@ -454,6 +475,7 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
         int newton = 0;
         for (std::unique_ptr<GroupRun>& g : groups) {
             step_group(*g);
+            record_contact(*g, result.contact_records);
             newton += g->simulation->last().newton_iterations;
         }
         if (groups.size() > 1 && scene.contact.bodies) {
@@ -494,6 +516,15 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
         history.write_csv(run->file("steps.csv"));
     if (scene.output.charts)
         history.save_charts(scene, bodies.size(), *run);
+    if (!result.contact_records.empty()) {
+        const Table cost = contact_cost_table(result.contact_records);
+        std::cout << "\n";
+        cost.print(std::cout);
+        if (scene.output.csv) {
+            contact_steps_table(result.contact_records).write_csv(run->file("contact_steps.csv"));
+            cost.write_csv(run->file("contact_cost.csv"));
+        }
+    }
     if (page) {
         const std::filesystem::path file = run->file(stem + ".html");
         const Eigen::Vector3d bound = page->write(file, result.records);

@@ -3,6 +3,8 @@
 
 #include "12_hyperelastic_newton/force_models.hpp"
 
+#include "common/error.hpp"
+
 #include <algorithm>
 
 namespace fem::scenes {
@@ -30,11 +32,18 @@ contact::ContactOptions contact_options(const SceneSpec& scene, bool self_contac
     return options;
 }
 
-hyper::NewtonOptions contact_newton_options(const SceneSpec& scene)
+/// Newton's options for a contact step: the scene's solver, made timed (*timed receives it when
+/// Newton makes it) and its tolerance, contact_newton_iterations.
+hyper::NewtonOptions contact_newton_options(const SceneSpec& scene, contact::TimedSolver** timed)
 {
     hyper::NewtonOptions options =
         hyper::newton_options_for({.solver = scene.solver, .newton_tolerance = scene.newton_tolerance});
     options.max_iterations = contact_newton_iterations;
+    options.make_solver = [make = options.make_solver, name = options.solver, timed] {
+        auto solver = std::make_unique<contact::TimedSolver>(make ? make() : cg::make_solver(name));
+        *timed = solver.get();
+        return solver;
+    };
     return options;
 }
 
@@ -47,17 +56,45 @@ ContactIntegrator::ContactIntegrator(dynamics::Integrator& own, std::vector<Scen
                                      std::vector<bool> self_contacts)
     : own_(own),
       levels_(std::move(levels)),
+      obstacles_(obstacles),
       potential_(std::make_unique<contact::ContactPotential>(
           body, std::move(obstacles),
           contact_options(scene, self_contact, std::move(vertex_body), std::move(self_contacts)))),
-      newton_(contact_newton_options(scene))
+      timed_(*potential_),
+      newton_(contact_newton_options(scene, &solver_)),
+      surface_(contact::surface_primitives(body.mesh())),
+      rest_(body.mesh().V)
 {
-    newton_.set_potential(potential_.get());
+    newton_.set_potential(&timed_);
+}
+
+ContactPairs ContactIntegrator::pairs(const Eigen::VectorXd& u, double time) const
+{
+    if (u.size() != 3 * rest_.rows())
+        throw Error(str("ContactIntegrator::pairs: u has ", u.size(), " entries, expected 3 x ", rest_.rows(),
+                        " vertices"));
+    ContactPairs counted;
+    if (const contact::SelfContactBarrier* self = potential_->self_barrier())
+        for (const contact::SurfacePair& pair : self->pairs(u, false))
+            ++(pair.kind == contact::PrimitivePair::point_triangle ? counted.point_triangle : counted.edge_edge);
+    const double reach = potential_->options().activation_distance;
+    for (int v : surface_.vertices) {
+        const Eigen::Vector3d x = rest_.row(v).transpose() + u.segment<3>(3 * v);
+        for (const auto& obstacle : obstacles_)
+            counted.vertex_obstacle += obstacle->distance(x, time) < reach ? 1 : 0;
+    }
+    return counted;
+}
+
+int ContactIntegrator::surface_primitives() const
+{
+    return static_cast<int>(surface_.vertices.size() + surface_.edges.rows() + surface_.triangles.rows());
 }
 
 dynamics::StepInfo ContactIntegrator::step(dynamics::Body& body, double time_step, dynamics::State& state)
 {
     const double end = state.time + time_step;
+    last_cost_ = {};
     // Near an obstacle at the start already: contact at once, without trying the own step.
     if (potential_->out_of_contact(state.u, state.time, state.u, end)) {
         dynamics::State trial = state;
@@ -83,8 +120,13 @@ dynamics::StepInfo ContactIntegrator::step(dynamics::Body& body, double time_ste
                 return true;
             },
             body, state, end);
+    const double barrier = timed_.barrier_seconds, collision = timed_.collision_seconds;
+    const double solves = solver_->seconds;
+    const int patterns = solver_->new_patterns;
     dynamics::StepInfo info = contact::contact_step(newton_, *potential_, body, time_step, state);
     info.boundary_work += model_change;
+    last_cost_ = {timed_.barrier_seconds - barrier, timed_.collision_seconds - collision, solver_->seconds - solves,
+                  solver_->new_patterns - patterns};
     return info;
 }
 
