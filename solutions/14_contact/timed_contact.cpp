@@ -19,7 +19,10 @@ auto timed(double& seconds, Call call)
 
 }  // namespace
 
-TimedSolver::TimedSolver(std::unique_ptr<cg::LinearSolver> inner) : LinearSolver(inner->name()), inner_(std::move(inner)) {}
+TimedSolver::TimedSolver(std::unique_ptr<cg::LinearSolver> inner)
+    : LinearSolver(inner->name(), inner->options()), inner_(std::move(inner))
+{
+}
 
 void TimedSolver::do_prepare(const Eigen::SparseMatrix<double>& A, bool same_pattern)
 {
@@ -30,6 +33,8 @@ void TimedSolver::do_prepare(const Eigen::SparseMatrix<double>& A, bool same_pat
 
 int TimedSolver::do_solve(const Eigen::VectorXd& b, Eigen::VectorXd& x)
 {
+    // The tolerance set on this (inexact Newton sets one per solve) is the inner solver's.
+    inner_->set_relative_tolerance(options().relative_tolerance);
     inner_->solve(b, x);
     seconds += inner_->stats().solve_seconds;
     return inner_->stats().iterations;
