@@ -118,7 +118,8 @@ public:
     /// μλ T [ (f₁'(y) y − f₁(y))/y³ · s sᵀ + f₁(y)/y · I₂ ] Tᵀ; the sum is projected once
     /// (chapter 12's project_to_psd): b' ∇²d of a sphere is negative semi-definite; plus the
     /// features' and self-contact's pair blocks (each projected) and the body friction pairs' 12×12
-    /// blocks (PSD as they are, BodyFriction::add_hessian).
+    /// blocks (PSD as they are, BodyFriction::add_hessian); with self_contact in the step's anticipated
+    /// pattern (explicit zeros, SelfContactBarrier::anticipated_pattern: no value changes).
     dynamics::SparseMatrix hessian(const Eigen::VectorXd& u) const override;
     /// min(1, safety × the earliest time of impact of any surface vertex's path x_v + s·Δx_v, of the
     /// features' pairs and (self_contact) of the surface pairs, SelfContactBarrier::time_of_impact).

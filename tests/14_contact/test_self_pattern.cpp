@@ -6,6 +6,7 @@
 
 #include "contact_bodies.hpp"
 
+#include "12_hyperelastic_newton/force_models.hpp"
 #include "12_hyperelastic_newton/newton.hpp"
 
 #include "09_conjugate_gradient/linear_solver.hpp"
@@ -15,6 +16,7 @@
 #include <Eigen/Core>
 #include <Eigen/Sparse>
 
+#include <limits>
 #include <memory>
 #include <set>
 #include <utility>
@@ -153,4 +155,19 @@ TEST_CASE("self-contact's anticipated pattern: one matrix pattern a step while p
     CHECK(plain_most > 1);         // pairs arrived within a step: the plain Hessian changed its pattern
     CHECK(anticipated_most == 1);  // the anticipated one kept the step's first
     CHECK(anticipated.contact->smallest_distance(anticipated.state.u) < 1e-3);  // they met, within d̂
+}
+
+TEST_CASE("self-contact's anticipated pattern refuses a negative or non-finite reach", "[self][ex14.9]")
+{
+    const TetMesh mesh = Approach::mesh();
+    const dynamics::Body body(test::free_scene(mesh), hyper::make_force_model("stable-neo-hookean", mesh, {1e5, 0.3, 1000.0}));
+    for (double reach : {-1.0, std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN()}) {
+        INFO("pattern reach " << reach);
+        CHECK_THROWS_WITH(ContactPotential(body, {}, Approach::options(reach)),
+                          Catch::Contains("anticipated Hessian pattern must be >= 0"));
+    }
+    SelfContactBarrier barrier(mesh, 1e-3);
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(3 * mesh.V.rows());
+    CHECK_THROWS_WITH(barrier.anticipate(zero, zero, -1e-3), Catch::Contains("must be a finite number >= 0"));
+    CHECK_THROWS_WITH(barrier.anticipate(zero, Eigen::VectorXd::Zero(3), 1e-3), Catch::Contains("the predicted motion"));
 }
