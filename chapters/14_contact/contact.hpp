@@ -60,6 +60,14 @@ struct ContactOptions {
     /// two bodies always hold each other off (SelfContactBarrier).
     std::vector<int> vertex_body;
     std::vector<bool> body_self_contact;
+    /// With self_contact, the reach of the Hessian's anticipated pattern as a multiple of d̂: at each
+    /// begin_step the pattern takes the vertex blocks of every pair of surface primitives whose boxes,
+    /// swept over the step's predicted motion (xᵗ to xᵗ + Δt vᵗ), come within pattern_reach × d̂
+    /// (SelfContactBarrier::anticipate; zeros where no pair is within d̂), so pairs that arrive
+    /// during the step's Newton iterations find their blocks there and the matrix keeps its pattern
+    /// (one ordering and symbolic analysis a step instead of one per arrival). The values do not
+    /// change. 0: only the pairs within d̂. docs/14_contact.md#bodies-against-bodies-the-cost
+    double pattern_reach = 1.0;
     /// A debug check: at every configuration the energy is asked of (each Newton iterate and each
     /// line-search trial), no body edge meets a triangle of an obstacle with edges (a box, a mesh), no
     /// such obstacle's edge a body triangle, and, with self_contact, no body edge a body triangle
@@ -86,7 +94,8 @@ public:
     /// with options.self_contact, its surface primitives against each other (SelfContactBarrier).
     /// fem::Error for no obstacle without self_contact, d̂ ≤ 0, κ < 0, a safety outside (0, 1),
     /// ε_v ≤ 0, ε_d < 0, a body_friction < 0 or > 0 without self_contact, and, with self_contact,
-    /// two surface primitives that share no vertex closer than d̂ at rest (their barrier would push the body at rest: a smaller d̂ is needed).
+    /// two surface primitives that share no vertex closer than d̂ at rest (their barrier would push the body at rest: a smaller d̂ is needed),
+    /// or a pattern_reach not a finite number ≥ 0.
     ContactPotential(const dynamics::Body& body, std::vector<std::shared_ptr<const Obstacle>> obstacles,
                      ContactOptions options = {});
 
@@ -95,7 +104,8 @@ public:
     /// ∇B) clamped to [κ_min, κ_max] (B: the unit-κ barrier sum, over free dofs); later κ doubles,
     /// up to κ_max, when the smallest distance is below ε_d and smaller than at the last step); the
     /// friction pairs from x_vᵗ (FrictionPair) and, with body_friction, the body's own pairs within d̂
-    /// (BodyFriction::lag, sticking to xᵗ).
+    /// (BodyFriction::lag, sticking to xᵗ); with self_contact, the Hessian's anticipated pattern
+    /// (ContactOptions::pattern_reach).
     void begin_step(dynamics::Body& body, const dynamics::State& state, double time_step) override;
 
     /// P(u) of the header [J] (+∞ when some surface vertex has d ≤ 0).
@@ -108,7 +118,8 @@ public:
     /// μλ T [ (f₁'(y) y − f₁(y))/y³ · s sᵀ + f₁(y)/y · I₂ ] Tᵀ; the sum is projected once
     /// (chapter 12's project_to_psd): b' ∇²d of a sphere is negative semi-definite; plus the
     /// features' and self-contact's pair blocks (each projected) and the body friction pairs' 12×12
-    /// blocks (PSD as they are, BodyFriction::add_hessian).
+    /// blocks (PSD as they are, BodyFriction::add_hessian); with self_contact in the step's anticipated
+    /// pattern (explicit zeros, SelfContactBarrier::anticipated_pattern: no value changes).
     dynamics::SparseMatrix hessian(const Eigen::VectorXd& u) const override;
     /// min(1, safety × the earliest time of impact of any surface vertex's path x_v + s·Δx_v, of the
     /// features' pairs and (self_contact) of the surface pairs, SelfContactBarrier::time_of_impact).

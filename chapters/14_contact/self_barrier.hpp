@@ -23,6 +23,13 @@
 // instead of a tree of its own. Exact: a pair within d̂ at such an x has its vertices' boxes within
 // d̂ of each other in every axis, so its swept boxes, grown by d̂ + 2δ, meet. At any other x the
 // tree is built there, as before.
+//
+// The Hessian's pattern (anticipate): a pair's block appears in the Hessian when the pair comes
+// within d̂, so pairs arriving over a step's Newton iterations give its matrix a new sparsity
+// pattern each (a new ordering and symbolic analysis in chapter 09's direct solver). anticipate fixes
+// for the step the vertex blocks of every candidate pair within a larger reach over the step's
+// predicted motion, as a matrix of explicit zeros the Hessian adds, which fills none of them.
+// The values are unchanged (a zero added to a sum changes no bit); only the pattern holds more.
 
 #include "14_contact/broad_phase.hpp"
 #include "14_contact/ccd.hpp"
@@ -87,6 +94,14 @@ public:
     /// motion's candidates within d̂ for the energy, gradient and Hessian that follow (header).
     /// fem::Error on sizes.
     double time_of_impact(const Eigen::VectorXd& u, const Eigen::VectorXd& du) const;
+    /// Fixes the pattern anticipated_pattern holds from now on: the 3×3 blocks (a, b) of every two
+    /// of the 4 vertices of each candidate pair (tree_candidates, a = b too) whose vertices' boxes,
+    /// swept from X + u to X + u + motion (3n each), come within reach [m] of each other (header).
+    /// reach = 0: none. fem::Error on sizes, or reach not a finite number ≥ 0.
+    void anticipate(const Eigen::VectorXd& u, const Eigen::VectorXd& motion, double reach);
+    /// anticipate's blocks as a 3n×3n matrix of explicit zeros (empty before anticipate): added to
+    /// the Hessian (ContactPotential::hessian), it changes no value and holds the pattern.
+    const Eigen::SparseMatrix<double>& anticipated_pattern() const { return anticipated_; }
     /// How many trees the broad phase has built since construction (each call of energy, gradient,
     /// Hessian, pairs or smallest_distance whose x lies outside the last motion's boxes, and each
     /// time_of_impact): what the motion's candidates save.
@@ -114,6 +129,7 @@ private:
     };
     mutable MotionCandidates motion_;
     mutable long long broad_phases_ = 0;
+    Eigen::SparseMatrix<double> anticipated_;  // anticipate's vertex blocks, zeros
 
     MatrixX3d rest_;
     double activation_distance_;

@@ -1,7 +1,9 @@
 // Study 6 of ch14_contact: what contact between bodies costs — two coarse bunnies thrown at each
 // other, stepped as one mesh with self-contact and, side by side, the same two bunnies without
-// contact (they pass through each other); per step the time in the contact potential (its barrier
-// with the broad phase, and its continuous collision check) against the time in the linear solves,
+// contact (they pass through each other), and the contact run again with the Hessian's pattern of
+// the pairs within d̂ alone (ContactOptions::pattern_reach = 0: a new pattern as pairs arrive); per
+// step the time in the contact potential (its barrier with the broad phase, and its continuous
+// collision check) against the time in the linear solves,
 // with the momentum kept and the surface checked for intersections at every step; then the contact
 // run again with Newton's tolerance loosened, its iterations against the end state's offset.
 // docs/14_contact.md#bodies-against-bodies-the-cost
@@ -36,6 +38,7 @@ namespace {
 /// What one run of the two bunnies measured.
 struct BunnyRun {
     int steps = 0, newton_iterations = 0, orderings = 0;
+    double nonzeros = 0.0;       ///< of the matrices Newton solved with, on average
     long long broad_phases = 0;  ///< trees the self-contact barrier built (SelfContactBarrier::broad_phases)
     double seconds = 0.0, solve_seconds = 0.0, barrier_seconds = 0.0, collision_seconds = 0.0;
     double momentum_drift = 0.0;  ///< the largest |Σ m v| over the run, relative to Σ m |v₀|
@@ -92,7 +95,7 @@ void bodies_study(const RunContext& run)
     options.self_contact = true;
     options.activation_distance = 1e-3;
 
-    const auto one_run = [&](bool with_contact, double tolerance) {
+    const auto one_run = [&](bool with_contact, double tolerance, double pattern_reach) {
         dynamics::Body body(scene, hyper::make_force_model("stable-neo-hookean", scene.mesh, scene.material));
         TimedSolver* solver = nullptr;
         hyper::NewtonOptions newton_options;
@@ -107,7 +110,9 @@ void bodies_study(const RunContext& run)
         std::unique_ptr<ContactPotential> contact;
         std::unique_ptr<TimedContact> timed;
         if (with_contact) {
-            contact = std::make_unique<ContactPotential>(body, std::vector<std::shared_ptr<const Obstacle>>{}, options);
+            ContactOptions run_options = options;
+            run_options.pattern_reach = pattern_reach;
+            contact = std::make_unique<ContactPotential>(body, std::vector<std::shared_ptr<const Obstacle>>{}, run_options);
             timed = std::make_unique<TimedContact>(*contact);
             newton.set_potential(timed.get());
         }
@@ -138,6 +143,7 @@ void bodies_study(const RunContext& run)
         result.u = state.u;
         result.solve_seconds = solver ? solver->seconds : 0.0;
         result.orderings = solver ? solver->new_patterns : 0;
+        result.nonzeros = solver && solver->prepares > 0 ? solver->nonzeros / solver->prepares : 0.0;
         result.broad_phases = contact ? contact->self_barrier()->broad_phases() : 0;
         if (timed) {
             result.barrier_seconds = timed->barrier_seconds;
@@ -146,12 +152,15 @@ void bodies_study(const RunContext& run)
         return result;
     };
     const double tolerance = hyper::NewtonOptions{}.relative_tolerance;  // 10⁻⁶, every other table's
-    const BunnyRun contact_run = one_run(true, tolerance), free_run = one_run(false, tolerance);
+    const double reach = ContactOptions{}.pattern_reach;  // the Hessian's anticipated pattern, in d̂
+    const BunnyRun contact_run = one_run(true, tolerance, reach), unanticipated_run = one_run(true, tolerance, 0.0),
+                   free_run = one_run(false, tolerance, reach);
 
     Table table(str(run.quick ? "Two blocks (2 x 64 vertices)" : "Two coarse bunnies (2 x 2,199 vertices)",
                     " thrown at each other at 1 m/s, spinning: per step, with self-contact and without"),
                 {{"run", Format::text}, {"steps", Format::integer}, {"Newton iterations", Format::integer},
-                 {"new matrix patterns", Format::integer}, {"broad phases", Format::integer},
+                 {"new matrix patterns", Format::integer}, {"matrix nonzeros", Format::scientific, 2},
+                 {"broad phases", Format::integer},
                  {"time per step [ms]", Format::fixed, 1}, {"linear solves [ms]", Format::fixed, 1},
                  {"barrier and broad phase [ms]", Format::fixed, 1}, {"collision check [ms]", Format::fixed, 1},
                  {"step time / without contact [measured]", Format::fixed, 2},
@@ -160,12 +169,13 @@ void bodies_study(const RunContext& run)
     const auto row = [&](const char* name, const BunnyRun& r) {
         const double per = 1e3 / r.steps;
         table.add_row({std::string(name), double(r.steps), double(r.newton_iterations), double(r.orderings),
-                       double(r.broad_phases), per * r.seconds,
+                       r.nonzeros, double(r.broad_phases), per * r.seconds,
                        per * r.solve_seconds, per * r.barrier_seconds, per * r.collision_seconds,
                        r.seconds / free_run.seconds, r.momentum_drift,
                        std::string(&r == &free_run ? "(passes through)" : r.intersection_free ? "yes" : "NO")});
     };
     row("self-contact", contact_run);
+    row("self-contact, pattern of the pairs within dhat", unanticipated_run);
     row("no contact", free_run);
     table.print(std::cout);
     table.write_csv(run.file("two_bunnies_table.csv"));
@@ -184,7 +194,7 @@ void bodies_study(const RunContext& run)
                  {"closest distance / dhat", Format::scientific, 1}, {"momentum drift [round-off]", Format::scientific, 1},
                  {"intersection-free", Format::text}});
     for (double loose_tolerance : {tolerance, 1e-3}) {
-        const BunnyRun r = loose_tolerance == tolerance ? contact_run : one_run(true, loose_tolerance);
+        const BunnyRun r = loose_tolerance == tolerance ? contact_run : one_run(true, loose_tolerance, reach);
         loose.add_row({loose_tolerance, double(r.newton_iterations), double(r.orderings), 1e3 * r.seconds / r.steps,
                        1e3 * r.solve_seconds / r.steps, r.seconds / free_run.seconds,
                        (r.u - contact_run.u).lpNorm<Eigen::Infinity>() / options.activation_distance,

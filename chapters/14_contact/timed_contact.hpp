@@ -34,6 +34,8 @@ public:
 
     double seconds = 0.0;  ///< prepares and solves so far [s]
     int new_patterns = 0;  ///< prepares with a new pattern so far
+    int prepares = 0;      ///< prepares so far
+    double nonzeros = 0.0; ///< the stored entries of the matrices prepared so far, summed
 
 private:
     void do_prepare(const Eigen::SparseMatrix<double>& A, bool same_pattern) override;

@@ -77,6 +77,9 @@ ContactPotential::ContactPotential(const dynamics::Body& body, std::vector<std::
     if (options_.body_friction > 0.0 && !options_.self_contact)
         throw Error(str("contact: friction between bodies (", options_.body_friction,
                         ") needs self-contact on: without it no pair of the body's surface is held"));
+    if (!(std::isfinite(options_.pattern_reach) && options_.pattern_reach >= 0.0))
+        throw Error(str("contact: the reach of the anticipated Hessian pattern must be >= 0 (a multiple of d̂; 0: none), got ",
+                        options_.pattern_reach));
     if (!(std::isfinite(options_.doubling_distance) && options_.doubling_distance >= 0.0))
         throw Error(str("contact: the doubling distance must be >= 0, got ", options_.doubling_distance));
     surface_ = surface_primitives(body.mesh()).vertices;
@@ -195,6 +198,8 @@ void ContactPotential::begin_step(dynamics::Body& body, const dynamics::State& s
     if (self_)
         body_friction_.lag(options_.body_friction > 0.0 ? self_->pairs(lag, false) : std::vector<SurfacePair>{}, lag,
                            state.u, stiffness_, options_.body_friction, options_.activation_distance);
+    if (self_)
+        self_->anticipate(state.u, time_step * state.v, options_.pattern_reach * options_.activation_distance);
     lag_u_.resize(0);
 }
 
@@ -362,6 +367,8 @@ dynamics::SparseMatrix ContactPotential::hessian(const Eigen::VectorXd& u) const
     body_friction_.add_hessian(u, friction_step_, triplets);
     dynamics::SparseMatrix H(u.size(), u.size());
     H.setFromTriplets(triplets.begin(), triplets.end());
+    if (self_ && self_->anticipated_pattern().nonZeros() > 0)
+        H += self_->anticipated_pattern();  // explicit zeros: the step's pattern, every value as it was
     return H;
 }
 

@@ -161,6 +161,38 @@ void SelfContactBarrier::add_hessian(const Eigen::VectorXd& u, double stiffness,
         throw Error("self-contact: the Hessian of the barrier was asked where two surface primitives touch (d = 0)");
 }
 
+void SelfContactBarrier::anticipate(const Eigen::VectorXd& u, const Eigen::VectorXd& motion, double reach)
+{
+    if (!(std::isfinite(reach) && reach >= 0.0))
+        throw Error(str("self-contact: the reach of the anticipated pattern must be a finite number >= 0 [m], got ", reach));
+    const MatrixX3d start = moved(rest_, u, "the displacement u");
+    const MatrixX3d end = moved(start, motion, "the predicted motion");
+    anticipated_ = Eigen::SparseMatrix<double>(u.size(), u.size());
+    if (reach == 0.0)
+        return;
+    ++broad_phases_;
+    const CandidatePairs candidates = kept(tree_candidates(surface_, start, end, reach));
+    std::vector<std::array<int, 2>> blocks;  // (a, b) for every two vertices of a candidate pair
+    const auto add = [&](const int (&v)[4]) {
+        for (int a : v)
+            for (int b : v)
+                blocks.push_back({a, b});
+    };
+    for (const auto& [vertex, triangle] : candidates.point_triangle)
+        add({vertex, surface_.triangles(triangle, 0), surface_.triangles(triangle, 1), surface_.triangles(triangle, 2)});
+    for (const auto& [first, second] : candidates.edge_edge)
+        add({surface_.edges(first, 0), surface_.edges(first, 1), surface_.edges(second, 0), surface_.edges(second, 1)});
+    std::sort(blocks.begin(), blocks.end());
+    blocks.erase(std::unique(blocks.begin(), blocks.end()), blocks.end());
+    std::vector<Eigen::Triplet<double>> zeros;
+    zeros.reserve(9 * blocks.size());
+    for (const auto& [a, b] : blocks)
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j)
+                zeros.emplace_back(3 * a + i, 3 * b + j, 0.0);
+    anticipated_.setFromTriplets(zeros.begin(), zeros.end());
+}
+
 std::vector<SurfacePair> SelfContactBarrier::pairs(const Eigen::VectorXd& u, bool with_derivatives) const
 {
     std::vector<SurfacePair> within;

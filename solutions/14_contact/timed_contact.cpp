@@ -27,6 +27,8 @@ TimedSolver::TimedSolver(std::unique_ptr<cg::LinearSolver> inner)
 void TimedSolver::do_prepare(const Eigen::SparseMatrix<double>& A, bool same_pattern)
 {
     new_patterns += same_pattern ? 0 : 1;
+    ++prepares;
+    nonzeros += double(A.nonZeros());
     inner_->prepare(A);
     seconds += inner_->stats().prepare_seconds;
 }

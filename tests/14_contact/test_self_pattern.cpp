@@ -1,0 +1,173 @@
+// Chapter 14: the self-contact Hessian's anticipated pattern (ContactOptions::pattern_reach,
+// SelfContactBarrier::anticipate): the same values as the Hessian of the pairs within d̂ alone, in a
+// pattern that holds that one's, and one pattern over a step's Newton iterations while pairs arrive.
+// docs/14_contact.md#bodies-against-bodies-the-cost
+#include "14_contact/contact.hpp"
+
+#include "contact_bodies.hpp"
+
+#include "12_hyperelastic_newton/force_models.hpp"
+#include "12_hyperelastic_newton/newton.hpp"
+
+#include "09_conjugate_gradient/linear_solver.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <Eigen/Core>
+#include <Eigen/Sparse>
+
+#include <limits>
+#include <memory>
+#include <set>
+#include <utility>
+#include <vector>
+
+using namespace fem;
+using namespace fem::contact;
+using fem::test::box_at;
+using fem::test::two_bodies;
+
+namespace {
+
+/// Chapter 09's default solver, counting the prepares whose matrix had a new sparsity pattern.
+class PatternCountingSolver final : public cg::LinearSolver {
+public:
+    explicit PatternCountingSolver(std::unique_ptr<cg::LinearSolver> inner)
+        : LinearSolver(inner->name()), inner_(std::move(inner))
+    {
+    }
+    bool is_direct() const override { return inner_->is_direct(); }
+    int new_patterns = 0;
+
+private:
+    void do_prepare(const Eigen::SparseMatrix<double>& A, bool same_pattern) override
+    {
+        new_patterns += same_pattern ? 0 : 1;
+        inner_->prepare(A);
+    }
+    int do_solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) override
+    {
+        inner_->solve(b, x);
+        return inner_->stats().iterations;
+    }
+    std::unique_ptr<cg::LinearSolver> inner_;
+};
+
+/// The (row, column) of every stored entry of A, explicit zeros included.
+std::set<std::pair<Eigen::Index, Eigen::Index>> pattern(const Eigen::SparseMatrix<double>& A)
+{
+    std::set<std::pair<Eigen::Index, Eigen::Index>> entries;
+    for (Eigen::Index j = 0; j < A.outerSize(); ++j)
+        for (Eigen::SparseMatrix<double>::InnerIterator it(A, j); it; ++it)
+            entries.emplace(it.row(), it.col());
+    return entries;
+}
+
+/// Two blocks of 2³ cells of 1 cm, 1.5 mm apart along x and offset in y and z, thrown at each other
+/// at ±0.5 m/s (2.5 mm closer a step of 1/400 s: pairs come within d̂ = 1 mm during the first
+/// step's Newton iterations), with self-contact, the Hessian's pattern reaching reach × d̂, and
+/// Newton's solver counting new patterns.
+struct Approach : test::ContactRun {
+    PatternCountingSolver* solver = nullptr;
+
+    explicit Approach(double reach) : ContactRun(test::free_scene(mesh()), options(reach), {}, {}, thrown())
+    {
+        hyper::NewtonOptions newton_options;
+        newton_options.relative_tolerance = 1e-9;
+        newton_options.max_iterations = 200;
+        newton_options.make_solver = [this] {
+            auto counting = std::make_unique<PatternCountingSolver>(cg::make_solver("default"));
+            solver = counting.get();
+            return counting;
+        };
+        newton = std::make_unique<hyper::NewtonBackwardEuler>(newton_options);
+        newton->set_potential(contact.get());
+    }
+    static TetMesh mesh()
+    {
+        return two_bodies(box_at(Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(0.01), 2),
+                          box_at(Eigen::Vector3d(0.0115, 0.002, -0.003), Eigen::Vector3d::Constant(0.01), 2));
+    }
+    static ContactOptions options(double reach)
+    {
+        ContactOptions options;
+        options.self_contact = true;
+        options.pattern_reach = reach;
+        return options;
+    }
+    static Eigen::VectorXd thrown()
+    {
+        const Eigen::Index n = mesh().V.rows();
+        Eigen::VectorXd velocity = Eigen::VectorXd::Zero(3 * n);
+        for (Eigen::Index v = 0; v < n; ++v)
+            velocity[3 * v] = v < n / 2 ? 0.5 : -0.5;
+        return velocity;
+    }
+};
+
+}  // namespace
+
+TEST_CASE("self-contact's anticipated pattern: the same Hessian values in a pattern that holds the plain one's",
+          "[self][ex14.9]")
+{
+    Approach plain(0.0), anticipated(1.0);
+    plain.contact->begin_step(*plain.body, plain.state, plain.time_step);
+    anticipated.contact->begin_step(*anticipated.body, anticipated.state, anticipated.time_step);
+    REQUIRE(plain.contact->stiffness() == anticipated.contact->stiffness());
+    CHECK(plain.contact->self_barrier()->anticipated_pattern().nonZeros() == 0);
+    // Along the predicted motion, from no pair within d̂ to several (at full speed the 1.5 mm gap
+    // closes by 2.5 mm over the step: 1 mm, 0.625 mm and 0.25 mm are left at 0.2, 0.35 and 0.5 of it).
+    std::size_t most_pairs = 0;
+    for (double fraction : {0.0, 0.2, 0.35, 0.5}) {
+        INFO("fraction " << fraction << " of the step's predicted motion");
+        const Eigen::VectorXd u = plain.state.u + fraction * plain.time_step * plain.state.v;
+        const std::size_t within = plain.contact->self_barrier()->pairs(u, false).size();
+        most_pairs = std::max(most_pairs, within);
+        const Eigen::SparseMatrix<double> H = plain.contact->hessian(u), G = anticipated.contact->hessian(u);
+        CHECK(Eigen::MatrixXd(G) == Eigen::MatrixXd(H));  // bit for bit: only zeros were added
+        const auto plain_pattern = pattern(H), anticipated_pattern = pattern(G);
+        CHECK(std::includes(anticipated_pattern.begin(), anticipated_pattern.end(), plain_pattern.begin(),
+                            plain_pattern.end()));
+        CHECK(anticipated_pattern.size() > plain_pattern.size());
+        // The same pattern at every point of the motion: the one anticipate fixed.
+        CHECK(anticipated_pattern == pattern(anticipated.contact->self_barrier()->anticipated_pattern()));
+    }
+    CHECK(most_pairs > 10);  // the blocks' pairs arrive along the motion
+}
+
+TEST_CASE("self-contact's anticipated pattern: one matrix pattern a step while pairs arrive, the same steps",
+          "[self][ex14.9]")
+{
+    Approach plain(0.0), anticipated(1.0);
+    int plain_most = 0, anticipated_most = 0;
+    for (int step = 0; step < 3; ++step) {
+        const int plain_before = plain.solver ? plain.solver->new_patterns : 0;
+        const int anticipated_before = anticipated.solver ? anticipated.solver->new_patterns : 0;
+        plain.step();
+        anticipated.step();
+        plain_most = std::max(plain_most, plain.solver->new_patterns - plain_before);
+        anticipated_most = std::max(anticipated_most, anticipated.solver->new_patterns - anticipated_before);
+        INFO("step " << step);
+        // The same Newton iterates up to the round-off of another elimination order.
+        CHECK((anticipated.state.u - plain.state.u).lpNorm<Eigen::Infinity>() <= 1e-9 * 1e-3);
+    }
+    INFO("most new patterns in one step: " << plain_most << " plain, " << anticipated_most << " anticipated");
+    CHECK(plain_most > 1);         // pairs arrived within a step: the plain Hessian changed its pattern
+    CHECK(anticipated_most == 1);  // the anticipated one kept the step's first
+    CHECK(anticipated.contact->smallest_distance(anticipated.state.u) < 1e-3);  // they met, within d̂
+}
+
+TEST_CASE("self-contact's anticipated pattern refuses a negative or non-finite reach", "[self][ex14.9]")
+{
+    const TetMesh mesh = Approach::mesh();
+    const dynamics::Body body(test::free_scene(mesh), hyper::make_force_model("stable-neo-hookean", mesh, {1e5, 0.3, 1000.0}));
+    for (double reach : {-1.0, std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN()}) {
+        INFO("pattern reach " << reach);
+        CHECK_THROWS_WITH(ContactPotential(body, {}, Approach::options(reach)),
+                          Catch::Contains("anticipated Hessian pattern must be >= 0"));
+    }
+    SelfContactBarrier barrier(mesh, 1e-3);
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(3 * mesh.V.rows());
+    CHECK_THROWS_WITH(barrier.anticipate(zero, zero, -1e-3), Catch::Contains("must be a finite number >= 0"));
+    CHECK_THROWS_WITH(barrier.anticipate(zero, Eigen::VectorXd::Zero(3), 1e-3), Catch::Contains("the predicted motion"));
+}
