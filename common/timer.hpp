@@ -22,6 +22,21 @@ private:
     Clock::time_point start_;
 };
 
+/// A stopwatch for a scope: adds the wall time from its construction to its end (a return or an
+/// exception) to a sum, e.g. the seconds of every call of a function (ContactClocks of chapter 14).
+class ScopeTimer {
+public:
+    /// Adds to seconds (it must outlive this).
+    explicit ScopeTimer(double& seconds) : seconds_(seconds) {}
+    ScopeTimer(const ScopeTimer&) = delete;
+    ScopeTimer& operator=(const ScopeTimer&) = delete;
+    ~ScopeTimer() { seconds_ += timer_.seconds(); }
+
+private:
+    double& seconds_;
+    Timer timer_;
+};
+
 /// The best (smallest) wall time in seconds of one call of work(), over repeated calls that stop
 /// after min_total_seconds of measuring or max_repeats calls, whichever comes first. The minimum
 /// filters out noise from the rest of the machine.

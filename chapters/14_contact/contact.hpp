@@ -76,6 +76,26 @@ struct ContactOptions {
     bool check_intersections = false;
 };
 
+/// Where a ContactPotential's time goes, for the tables of what contact costs (study 6 of ch14_contact,
+/// the scenes runner's contact_steps.csv): wall time summed over whole calls (one steady_clock read
+/// at each call's start and end, common/timer.hpp; no clock per pair, so they cost nothing to keep),
+/// since the potential's construction or its last reset_clocks. The calls contact_step makes of the
+/// potential itself (has_free_start, its stages' obstacle_advance, the barrier energies it books as
+/// work) and out_of_contact, smallest_distance are in neither clock.
+/// docs/14_contact.md#bodies-against-bodies-the-cost
+struct ContactClocks {
+    /// begin_step (κ, the lagged friction pairs, the anticipated pattern) and every energy, gradient
+    /// and Hessian: the barrier with its broad phase (a tree, or the last motion's candidates) and
+    /// the friction terms [s].
+    double barrier_seconds = 0.0;
+    /// largest_safe_step (the line search's continuous collision check, with its own broad phase over
+    /// the swept boxes) and start_velocity (the start's check against the obstacles) [s].
+    double collision_seconds = 0.0;
+    /// The trees the self-contact barrier built, whichever call asked (SelfContactBarrier::broad_phases,
+    /// its check at rest in the constructor included; 0 without self_contact).
+    long long broad_phases = 0;
+};
+
 /// The minimiser of ‖g + κ h‖ over κ: κ = −gᵀh/‖h‖² (g, h of one size), the κ whose barrier force
 /// best balances the body's force (IPC's initial κ); 0 when h = 0. fem::Error on sizes.
 double balancing_stiffness(const Eigen::VectorXd& g, const Eigen::VectorXd& h);
@@ -182,6 +202,11 @@ public:
     /// Used once, by the next begin_step (step_with_friction_updates). fem::Error on u's size.
     void lag_friction_at(const Eigen::VectorXd& u);
 
+    /// The clocks since construction or the last reset_clocks (ContactClocks).
+    ContactClocks clocks() const;
+    /// Sets the clocks to zero: a step's clocks, read after it, are that step's alone.
+    void reset_clocks();
+
     /// The constants it was made with.
     const ContactOptions& options() const { return options_; }
     /// κ [N/m] of the current step (the fixed one, or the adaptive rule's).
@@ -222,6 +247,8 @@ private:
     Eigen::VectorXd lag_u_;  // empty: lag at the step's start
     double next_fraction_ = 1.0, fraction_ = 1.0;  // of the step's obstacle motion: the next step's, this one's
     Eigen::VectorXd next_start_, start_;           // the start velocity set for the next step, this one's (empty: none)
+    mutable double barrier_seconds_ = 0.0, collision_seconds_ = 0.0;  // ContactClocks' sums
+    long long broad_phases_before_ = 0;  // the self barrier's broad phases at the last reset_clocks
 };
 
 /// The friction lag iterated to convergence (step_with_friction_updates with updates = 0) stops when

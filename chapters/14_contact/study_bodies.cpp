@@ -10,7 +10,7 @@
 #include "14_contact/contact.hpp"
 #include "14_contact/intersections.hpp"
 #include "14_contact/studies.hpp"
-#include "14_contact/timed_contact.hpp"
+#include "14_contact/timed_solver.hpp"
 
 #include "12_hyperelastic_newton/force_models.hpp"
 #include "12_hyperelastic_newton/newton.hpp"
@@ -39,7 +39,7 @@ namespace {
 struct BunnyRun {
     int steps = 0, newton_iterations = 0, orderings = 0;
     double nonzeros = 0.0;       ///< of the matrices Newton solved with, on average
-    long long broad_phases = 0;  ///< trees the self-contact barrier built (SelfContactBarrier::broad_phases)
+    long long broad_phases = 0;  ///< trees the self-contact barrier built (ContactClocks::broad_phases)
     double seconds = 0.0, solve_seconds = 0.0, barrier_seconds = 0.0, collision_seconds = 0.0;
     double momentum_drift = 0.0;  ///< the largest |Σ m v| over the run, relative to Σ m |v₀|
     bool intersection_free = true;
@@ -108,13 +108,11 @@ void bodies_study(const RunContext& run)
         };
         hyper::NewtonBackwardEuler newton(newton_options);
         std::unique_ptr<ContactPotential> contact;
-        std::unique_ptr<TimedContact> timed;
         if (with_contact) {
             ContactOptions run_options = options;
             run_options.pattern_reach = pattern_reach;
             contact = std::make_unique<ContactPotential>(body, std::vector<std::shared_ptr<const Obstacle>>{}, run_options);
-            timed = std::make_unique<TimedContact>(*contact);
-            newton.set_potential(timed.get());
+            newton.set_potential(contact.get());
         }
         dynamics::State state = dynamics::initial_state(body, {}, v0);
         const SurfacePrimitives surface = surface_primitives(scene.mesh);
@@ -144,10 +142,11 @@ void bodies_study(const RunContext& run)
         result.solve_seconds = solver ? solver->seconds : 0.0;
         result.orderings = solver ? solver->new_patterns : 0;
         result.nonzeros = solver && solver->prepares > 0 ? solver->nonzeros / solver->prepares : 0.0;
-        result.broad_phases = contact ? contact->self_barrier()->broad_phases() : 0;
-        if (timed) {
-            result.barrier_seconds = timed->barrier_seconds;
-            result.collision_seconds = timed->collision_seconds;
+        if (contact) {
+            const ContactClocks clocks = contact->clocks();
+            result.broad_phases = clocks.broad_phases;
+            result.barrier_seconds = clocks.barrier_seconds;
+            result.collision_seconds = clocks.collision_seconds;
         }
         return result;
     };

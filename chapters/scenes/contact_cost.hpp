@@ -12,8 +12,9 @@
 
 namespace fem::scenes {
 
-/// The time one contact step spent in each part (chapter 14's TimedContact and TimedSolver,
-/// 14_contact/timed_contact.hpp): all zero for a step taken out of contact.
+/// The time one contact step spent in each part (chapter 14's ContactClocks of the contact potential,
+/// 14_contact/contact.hpp, and TimedSolver, 14_contact/timed_solver.hpp): all zero for a step taken
+/// out of contact.
 struct ContactStepCost {
     double barrier_seconds = 0.0;    ///< the barrier's energy, gradient and Hessian with their broad phase, begin_step [s]
     double collision_seconds = 0.0;  ///< the continuous collision check of the line search, the start's check [s]

@@ -18,7 +18,7 @@
 #include "scenes/scene_file.hpp"
 
 #include "14_contact/contact.hpp"
-#include "14_contact/timed_contact.hpp"
+#include "14_contact/timed_solver.hpp"
 
 #include "12_hyperelastic_newton/newton.hpp"
 
@@ -75,8 +75,8 @@ public:
     bool last_contact() const { return last_contact_; }
     const contact::ContactPotential& potential() const { return *potential_; }
     /// The last step's time in the barrier, the collision check and the linear solves, and its new
-    /// matrix patterns (contact_cost.hpp; chapter 14's TimedContact and TimedSolver around the
-    /// contact step's potential and solver): zeros when it was out of contact.
+    /// matrix patterns (contact_cost.hpp; chapter 14's ContactClocks of the contact step's potential
+    /// and TimedSolver around its solver): zeros when it was out of contact.
     const ContactStepCost& last_cost() const { return last_cost_; }
     /// The contact pairs at u (3n) at time t (contact_cost.hpp): the self-contact barrier's pairs
     /// within d̂ by kind, and the surface vertices closer than d̂ to each obstacle (one pair per
@@ -90,7 +90,6 @@ private:
     std::vector<SceneForces*> levels_;
     std::vector<std::shared_ptr<const contact::Obstacle>> obstacles_;
     std::unique_ptr<contact::ContactPotential> potential_;
-    contact::TimedContact timed_;              // potential_, timed; Newton's potential
     contact::TimedSolver* solver_ = nullptr;  // Newton's solver, timed (owned by newton_)
     hyper::NewtonBackwardEuler newton_;
     contact::SurfacePrimitives surface_;

@@ -12,6 +12,7 @@
 #include "04_tet_jacobians/tet_jacobians.hpp"
 
 #include "common/error.hpp"
+#include "common/timer.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -147,6 +148,7 @@ bool ContactPotential::out_of_contact(const Eigen::VectorXd& u, double time, con
 
 void ContactPotential::begin_step(dynamics::Body& body, const dynamics::State& state, double time_step)
 {
+    const ScopeTimer clock(barrier_seconds_);
     require_positive(time_step, "time step dt [s]");
     fraction_ = std::exchange(next_fraction_, 1.0);
     start_ = std::exchange(next_start_, Eigen::VectorXd());
@@ -201,6 +203,17 @@ void ContactPotential::begin_step(dynamics::Body& body, const dynamics::State& s
     if (self_)
         self_->anticipate(state.u, time_step * state.v, options_.pattern_reach * options_.activation_distance);
     lag_u_.resize(0);
+}
+
+ContactClocks ContactPotential::clocks() const
+{
+    return {barrier_seconds_, collision_seconds_, self_ ? self_->broad_phases() - broad_phases_before_ : 0};
+}
+
+void ContactPotential::reset_clocks()
+{
+    barrier_seconds_ = collision_seconds_ = 0.0;
+    broad_phases_before_ = self_ ? self_->broad_phases() : 0;
 }
 
 void ContactPotential::lag_friction_at(const Eigen::VectorXd& u)
@@ -269,6 +282,7 @@ double ContactPotential::barrier_energy(const Eigen::VectorXd& u, double time) c
 
 double ContactPotential::energy(const Eigen::VectorXd& u) const
 {
+    const ScopeTimer clock(barrier_seconds_);
     if (check_)
         check_->require_none(rest_ + u.reshaped<Eigen::RowMajor>(rest_.rows(), 3), time_);
     double total = barrier_energy(u, time_);
@@ -310,6 +324,7 @@ Eigen::VectorXd ContactPotential::barrier_forces(const Eigen::VectorXd& u) const
 
 Eigen::VectorXd ContactPotential::gradient(const Eigen::VectorXd& u) const
 {
+    const ScopeTimer clock(barrier_seconds_);
     Eigen::VectorXd gradient = -barrier_forces(u);
     for (const FrictionPair& pair : pairs_)
         gradient.segment<3>(3 * pair.vertex) += pair_friction(pair, u).gradient;
@@ -334,6 +349,7 @@ double ContactPotential::obstacle_work(const Eigen::VectorXd& u, double time_ste
 
 dynamics::SparseMatrix ContactPotential::hessian(const Eigen::VectorXd& u) const
 {
+    const ScopeTimer clock(barrier_seconds_);
     // Every term of P acts on one vertex: the Hessian is block diagonal, each vertex's block the sum
     // of its barrier and friction terms, projected once (the nearest PSD matrix to the vertex's block).
     std::map<int, Eigen::Matrix3d> blocks;
@@ -374,6 +390,7 @@ dynamics::SparseMatrix ContactPotential::hessian(const Eigen::VectorXd& u) const
 
 double ContactPotential::largest_safe_step(const Eigen::VectorXd& u, const Eigen::VectorXd& du) const
 {
+    const ScopeTimer clock(collision_seconds_);
     double step = 1.0;
     for (int v : surface_) {
         const Eigen::Vector3d change = du.segment<3>(3 * v);
@@ -468,6 +485,7 @@ bool ContactPotential::has_free_start(const dynamics::Body& body, const dynamics
 Eigen::VectorXd ContactPotential::start_velocity(const dynamics::Body& body, const dynamics::State& state,
                                                  double time_step) const
 {
+    const ScopeTimer clock(collision_seconds_);
     if (start_.size() > 0) {  // a stage of contact_step: the last stage's solution, free by obstacle_advance
         Eigen::VectorXd v = body.pin_velocity();
         body.dofs().scatter(body.dofs().gather(start_), v);

@@ -60,12 +60,11 @@ ContactIntegrator::ContactIntegrator(dynamics::Integrator& own, std::vector<Scen
       potential_(std::make_unique<contact::ContactPotential>(
           body, std::move(obstacles),
           contact_options(scene, self_contact, std::move(vertex_body), std::move(self_contacts)))),
-      timed_(*potential_),
       newton_(contact_newton_options(scene, &solver_)),
       surface_(contact::surface_primitives(body.mesh())),
       rest_(body.mesh().V)
 {
-    newton_.set_potential(&timed_);
+    newton_.set_potential(potential_.get());
 }
 
 ContactPairs ContactIntegrator::pairs(const Eigen::VectorXd& u, double time) const
@@ -120,12 +119,13 @@ dynamics::StepInfo ContactIntegrator::step(dynamics::Body& body, double time_ste
                 return true;
             },
             body, state, end);
-    const double barrier = timed_.barrier_seconds, collision = timed_.collision_seconds;
+    potential_->reset_clocks();
     const double solves = solver_->seconds;
     const int patterns = solver_->new_patterns;
     dynamics::StepInfo info = contact::contact_step(newton_, *potential_, body, time_step, state);
     info.boundary_work += model_change;
-    last_cost_ = {timed_.barrier_seconds - barrier, timed_.collision_seconds - collision, solver_->seconds - solves,
+    const contact::ContactClocks clocks = potential_->clocks();
+    last_cost_ = {clocks.barrier_seconds, clocks.collision_seconds, solver_->seconds - solves,
                   solver_->new_patterns - patterns};
     return info;
 }

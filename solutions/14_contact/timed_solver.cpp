@@ -1,0 +1,29 @@
+// Chapter 14: the linear solver, timed. docs/14_contact.md#bodies-against-bodies-the-cost
+#include "14_contact/timed_solver.hpp"
+
+namespace fem::contact {
+
+TimedSolver::TimedSolver(std::unique_ptr<cg::LinearSolver> inner)
+    : LinearSolver(inner->name(), inner->options()), inner_(std::move(inner))
+{
+}
+
+void TimedSolver::do_prepare(const Eigen::SparseMatrix<double>& A, bool same_pattern)
+{
+    new_patterns += same_pattern ? 0 : 1;
+    ++prepares;
+    nonzeros += double(A.nonZeros());
+    inner_->prepare(A);
+    seconds += inner_->stats().prepare_seconds;
+}
+
+int TimedSolver::do_solve(const Eigen::VectorXd& b, Eigen::VectorXd& x)
+{
+    // The tolerance set on this (inexact Newton sets one per solve) is the inner solver's.
+    inner_->set_relative_tolerance(options().relative_tolerance);
+    inner_->solve(b, x);
+    seconds += inner_->stats().solve_seconds;
+    return inner_->stats().iterations;
+}
+
+}  // namespace fem::contact
