@@ -1,6 +1,7 @@
 // Chapter 14: the self-contact Hessian's anticipated pattern (ContactOptions::pattern_reach,
 // SelfContactBarrier::anticipate): the same values as the Hessian of the pairs within d̂ alone, in a
-// pattern that holds that one's, and one pattern over a step's Newton iterations while pairs arrive.
+// pattern that holds that one's, and one pattern over a step's Newton iterations while pairs arrive;
+// the contact potential's clocks (ContactClocks) that split such a step's time.
 // docs/14_contact.md#bodies-against-bodies-the-cost
 #include "14_contact/contact.hpp"
 
@@ -10,6 +11,8 @@
 #include "12_hyperelastic_newton/newton.hpp"
 
 #include "09_conjugate_gradient/linear_solver.hpp"
+
+#include "common/timer.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -155,6 +158,41 @@ TEST_CASE("self-contact's anticipated pattern: one matrix pattern a step while p
     CHECK(plain_most > 1);         // pairs arrived within a step: the plain Hessian changed its pattern
     CHECK(anticipated_most == 1);  // the anticipated one kept the step's first
     CHECK(anticipated.contact->smallest_distance(anticipated.state.u) < 1e-3);  // they met, within d̂
+}
+
+TEST_CASE("the contact potential's clocks: parts of its steps' time, its broad phases, zero after a reset",
+          "[self][ex14.9]")
+{
+    Approach run(1.0);
+    const SelfContactBarrier& self = *run.contact->self_barrier();
+    ContactClocks clocks = run.contact->clocks();
+    CHECK(clocks.barrier_seconds == 0.0);
+    CHECK(clocks.collision_seconds == 0.0);
+    CHECK(clocks.broad_phases == self.broad_phases());  // the constructor's check at rest among them
+    CHECK(clocks.broad_phases > 0);
+    for (int step = 0; step < 2; ++step) {
+        run.contact->reset_clocks();
+        const long long before = self.broad_phases();
+        const Timer timer;
+        run.step();
+        const double seconds = timer.seconds();
+        clocks = run.contact->clocks();
+        INFO("step " << step << ": " << seconds << " s, barrier " << clocks.barrier_seconds << " s, collision check "
+                     << clocks.collision_seconds << " s");
+        CHECK(clocks.barrier_seconds > 0.0);    // begin_step, the energies, gradients and Hessians
+        CHECK(clocks.collision_seconds > 0.0);  // the start velocity, the line searches' times of impact
+        CHECK(clocks.barrier_seconds + clocks.collision_seconds <= seconds);  // parts of the step, none twice
+        CHECK(clocks.broad_phases == self.broad_phases() - before);
+    }
+    // Reset, and asked only what neither clock covers: the clocks stay at zero.
+    run.contact->reset_clocks();
+    const long long at_reset = self.broad_phases();
+    run.contact->smallest_distance(run.state.u);
+    run.contact->barrier_energy(run.state.u, run.state.time);
+    clocks = run.contact->clocks();
+    CHECK(clocks.barrier_seconds == 0.0);
+    CHECK(clocks.collision_seconds == 0.0);
+    CHECK(clocks.broad_phases == self.broad_phases() - at_reset);  // the trees they built, if any
 }
 
 TEST_CASE("self-contact's anticipated pattern refuses a negative or non-finite reach", "[self][ex14.9]")
