@@ -1,6 +1,7 @@
 // Chapter 14: the contact potential and the linear solver, timed. docs/14_contact.md#bodies-against-bodies-the-cost
 #include "14_contact/timed_contact.hpp"
 
+#include "common/error.hpp"
 #include "common/timer.hpp"
 
 namespace fem::contact {
@@ -29,7 +30,14 @@ void TimedSolver::do_prepare(const Eigen::SparseMatrix<double>& A, bool same_pat
     new_patterns += same_pattern ? 0 : 1;
     ++prepares;
     nonzeros += double(A.nonZeros());
-    inner_->prepare(A);
+    // A factorization that fails (a matrix that is not positive definite) costs its time too.
+    const Timer timer;
+    try {
+        inner_->prepare(A);
+    } catch (const Error&) {
+        seconds += timer.seconds();
+        throw;
+    }
     seconds += inner_->stats().prepare_seconds;
 }
 
@@ -62,6 +70,11 @@ Eigen::VectorXd TimedContact::gradient(const Eigen::VectorXd& u) const
 dynamics::SparseMatrix TimedContact::hessian(const Eigen::VectorXd& u) const
 {
     return timed(barrier_seconds, [&] { return contact_.hessian(u); });
+}
+
+dynamics::SparseMatrix TimedContact::exact_hessian(const Eigen::VectorXd& u) const
+{
+    return timed(barrier_seconds, [&] { return contact_.exact_hessian(u); });
 }
 
 double TimedContact::largest_safe_step(const Eigen::VectorXd& u, const Eigen::VectorXd& du) const
