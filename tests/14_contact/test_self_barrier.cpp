@@ -106,18 +106,23 @@ Eigen::Vector3d momentum(const dynamics::Body& body, const Eigen::VectorXd& v, E
     return p;
 }
 
-}  // namespace
-
-TEST_CASE("self-contact barrier: energy, gradient and Hessian against central differences, PSD", "[self][ex14.9]")
+/// Two one-cell cubes face to face 0.4 mm apart, the second turned 0.3 rad about x (the faces'
+/// normal) and shifted, so that vertices stand over the other's face and edges cross at angles:
+/// point–triangle and edge–edge pairs within d̂ = 1 mm. One mesh, the first cube's 8 vertices first.
+TetMesh turned_cubes()
 {
-    // Two one-cell cubes face to face 0.4 mm apart, the second turned 0.3 rad about x (the faces'
-    // normal) and shifted, so that vertices stand over the other's face and edges cross at angles:
-    // point–triangle and edge–edge pairs within d̂ = 1 mm.
     const TetMesh first = box_at(Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(0.1));
     TetMesh second = box_at(Eigen::Vector3d(-0.05, -0.05, -0.05), Eigen::Vector3d::Constant(0.1));
     const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()).toRotationMatrix();
     second.V = (second.V * turn.transpose()).rowwise() + Eigen::RowVector3d(0.1504, 0.07, 0.04);
-    const TetMesh mesh = two_bodies(first, second);
+    return two_bodies(first, second);
+}
+
+}  // namespace
+
+TEST_CASE("self-contact barrier: energy, gradient and Hessian against central differences, PSD", "[self][ex14.9]")
+{
+    const TetMesh mesh = turned_cubes();
     const SelfContactBarrier barrier(mesh, 1e-3);
     const SelfPotential potential{barrier, 50.0};
     const Eigen::Index n = 3 * mesh.V.rows();
@@ -153,7 +158,7 @@ TEST_CASE("self-contact barrier: energy, gradient and Hessian against central di
     const Eigen::VectorXd rest = Eigen::VectorXd::Zero(3 * 27);
     CHECK(alone.energy(rest, 50.0) == 0.0);
     CHECK(alone.smallest_distance(rest, 0.2) > 0.0);
-    CHECK_THROWS_AS(SelfContactBarrier(first, 0.0), Error);
+    CHECK_THROWS_AS(SelfContactBarrier(mesh, 0.0), Error);
     CHECK_THROWS_AS(alone.energy(Eigen::VectorXd::Zero(5), 1.0), Error);
 }
 
@@ -162,11 +167,8 @@ TEST_CASE("self-contact barrier's Hessian unprojected and by absolute values: th
 {
     // The pairs of the test above (point–triangle and edge–edge within d̂): with no projection the
     // blocks sum to ∇²P itself; with |λ| the sum is PSD and lies above the clamped one (|λ| ≥ max(λ, 0)).
-    const TetMesh first = box_at(Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(0.1));
-    TetMesh second = box_at(Eigen::Vector3d(-0.05, -0.05, -0.05), Eigen::Vector3d::Constant(0.1));
-    const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()).toRotationMatrix();
-    second.V = (second.V * turn.transpose()).rowwise() + Eigen::RowVector3d(0.1504, 0.07, 0.04);
-    const TetMesh mesh = two_bodies(first, second);
+    const TetMesh mesh = turned_cubes();
+    const Eigen::Index half = mesh.V.rows() / 2;  // the first cube's vertices
     const SelfContactBarrier barrier(mesh, 1e-3);
     const SelfPotential potential{barrier, 50.0};
     const Eigen::Index n = 3 * mesh.V.rows();
@@ -199,7 +201,7 @@ TEST_CASE("self-contact barrier's Hessian unprojected and by absolute values: th
         // pairs within d̂ at rest: its mesh has the second cube 2 mm farther, u brings it back.
         TetMesh apart = mesh;
         Eigen::VectorXd u_apart = u;
-        for (Eigen::Index v = first.V.rows(); v < mesh.V.rows(); ++v) {
+        for (Eigen::Index v = half; v < mesh.V.rows(); ++v) {
             apart.V(v, 0) += 2e-3;
             u_apart[3 * v] -= 2e-3;
         }
