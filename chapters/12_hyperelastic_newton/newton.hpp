@@ -131,6 +131,10 @@ public:
     /// A positive semi-definite ∇²P(u) (3n×3n) [N/m] whose entries lie in the 3×3 blocks of vertices
     /// that share a tet (the pattern of every stiffness matrix of the course holds them).
     virtual dynamics::SparseMatrix hessian(const Eigen::VectorXd& u) const = 0;
+    /// ∇²P(u) as it is, possibly indefinite (3n×3n, the same blocks as hessian): what Newton adds to
+    /// the exact K when it tries the exact Hessian first (HessianChoice::exact_then_definite, exact);
+    /// the definite Hessian takes hessian(u). Default: hessian(u) (a potential with no other).
+    virtual dynamics::SparseMatrix exact_hessian(const Eigen::VectorXd& u) const { return hessian(u); }
     /// The largest α in (0, 1] with P finite on the whole segment u + s·du, s ∈ [0, α], shrunk by
     /// a safety factor (default: 1, a potential that is finite everywhere).
     virtual double largest_safe_step(const Eigen::VectorXd& u, const Eigen::VectorXd& du) const

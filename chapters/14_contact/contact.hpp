@@ -32,6 +32,7 @@
 #include <Eigen/Core>
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -68,6 +69,16 @@ struct ContactOptions {
     /// (one ordering and symbolic analysis a step instead of one per arrival). The values do not
     /// change. 0: only the pairs within d̂. docs/14_contact.md#bodies-against-bodies-the-cost
     double pattern_reach = 1.0;
+    /// How each barrier block of the Hessian is made PSD (a vertex's block against the obstacles, an
+    /// edge or corner pair's, a self-contact pair's 12×12): chapter 12's project_to_psd, clamp (negative
+    /// eigenvalues to 0) or absolute (to |λ|). docs/14_contact.md#bodies-against-bodies-the-cost
+    hyper::Projection barrier_projection = hyper::Projection::clamp;
+    /// What ContactPotential::exact_hessian holds, the Hessian chapter 12's Newton tries first
+    /// (HessianChoice::exact_then_definite: kept where M + Δt² (K + ∇²P) factors and gives descent, else
+    /// the definite one): true, the barrier's blocks as they are (∇²P itself, so that Newton converges
+    /// quadratically wherever the whole step's Hessian is definite); false, projected as in hessian.
+    /// docs/14_contact.md#bodies-against-bodies-the-cost
+    bool exact_barrier_hessian = false;
     /// A debug check: at every configuration the energy is asked of (each Newton iterate and each
     /// line-search trial), no body edge meets a triangle of an obstacle with edges (a box, a mesh), no
     /// such obstacle's edge a body triangle, and, with self_contact, no body edge a body triangle
@@ -136,11 +147,16 @@ public:
     /// ∇²P made PSD (3n×3n, vertex blocks only): each vertex's block is the sum of κ (b'' ∇d ∇dᵀ + b' ∇²d)
     /// over its active pairs and, per friction pair with s = Tᵀ(x − start), y = ‖s‖,
     /// μλ T [ (f₁'(y) y − f₁(y))/y³ · s sᵀ + f₁(y)/y · I₂ ] Tᵀ; the sum is projected once
-    /// (chapter 12's project_to_psd): b' ∇²d of a sphere is negative semi-definite; plus the
+    /// (chapter 12's project_to_psd, ContactOptions::barrier_projection): b' ∇²d of a sphere is negative semi-definite; plus the
     /// features' and self-contact's pair blocks (each projected) and the body friction pairs' 12×12
     /// blocks (PSD as they are, BodyFriction::add_hessian); with self_contact in the step's anticipated
     /// pattern (explicit zeros, SelfContactBarrier::anticipated_pattern: no value changes).
     dynamics::SparseMatrix hessian(const Eigen::VectorXd& u) const override;
+    /// ∇²P itself when ContactOptions::exact_barrier_hessian (hessian's blocks unprojected: each
+    /// vertex's barrier and friction block, the features' and self-contact's pair blocks; the body
+    /// friction pairs' as in hessian), else hessian(u): what Newton tries first (chapter 12's
+    /// HessianChoice::exact_then_definite). docs/14_contact.md#bodies-against-bodies-the-cost
+    dynamics::SparseMatrix exact_hessian(const Eigen::VectorXd& u) const override;
     /// min(1, safety × the earliest time of impact of any surface vertex's path x_v + s·Δx_v, of the
     /// features' pairs and (self_contact) of the surface pairs, SelfContactBarrier::time_of_impact).
     double largest_safe_step(const Eigen::VectorXd& u, const Eigen::VectorXd& du) const override;
@@ -221,6 +237,8 @@ public:
 
 private:
     Eigen::Vector3d position(const Eigen::VectorXd& u, int vertex) const;
+    /// hessian's matrix with every barrier block projected as projection says (none: as it is).
+    dynamics::SparseMatrix assembled_hessian(const Eigen::VectorXd& u, std::optional<hyper::Projection> projection) const;
     /// The first of start_velocity's candidates that reaches no obstacle held at obstacle_time, or an
     /// empty vector (blocked, when given, receives each candidate's first vertex and obstacle met).
     Eigen::VectorXd free_start(const dynamics::Body& body, const dynamics::State& state, double time_step,

@@ -18,6 +18,8 @@
 
 #include "14_contact/obstacles.hpp"
 
+#include "12_hyperelastic_newton/materials.hpp"
+
 #include "13_skinning/skinning.hpp"
 
 #include "10_linear_dynamics/body.hpp"
@@ -28,6 +30,7 @@
 #include <Eigen/Sparse>
 
 #include <memory>
+#include <optional>
 #include <vector>
 
 namespace fem::contact {
@@ -48,9 +51,11 @@ public:
     double energy(const Eigen::VectorXd& u, double time, double stiffness) const;
     /// Adds its gradient (3n) to gradient.
     void add_gradient(const Eigen::VectorXd& u, double time, double stiffness, Eigen::VectorXd& gradient) const;
-    /// Appends its Hessian's entries, each pair's block projected to PSD (6×6 or 9×9), to triplets.
+    /// Appends its Hessian's entries, each pair's block projected to PSD (6×6 or 9×9; chapter 12's
+    /// project_to_psd with projection; none: as they are), to triplets.
     void add_hessian(const Eigen::VectorXd& u, double time, double stiffness,
-                     std::vector<Eigen::Triplet<double>>& triplets) const;
+                     std::vector<Eigen::Triplet<double>>& triplets,
+                     std::optional<hyper::Projection> projection = hyper::Projection::clamp) const;
     /// Σ_o w_o · (the force of obstacle o's pairs on the body) at u [N·m/s]: its part of
     /// ContactPotential::obstacle_work before the factor Δt.
     double obstacle_power(const Eigen::VectorXd& u, double time, double stiffness) const;

@@ -70,6 +70,10 @@ int main(int argc, char** argv)
         ->check(check::real(0.0, 1.0, check::Ends::open_closed))->capture_default_str();
     cli.app.add_option("--duration", settings.duration, "Length of each run [s]")
         ->check(check::real(0.0, 5.0, check::Ends::open_closed))->capture_default_str();
+    bool hessian_variants = false;
+    cli.app.add_flag("--hessian-variants", hessian_variants,
+                     "Also run the two bunnies with the barrier's Hessian and kappa changed (five more runs, minutes): "
+                     "two_bunnies_hessian_table.csv");
     std::vector<std::string> ccd_files;
     cli.app.add_option("--ccd-queries", ccd_files,
                        "CCD benchmark query files, each in a folder vertex-face or edge-edge: run only the CCD study")
@@ -77,7 +81,7 @@ int main(int argc, char** argv)
     cli.check_options([&] {
         if (!ccd_files.empty()) {  // runs the CCD study alone: another study's option would be ignored
             for (const char* other : {"--dhat", "--kappa", "--dt", "--tolerance", "--friction-updates", "--height",
-                                      "--duration"})
+                                      "--duration", "--hessian-variants"})
                 if (cli.app.count(other) > 0)
                     throw Error(str(other, ": --ccd-queries runs only the CCD study and would ignore it"));
             cli.protect_inputs({ccd_files.begin(), ccd_files.end()});
@@ -121,7 +125,7 @@ int main(int argc, char** argv)
         study::mesh_study(run, settings);
         study::ccd_study(run, study::ccd_benchmark_files());
         study::self_contact_study(run);
-        study::bodies_study(run);
+        study::bodies_study(run, hessian_variants);
         study::stack_study(run);
     });
 }

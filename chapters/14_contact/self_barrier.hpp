@@ -35,11 +35,14 @@
 #include "14_contact/ccd.hpp"
 #include "14_contact/distances.hpp"
 
+#include "12_hyperelastic_newton/materials.hpp"
+
 #include "common/mesh.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/Sparse>
 
+#include <optional>
 #include <vector>
 
 namespace fem::contact {
@@ -79,9 +82,11 @@ public:
     /// fem::Error where a pair touches (d = 0) or on sizes.
     void add_gradient(const Eigen::VectorXd& u, double stiffness, Eigen::VectorXd& gradient) const;
     /// Appends its Hessian's entries to triplets (3n×3n): each pair's 12×12 block κ ∇²(m_k b(d_k))
-    /// projected to PSD on its own (chapter 12's project_to_psd, clamp), so the sum is PSD.
+    /// projected to PSD on its own (chapter 12's project_to_psd with projection: clamp sets its negative
+    /// eigenvalues to 0, absolute to |λ|), so the sum is PSD; no projection: the blocks as they are.
     /// fem::Error where a pair touches (d = 0) or on u's size.
-    void add_hessian(const Eigen::VectorXd& u, double stiffness, std::vector<Eigen::Triplet<double>>& triplets) const;
+    void add_hessian(const Eigen::VectorXd& u, double stiffness, std::vector<Eigen::Triplet<double>>& triplets,
+                     std::optional<hyper::Projection> projection = hyper::Projection::clamp) const;
     /// The pairs within d̂ at u (3n), with their barrier's gradient and Hessian when with_derivatives
     /// (κ-free: the force of pair k on its 4 vertices is −κ ∇(m_k b(d_k)), SurfacePair::barrier's
     /// gradient). fem::Error where a pair touches (d = 0) or on u's size.

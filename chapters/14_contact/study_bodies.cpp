@@ -5,7 +5,9 @@
 // step the time in the contact potential (its barrier with the broad phase, and its continuous
 // collision check) against the time in the linear solves,
 // with the momentum kept and the surface checked for intersections at every step; then the contact
-// run again with Newton's tolerance loosened, its iterations against the end state's offset.
+// run again with Newton's tolerance loosened, its iterations against the end state's offset; and
+// again (on request) with the barrier's Hessian projected otherwise or tried exact first, and κ
+// doubled or fixed.
 // docs/14_contact.md#bodies-against-bodies-the-cost
 #include "14_contact/contact.hpp"
 #include "14_contact/intersections.hpp"
@@ -45,11 +47,15 @@ struct BunnyRun {
     bool intersection_free = true;
     double smallest_distance = 0.0;  ///< between the bunnies' surfaces over the run (contact only) [m]
     Eigen::VectorXd u;               ///< the displacements after the last step (3n) [m]
+    int most_iterations = 0;   ///< of one step
+    int fallbacks = 0;         ///< Newton iterations whose exact Hessian failed (HessianChoice::exact_then_definite)
+    int factorizations = 0;    ///< the matrices the linear solver prepared, failed ones included
+    double stiffness = 0.0;    ///< κ of the last step [N/m]
 };
 
 }  // namespace
 
-void bodies_study(const RunContext& run)
+void bodies_study(const RunContext& run, bool hessian_variants)
 {
     std::cout << "\n== 6. Bodies against bodies: two coarse bunnies thrown at each other, one mesh with self-contact,\n"
                  "   beside the same two bunnies without contact; where a step's time goes\n\n";
@@ -95,7 +101,7 @@ void bodies_study(const RunContext& run)
     options.self_contact = true;
     options.activation_distance = 1e-3;
 
-    const auto one_run = [&](bool with_contact, double tolerance, double pattern_reach) {
+    const auto one_run = [&](bool with_contact, double tolerance, const ContactOptions& run_options) {
         dynamics::Body body(scene, hyper::make_force_model("stable-neo-hookean", scene.mesh, scene.material));
         TimedSolver* solver = nullptr;
         hyper::NewtonOptions newton_options;
@@ -109,8 +115,6 @@ void bodies_study(const RunContext& run)
         hyper::NewtonBackwardEuler newton(newton_options);
         std::unique_ptr<ContactPotential> contact;
         if (with_contact) {
-            ContactOptions run_options = options;
-            run_options.pattern_reach = pattern_reach;
             contact = std::make_unique<ContactPotential>(body, std::vector<std::shared_ptr<const Obstacle>>{}, run_options);
             newton.set_potential(contact.get());
         }
@@ -127,6 +131,10 @@ void bodies_study(const RunContext& run)
                 with_contact ? contact_step(newton, *contact, body, scene.time_step, state) : newton.step(body, scene.time_step, state);
             result.seconds += timer.seconds();
             result.newton_iterations += info.newton_iterations;
+            result.most_iterations = std::max(result.most_iterations, info.newton_iterations);
+            result.fallbacks += newton.last().definite_fallbacks;
+            if (with_contact)
+                result.stiffness = contact->stiffness();
             ++result.steps;
             Eigen::Vector3d momentum = Eigen::Vector3d::Zero();
             for (Eigen::Index k = 0; k < state.v.size(); ++k)
@@ -141,6 +149,7 @@ void bodies_study(const RunContext& run)
         result.u = state.u;
         result.solve_seconds = solver ? solver->seconds : 0.0;
         result.orderings = solver ? solver->new_patterns : 0;
+        result.factorizations = solver ? static_cast<int>(solver->prepares) : 0;
         result.nonzeros = solver && solver->prepares > 0 ? solver->nonzeros / solver->prepares : 0.0;
         if (contact) {
             const ContactClocks clocks = contact->clocks();
@@ -151,9 +160,10 @@ void bodies_study(const RunContext& run)
         return result;
     };
     const double tolerance = hyper::NewtonOptions{}.relative_tolerance;  // 10⁻⁶, every other table's
-    const double reach = ContactOptions{}.pattern_reach;  // the Hessian's anticipated pattern, in d̂
-    const BunnyRun contact_run = one_run(true, tolerance, reach), unanticipated_run = one_run(true, tolerance, 0.0),
-                   free_run = one_run(false, tolerance, reach);
+    ContactOptions unanticipated = options;
+    unanticipated.pattern_reach = 0.0;
+    const BunnyRun contact_run = one_run(true, tolerance, options), unanticipated_run = one_run(true, tolerance, unanticipated),
+                   free_run = one_run(false, tolerance, options);
 
     Table table(str(run.quick ? "Two blocks (2 x 64 vertices)" : "Two coarse bunnies (2 x 2,199 vertices)",
                     " thrown at each other at 1 m/s, spinning: per step, with self-contact and without"),
@@ -193,7 +203,7 @@ void bodies_study(const RunContext& run)
                  {"closest distance / dhat", Format::scientific, 1}, {"momentum drift [round-off]", Format::scientific, 1},
                  {"intersection-free", Format::text}});
     for (double loose_tolerance : {tolerance, 1e-3}) {
-        const BunnyRun r = loose_tolerance == tolerance ? contact_run : one_run(true, loose_tolerance, reach);
+        const BunnyRun r = loose_tolerance == tolerance ? contact_run : one_run(true, loose_tolerance, options);
         loose.add_row({loose_tolerance, double(r.newton_iterations), double(r.orderings), 1e3 * r.seconds / r.steps,
                        1e3 * r.solve_seconds / r.steps, r.seconds / free_run.seconds,
                        (r.u - contact_run.u).lpNorm<Eigen::Infinity>() / options.activation_distance,
@@ -202,6 +212,60 @@ void bodies_study(const RunContext& run)
     }
     loose.print(std::cout);
     loose.write_csv(run.file("two_bunnies_tolerance_table.csv"));
+    if (!hessian_variants)
+        return;
+
+    // What cuts the impact steps' iterations at the same tolerance: the barrier blocks' projection
+    // (ContactOptions::barrier_projection), the exact barrier Hessian tried first
+    // (ContactOptions::exact_barrier_hessian, under chapter 12's HessianChoice::exact_then_definite),
+    // and κ: doubled at a step's start while the bunnies are within 0.1 d̂ and closing (the adaptive
+    // rule with ε_d = 0.1 d̂ over the bounding-box diagonal), or fixed at 100 times the adaptive run's.
+    const double diagonal = (scene.mesh.V.colwise().maxCoeff() - scene.mesh.V.colwise().minCoeff()).norm();
+    const double kappa = contact_run.stiffness;
+    struct Variant {
+        const char* name;
+        hyper::Projection projection;
+        bool exact;
+        double stiffness, doubling_distance;
+    };
+    const double ipc = ContactOptions{}.doubling_distance;
+    Table variants(str(run.quick ? "Two blocks" : "Two coarse bunnies",
+                       " with self-contact at Newton tolerance 1e-6: the barrier's Hessian and kappa against the iterations"),
+                   {{"barrier Hessian", Format::text}, {"kappa", Format::text}, {"Newton iterations", Format::integer},
+                    {"most in a step", Format::integer}, {"exact Hessian failed", Format::integer},
+                    {"factorizations", Format::integer}, {"new matrix patterns", Format::integer},
+                    {"time per step [ms]", Format::fixed, 1},
+                    {"linear solves [ms]", Format::fixed, 1}, {"step time / without contact [measured]", Format::fixed, 2},
+                    {"closest distance / dhat", Format::scientific, 1},
+                    {"largest offset from the first row / dhat", Format::scientific, 1},
+                    {"momentum drift [round-off]", Format::scientific, 1}, {"intersection-free", Format::text}});
+    for (const Variant& variant :
+         {Variant{"clamp", hyper::Projection::clamp, false, 0.0, ipc},
+          Variant{"absolute values", hyper::Projection::absolute, false, 0.0, ipc},
+          Variant{"exact, else clamp", hyper::Projection::clamp, true, 0.0, ipc},
+          Variant{"clamp", hyper::Projection::clamp, false, 0.0, 0.1 * options.activation_distance / diagonal},
+          Variant{"clamp", hyper::Projection::clamp, false, 100.0 * kappa, ipc},
+          Variant{"exact, else clamp", hyper::Projection::clamp, true, 100.0 * kappa, ipc}}) {
+        ContactOptions variant_options = options;
+        variant_options.barrier_projection = variant.projection;
+        variant_options.exact_barrier_hessian = variant.exact;
+        variant_options.stiffness = variant.stiffness;
+        variant_options.doubling_distance = variant.doubling_distance;
+        const bool as_default = variant.projection == options.barrier_projection && variant.exact == options.exact_barrier_hessian &&
+                                variant.stiffness == options.stiffness && variant.doubling_distance == ipc;
+        const BunnyRun r = as_default ? contact_run : one_run(true, tolerance, variant_options);
+        variants.add_row({std::string(variant.name),
+                          std::string(variant.stiffness > 0.0           ? "fixed, 100 x adaptive"
+                                      : variant.doubling_distance != ipc ? "adaptive, doubled below 0.1 dhat"
+                                                                         : "adaptive"),
+                          double(r.newton_iterations), double(r.most_iterations), double(r.fallbacks),
+                          double(r.factorizations), double(r.orderings), 1e3 * r.seconds / r.steps, 1e3 * r.solve_seconds / r.steps,
+                          r.seconds / free_run.seconds, r.smallest_distance / options.activation_distance,
+                          (r.u - contact_run.u).lpNorm<Eigen::Infinity>() / options.activation_distance, r.momentum_drift,
+                          std::string(r.intersection_free ? "yes" : "NO")});
+    }
+    variants.print(std::cout);
+    variants.write_csv(run.file("two_bunnies_hessian_table.csv"));
 }
 
 }  // namespace fem::contact::study

@@ -17,7 +17,8 @@ namespace fem::contact {
 
 /// A chapter 09 LinearSolver, timed: seconds sums the wrapped solver's own prepare_seconds (its
 /// factorisation or preconditioner, with the symbolic analysis of a new pattern) and solve_seconds
-/// of every prepare and solve; new_patterns counts the prepares with a new sparsity pattern (a new
+/// of every prepare and solve, and the time of each prepare that failed (fem::Error, passed on: a
+/// Cholesky factorization of a matrix that is not positive definite); new_patterns counts the prepares with a new sparsity pattern (a new
 /// fill-reducing ordering and symbolic analysis). Answers as the wrapped solver: it starts with the
 /// wrapped solver's options, and each solve passes on the relative tolerance set on it
 /// (set_relative_tolerance, which inexact Newton sets per solve).
@@ -29,7 +30,7 @@ public:
 
     double seconds = 0.0;  ///< prepares and solves so far [s]
     int new_patterns = 0;  ///< prepares with a new pattern so far
-    int prepares = 0;      ///< prepares so far
+    int prepares = 0;      ///< prepares so far, failed ones included
     double nonzeros = 0.0; ///< the stored entries of the matrices prepared so far, summed
 
 private:

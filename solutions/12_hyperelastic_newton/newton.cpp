@@ -326,7 +326,7 @@ dynamics::StepInfo NewtonBackwardEuler::step(dynamics::Body& body, double time_s
             if (coefficients.beta != 0.0)
                 damped_K += (coefficients.beta / time_step) * damping.start_stiffness();
             if (potential_ != nullptr)
-                damped_K += potential_->hessian(u);
+                damped_K += definite ? potential_->hessian(u) : potential_->exact_hessian(u);
             K = &damped_K;
         }
         const dynamics::SparseMatrix& M = body.mass_matrix();

@@ -350,6 +350,19 @@ double ContactPotential::obstacle_work(const Eigen::VectorXd& u, double time_ste
 dynamics::SparseMatrix ContactPotential::hessian(const Eigen::VectorXd& u) const
 {
     const ScopeTimer clock(barrier_seconds_);
+    return assembled_hessian(u, options_.barrier_projection);
+}
+
+dynamics::SparseMatrix ContactPotential::exact_hessian(const Eigen::VectorXd& u) const
+{
+    const ScopeTimer clock(barrier_seconds_);
+    return assembled_hessian(u, options_.exact_barrier_hessian ? std::nullopt
+                                                               : std::optional<hyper::Projection>(options_.barrier_projection));
+}
+
+dynamics::SparseMatrix ContactPotential::assembled_hessian(const Eigen::VectorXd& u,
+                                                           std::optional<hyper::Projection> projection) const
+{
     // Every term of P acts on one vertex: the Hessian is block diagonal, each vertex's block the sum
     // of its barrier and friction terms, projected once (the nearest PSD matrix to the vertex's block).
     std::map<int, Eigen::Matrix3d> blocks;
@@ -372,14 +385,14 @@ dynamics::SparseMatrix ContactPotential::hessian(const Eigen::VectorXd& u) const
         add(pair.vertex, pair_friction(pair, u).hessian);
     std::vector<Eigen::Triplet<double>> triplets;
     for (const auto& [vertex, block] : blocks) {
-        const Eigen::Matrix3d projected = hyper::project_to_psd<3>(block, hyper::Projection::clamp);
+        const Eigen::Matrix3d projected = projection ? hyper::project_to_psd<3>(block, *projection) : block;
         for (int i = 0; i < 3; ++i)
             for (int j = 0; j < 3; ++j)
                 triplets.emplace_back(3 * vertex + i, 3 * vertex + j, projected(i, j));
     }
-    features_.add_hessian(u, time_, stiffness_, triplets);
+    features_.add_hessian(u, time_, stiffness_, triplets, projection);
     if (self_)
-        self_->add_hessian(u, stiffness_, triplets);
+        self_->add_hessian(u, stiffness_, triplets, projection);
     body_friction_.add_hessian(u, friction_step_, triplets);
     dynamics::SparseMatrix H(u.size(), u.size());
     H.setFromTriplets(triplets.begin(), triplets.end());

@@ -175,18 +175,19 @@ void FeatureBarrier::add_gradient(const Eigen::VectorXd& u, double time, double 
 }
 
 void FeatureBarrier::add_hessian(const Eigen::VectorXd& u, double time, double stiffness,
-                                 std::vector<Eigen::Triplet<double>>& triplets) const
+                                 std::vector<Eigen::Triplet<double>>& triplets,
+                                 std::optional<hyper::Projection> projection) const
 {
     const bool apart = for_each_pair(u, time, activation_distance_, true, [&](const Pair& pair) {
-        // Each pair's block is made PSD on its own (a sum of PSD blocks is PSD).
-        Eigen::Matrix<double, 9, 9> block;
-        if (pair.count == 2) {
+        // Each pair's block is made PSD on its own (a sum of PSD blocks is PSD), or left as it is.
+        Eigen::Matrix<double, 9, 9> block = pair.hessian;
+        if (projection && pair.count == 2) {
             block.setZero();
             block.topLeftCorner<6, 6>() =
                 hyper::project_to_psd<6>(Eigen::Matrix<double, 6, 6>(pair.hessian.topLeftCorner<6, 6>()),
-                                         hyper::Projection::clamp);
-        } else {
-            block = hyper::project_to_psd<9>(pair.hessian, hyper::Projection::clamp);
+                                         *projection);
+        } else if (projection) {
+            block = hyper::project_to_psd<9>(pair.hessian, *projection);
         }
         for (int a = 0; a < pair.count; ++a)
             for (int b = 0; b < pair.count; ++b)

@@ -150,12 +150,15 @@ void SelfContactBarrier::add_gradient(const Eigen::VectorXd& u, double stiffness
 }
 
 void SelfContactBarrier::add_hessian(const Eigen::VectorXd& u, double stiffness,
-                                     std::vector<Eigen::Triplet<double>>& triplets) const
+                                     std::vector<Eigen::Triplet<double>>& triplets,
+                                     std::optional<hyper::Projection> projection) const
 {
     const bool apart = for_each_pair(u, activation_distance_, true, [&](const SurfacePair& pair) {
-        // Each pair's block is made PSD on its own (a sum of PSD blocks is PSD).
+        // Each pair's block is made PSD on its own (a sum of PSD blocks is PSD), or left as it is.
         add_pair_block(pair.vertices,
-                       stiffness * hyper::project_to_psd<12>(pair.barrier.hessian, hyper::Projection::clamp), triplets);
+                       stiffness * (projection ? hyper::project_to_psd<12>(pair.barrier.hessian, *projection)
+                                               : pair.barrier.hessian),
+                       triplets);
     });
     if (!apart)
         throw Error("self-contact: the Hessian of the barrier was asked where two surface primitives touch (d = 0)");

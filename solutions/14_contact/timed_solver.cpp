@@ -1,6 +1,9 @@
 // Chapter 14: the linear solver, timed. docs/14_contact.md#bodies-against-bodies-the-cost
 #include "14_contact/timed_solver.hpp"
 
+#include "common/error.hpp"
+#include "common/timer.hpp"
+
 namespace fem::contact {
 
 TimedSolver::TimedSolver(std::unique_ptr<cg::LinearSolver> inner)
@@ -13,7 +16,14 @@ void TimedSolver::do_prepare(const Eigen::SparseMatrix<double>& A, bool same_pat
     new_patterns += same_pattern ? 0 : 1;
     ++prepares;
     nonzeros += double(A.nonZeros());
-    inner_->prepare(A);
+    // A factorization that fails (a matrix that is not positive definite) costs its time too.
+    const Timer timer;
+    try {
+        inner_->prepare(A);
+    } catch (const Error&) {
+        seconds += timer.seconds();
+        throw;
+    }
     seconds += inner_->stats().prepare_seconds;
 }
 

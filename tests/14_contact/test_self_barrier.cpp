@@ -30,11 +30,14 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <vector>
 
 using namespace fem;
 using namespace fem::contact;
 using fem::test::box_at;
+using fem::test::entries_of;
+using fem::test::EntriesNear;
 using fem::test::two_bodies;
 
 namespace {
@@ -103,18 +106,23 @@ Eigen::Vector3d momentum(const dynamics::Body& body, const Eigen::VectorXd& v, E
     return p;
 }
 
-}  // namespace
-
-TEST_CASE("self-contact barrier: energy, gradient and Hessian against central differences, PSD", "[self][ex14.9]")
+/// Two one-cell cubes face to face 0.4 mm apart, the second turned 0.3 rad about x (the faces'
+/// normal) and shifted, so that vertices stand over the other's face and edges cross at angles:
+/// point–triangle and edge–edge pairs within d̂ = 1 mm. One mesh, the first cube's 8 vertices first.
+TetMesh turned_cubes()
 {
-    // Two one-cell cubes face to face 0.4 mm apart, the second turned 0.3 rad about x (the faces'
-    // normal) and shifted, so that vertices stand over the other's face and edges cross at angles:
-    // point–triangle and edge–edge pairs within d̂ = 1 mm.
     const TetMesh first = box_at(Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(0.1));
     TetMesh second = box_at(Eigen::Vector3d(-0.05, -0.05, -0.05), Eigen::Vector3d::Constant(0.1));
     const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()).toRotationMatrix();
     second.V = (second.V * turn.transpose()).rowwise() + Eigen::RowVector3d(0.1504, 0.07, 0.04);
-    const TetMesh mesh = two_bodies(first, second);
+    return two_bodies(first, second);
+}
+
+}  // namespace
+
+TEST_CASE("self-contact barrier: energy, gradient and Hessian against central differences, PSD", "[self][ex14.9]")
+{
+    const TetMesh mesh = turned_cubes();
     const SelfContactBarrier barrier(mesh, 1e-3);
     const SelfPotential potential{barrier, 50.0};
     const Eigen::Index n = 3 * mesh.V.rows();
@@ -150,8 +158,77 @@ TEST_CASE("self-contact barrier: energy, gradient and Hessian against central di
     const Eigen::VectorXd rest = Eigen::VectorXd::Zero(3 * 27);
     CHECK(alone.energy(rest, 50.0) == 0.0);
     CHECK(alone.smallest_distance(rest, 0.2) > 0.0);
-    CHECK_THROWS_AS(SelfContactBarrier(first, 0.0), Error);
+    CHECK_THROWS_AS(SelfContactBarrier(mesh, 0.0), Error);
     CHECK_THROWS_AS(alone.energy(Eigen::VectorXd::Zero(5), 1.0), Error);
+}
+
+TEST_CASE("self-contact barrier's Hessian unprojected and by absolute values: the central differences' Hessian, "
+          "and above it", "[self][ex14.9]")
+{
+    // The pairs of the test above (point–triangle and edge–edge within d̂): with no projection the
+    // blocks sum to ∇²P itself; with |λ| the sum is PSD and lies above the clamped one (|λ| ≥ max(λ, 0)).
+    const TetMesh mesh = turned_cubes();
+    const Eigen::Index half = mesh.V.rows() / 2;  // the first cube's vertices
+    const SelfContactBarrier barrier(mesh, 1e-3);
+    const SelfPotential potential{barrier, 50.0};
+    const Eigen::Index n = 3 * mesh.V.rows();
+    const auto assembled = [&](const Eigen::VectorXd& u, std::optional<hyper::Projection> projection) {
+        std::vector<Eigen::Triplet<double>> triplets;
+        barrier.add_hessian(u, potential.stiffness, triplets, projection);
+        Eigen::SparseMatrix<double> sparse(n, n);
+        sparse.setFromTriplets(triplets.begin(), triplets.end());
+        return Eigen::MatrixXd(sparse);
+    };
+    for (unsigned seed : {1u, 2u, 3u}) {
+        const Eigen::VectorXd u = 5e-5 * random_vector(n, seed);
+        const test::CentralDifferences differences = test::central_differences(potential, u, 1e-8);
+        const Eigen::MatrixXd symmetric = 0.5 * (differences.hessian + differences.hessian.transpose());
+        const Eigen::MatrixXd exact = assembled(u, std::nullopt), clamped = assembled(u, hyper::Projection::clamp),
+                              absolute = assembled(u, hyper::Projection::absolute);
+        INFO("seed " << seed << ", |H| " << exact.norm() << ", |H - H_fd| " << (exact - symmetric).norm());
+        CHECK((exact - symmetric).norm() <= 1e-4 * symmetric.norm());
+        // Indefinite as it is (the projection has something to do here), PSD projected.
+        const double scale = exact.norm();
+        CHECK(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(exact).eigenvalues().minCoeff() < -1e-8 * scale);
+        CHECK(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(absolute).eigenvalues().minCoeff() >= -1e-8 * scale);
+        CHECK(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(absolute - clamped).eigenvalues().minCoeff() >=
+              -1e-8 * scale);
+        CHECK((absolute - clamped).norm() > 1e-8 * scale);
+        // |λ| − max(λ, 0) = max(−λ, 0) per block: absolute − clamped = clamped − exact.
+        CHECK((absolute - clamped - (clamped - exact)).norm() <= 1e-10 * scale);
+        // The contact potential (κ fixed at the same 50 N/m) hands Newton these: hessian projected as
+        // ContactOptions::barrier_projection says, exact_hessian as it is only when asked. It refuses
+        // pairs within d̂ at rest: its mesh has the second cube 2 mm farther, u brings it back.
+        TetMesh apart = mesh;
+        Eigen::VectorXd u_apart = u;
+        for (Eigen::Index v = half; v < mesh.V.rows(); ++v) {
+            apart.V(v, 0) += 2e-3;
+            u_apart[3 * v] -= 2e-3;
+        }
+        const SelfContactBarrier apart_barrier(apart, 1e-3);
+        const auto apart_assembled = [&](std::optional<hyper::Projection> projection) {
+            std::vector<Eigen::Triplet<double>> triplets;
+            apart_barrier.add_hessian(u_apart, potential.stiffness, triplets, projection);
+            Eigen::SparseMatrix<double> sparse(n, n);
+            sparse.setFromTriplets(triplets.begin(), triplets.end());
+            return Eigen::MatrixXd(sparse);
+        };
+        const Eigen::MatrixXd apart_exact = apart_assembled(std::nullopt),
+                              apart_absolute = apart_assembled(hyper::Projection::absolute);
+        CHECK((apart_exact - exact).norm() <= 1e-2 * scale);  // the same pairs, near the same positions
+        for (bool exact_first : {false, true}) {
+            ContactOptions options;
+            options.self_contact = true;
+            options.stiffness = potential.stiffness;
+            options.barrier_projection = hyper::Projection::absolute;
+            options.exact_barrier_hessian = exact_first;
+            const test::ContactRun run(test::free_scene(apart), options);
+            INFO("exact_barrier_hessian " << exact_first);
+            CHECK_THAT(entries_of(run.contact->hessian(u_apart)), EntriesNear(apart_absolute, 1e-12 * scale, 1e-12));
+            CHECK_THAT(entries_of(run.contact->exact_hessian(u_apart)),
+                       EntriesNear(exact_first ? apart_exact : apart_absolute, 1e-12 * scale, 1e-12));
+        }
+    }
 }
 
 TEST_CASE("broad phase: brute force, the AABB tree and the spatial hash find the same pairs, every pair within r",
