@@ -14,6 +14,21 @@ from pathlib import Path
 CHAPTER_SOURCE = re.compile(r"/(?:chapters|solutions|exercises|tests)/(?P<number>\d\d)_\w+/")
 
 
+UNITY_INCLUDE = re.compile(r'^#include "(?P<path>[^"]+)"$', re.MULTILINE)
+
+
+def with_unity_sources(build, inputs):
+    """The inputs, each unity source CMake generated (FEM_UNITY_TESTS: <target>.dir/Unity/unity_N_cxx.cxx,
+    relative to the build folder) followed by the sources it includes."""
+    expanded = []
+    for path in inputs:
+        expanded.append(path)
+        if "/Unity/unity_" in path and path.endswith(".cxx"):
+            unity = Path(path) if Path(path).is_absolute() else build / path
+            expanded += UNITY_INCLUDE.findall(unity.read_text())
+    return expanded
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--build", type=Path, required=True, help="a configured build folder")
@@ -29,7 +44,7 @@ def main():
     if result.returncode != 0:
         print(f"FAIL there is no target test_ch{number} in {args.build}: {result.stderr.strip()}")
         return 1
-    inputs = result.stdout.split()
+    inputs = with_unity_sources(args.build, result.stdout.split())
     later = sorted({i for i in inputs if (m := CHAPTER_SOURCE.search(i)) and m["number"] > number})
     own_tests = [i for i in inputs if f"/tests/{args.chapter}/" in i and i.endswith(".cpp")]
     problems = [f"test_ch{number} builds {path}, a file of a later chapter" for path in later]

@@ -2,6 +2,7 @@
 // Every check compares with the tensor formulas σ = λ tr(ε) I + 2μ ε and ψ = μ ε:ε + (λ/2) tr(ε)²,
 // written out here independently of the Voigt code. docs/05_strain_stress.md
 #include "05_strain_stress/strain_stress.hpp"
+#include "rubber.hpp"
 
 #include "common/error.hpp"
 
@@ -19,13 +20,11 @@ using namespace fem::elastic;
 using fem::test::random_matrix;
 using fem::test::row_major_vec;
 using Catch::Matchers::Contains;
+using fem::test::rubber;
 using fem::test::EntriesNear;
 using fem::test::entries_of;
 
 namespace {
-
-// Y = 1e5 Pa, ν = 0.45: λ = νY/((1+ν)(1−2ν)), μ = Y/(2(1+ν)), written out by hand.
-const Lame rubber{0.45e5 / (1.45 * 0.1), 1e5 / 2.9};
 
 Eigen::Matrix3d tensor_stress(const Lame& m, const Eigen::Matrix3d& eps)
 {

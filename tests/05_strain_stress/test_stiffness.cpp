@@ -2,6 +2,7 @@
 // ψ = μ ε:ε + (λ/2) tr(ε)² computed here from the 3×3 strain; rigid modes, a patch test on a distorted
 // mesh, the lecture's Voigt slip, and conditioning as ν → ½. docs/05_strain_stress.md
 #include "05_strain_stress/strain_stress.hpp"
+#include "rubber.hpp"
 
 #include "04_tet_jacobians/tet_jacobians.hpp"
 #include "common/error.hpp"
@@ -20,11 +21,10 @@ using namespace fem::elastic;
 using fem::test::skew_tet;
 using fem::tet::TetVertices;
 using Catch::Matchers::Contains;
+using fem::test::rubber;
 using Vector12d = Eigen::Matrix<double, 12, 1>;
 
 namespace {
-
-const Lame rubber{0.45e5 / (1.45 * 0.1), 1e5 / 2.9};  // Y = 1e5 Pa, ν = 0.45, written out by hand
 
 TetVertices rows_of(const Vector12d& q)
 {

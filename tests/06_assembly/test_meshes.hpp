@@ -2,6 +2,7 @@
 // Meshes and independent reference answers shared by the tests of chapter 06.
 
 #include "05_strain_stress/strain_stress.hpp"
+#include "../05_strain_stress/rubber.hpp"
 #include "common/mesh.hpp"
 
 #include <Eigen/Core>
@@ -14,9 +15,6 @@
 #include <vector>
 
 namespace fem::test {
-
-/// Rubber, Y = 1e5 Pa and ν = 0.45, with λ and μ written out by hand.
-inline const elastic::Lame rubber{0.45e5 / (1.45 * 0.1), 1e5 / 2.9};
 
 /// A box mesh with its interior vertices moved at random (by at most 0.15 of a cell, which keeps
 /// every Kuhn tet positively oriented) and its vertices numbered in a random order, so that no

@@ -20,7 +20,7 @@ using Catch::Matchers::Contains;
 
 namespace {
 
-const double rho = 1000.0;
+const double density = 1000.0;
 
 // The dofs of the vertices not in `pinned`, ascending: the index list P encodes.
 std::vector<int> free_dofs(int vertex_count, const std::vector<int>& pinned)
@@ -82,8 +82,8 @@ TEST_CASE("pinned: PᵀKP and PᵀKP + M are SPD, free-floating K is singular an
 {
     const TetMesh mesh = fem::test::distorted_mesh(4, 2, 2);
     const SparseMatrix K = stiffness_matrix(mesh, fem::test::rubber);
-    const SparseMatrix M = lumped_mass_matrix(mesh, rho);
-    const Eigen::VectorXd f = gravity_load(mesh, rho);
+    const SparseMatrix M = lumped_mass_matrix(mesh, density);
+    const Eigen::VectorXd f = gravity_load(mesh, density);
 
     // Free-floating: the solve must refuse (6 rigid modes), never return a silent wrong answer.
     CHECK_THROWS_WITH(solve_spd(K, f), Contains("singular") || Contains("not SPD"));

@@ -2,6 +2,7 @@
 // Test matrices and references of chapter 08, built without the chapter's own code: random dense
 // matrices, sparse SPD matrices as Eigen sees them, and Eigen's factorizations as the reference.
 
+#include "05_strain_stress/strain_stress.hpp"
 #include "07_sparse_storage/sparse_formats.hpp"
 
 #include "common/error.hpp"
@@ -18,6 +19,9 @@
 #include <vector>
 
 namespace fem::direct::test {
+
+/// The rubber of the model problems' meshes: Young's modulus 10⁵ Pa, Poisson ratio 0.45.
+inline const elastic::Lame rubber = elastic::lame_parameters(1e5, 0.45);
 
 /// The message of the fem::Error that work() throws, or "" if it throws none. Other exceptions
 /// (an unfinished exercise's fem::NotImplemented) propagate and fail the test.

@@ -21,8 +21,6 @@ using Catch::Matchers::Contains;
 
 namespace {
 
-const elastic::Lame rubber = elastic::lame_parameters(1e5, 0.45);
-
 /// A path 0 — 1 — … — (n−1) with a dominant diagonal, then renumbered by perm (new = position).
 sparse::CscMatrix path_matrix(int n, const std::vector<int>& perm)
 {

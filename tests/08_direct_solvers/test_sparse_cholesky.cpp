@@ -28,8 +28,6 @@ using fem::test::entries_of;
 
 namespace {
 
-const elastic::Lame rubber = elastic::lame_parameters(1e5, 0.45);
-
 struct Named {
     std::string name;
     sparse::CscMatrix A;

@@ -25,8 +25,6 @@ using namespace fem::direct::test;
 
 namespace {
 
-const elastic::Lame rubber = elastic::lame_parameters(1e5, 0.45);
-
 /// Everything the factorization and the solves produce, to be compared bit for bit.
 struct Results {
     sparse::CscMatrix L;

@@ -15,6 +15,12 @@
 
 namespace fem::cg::test {
 
+/// ‖x − reference‖ / ‖reference‖ of two vectors of one length (reference nonzero).
+inline double relative_error(const Eigen::VectorXd& x, const Eigen::VectorXd& reference)
+{
+    return (x - reference).norm() / reference.norm();
+}
+
 /// Q diag(eigenvalues) Qᵀ with Q orthogonal (the Q of a random matrix's QR), made exactly
 /// symmetric, as a dense matrix.
 inline Eigen::MatrixXd spd_with_spectrum(const Eigen::VectorXd& eigenvalues, unsigned seed)

@@ -29,6 +29,7 @@ using namespace fem::cg;
 using fem::test::EntriesNear;
 using fem::test::entries_of;
 using fem::cg::test::dense_solve;
+using fem::cg::test::relative_error;
 using fem::random_vector;
 using fem::cg::test::spd_with_spectrum;
 using Catch::Matchers::Contains;
@@ -43,11 +44,6 @@ EigenOperator sparse_operator(const Eigen::MatrixXd& A)
 Eigen::SparseMatrix<double> laplacian_2d(int n)
 {
     return fem::sparse::to_eigen(fem::direct::laplacian_2d(n));
-}
-
-double relative_error(const Eigen::VectorXd& x, const Eigen::VectorXd& reference)
-{
-    return (x - reference).norm() / reference.norm();
 }
 
 }  // namespace

@@ -25,6 +25,7 @@
 using namespace fem::cg;
 using fem::cg::test::dense_solve;
 using fem::cg::test::kershaw_matrix;
+using fem::cg::test::relative_error;
 using fem::random_vector;
 using fem::cg::test::spd_with_spectrum;
 using fem::cg::test::tridiagonal_laplacian;
@@ -43,11 +44,6 @@ CsrMatrix csr_of(const Eigen::MatrixXd& A)
 Eigen::MatrixXd dense_of(const CsrMatrix& A)
 {
     return Eigen::MatrixXd(fem::sparse::to_eigen(A));
-}
-
-double relative_error(const Eigen::VectorXd& x, const Eigen::VectorXd& reference)
-{
-    return (x - reference).norm() / reference.norm();
 }
 
 /// A random lower triangular n×n matrix with a nonzero diagonal in [1, 2] and off-diagonal entries

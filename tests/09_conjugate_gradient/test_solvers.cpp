@@ -18,14 +18,10 @@
 using namespace fem::cg;
 using fem::random_vector;
 using fem::cg::test::spd_with_spectrum;
+using fem::cg::test::relative_error;
 using Catch::Matchers::Contains;
 
 namespace {
-
-double relative_error(const Eigen::VectorXd& x, const Eigen::VectorXd& reference)
-{
-    return (x - reference).norm() / reference.norm();
-}
 
 bool listed(const std::string& name)
 {

@@ -10,6 +10,7 @@
 #include "common/mesh_io.hpp"
 #include "common/random.hpp"
 
+#include "../common/bunny_meshes.hpp"
 #include "../common/test_support.hpp"
 
 #include <catch2/catch.hpp>
@@ -22,13 +23,12 @@
 
 using namespace fem;
 using namespace fem::skin;
+using fem::test::bunny_surface;
+using fem::test::bunny_tets;
 using fem::test::EntriesNear;
 using fem::test::entries_of;
 
 namespace {
-
-TetMesh bunny_tets() { return io::read_tet_mesh(data_path("bunny_coarse.node")); }
-TriMesh bunny() { return io::read_tri_mesh(data_path("bunny.obj")); }
 
 /// Points exactly on the mesh's vertices, on the midpoints of the edges and the centroids of the
 /// faces of every k-th tet, and the tets' centroids.
@@ -98,7 +98,7 @@ namespace {
 /// Every vertex of the bunny and the special points of TetGen's tets: the brute force's tet.
 void check_on_bunny(const BarycentricFrames& frames, const PointLocator& locator, double tolerance)
 {
-    const TriMesh surface = bunny();
+    const TriMesh surface = bunny_surface();
     std::vector<Eigen::Vector3d> points;
     for (Eigen::Index v = 0; v < surface.V.rows(); ++v)
         points.push_back(surface.V.row(v).transpose());
@@ -264,7 +264,7 @@ TEST_CASE("points just inside the tolerance beyond a corner, by the tree: the br
 
 TEST_CASE("the coarse lattice encloses the bunny: every vertex inside, brute force and chapter 04 agree", "[ex13.1]")
 {
-    const TriMesh surface = bunny();
+    const TriMesh surface = bunny_surface();
     const TetMesh lattice = enclosing_lattice(surface, 6);
     const BarycentricFrames frames(lattice, "lattice");
     for (Eigen::Index v = 0; v < surface.V.rows(); ++v)
@@ -285,7 +285,7 @@ TEST_CASE("the coarse lattice encloses the bunny: every vertex inside, brute for
 
 TEST_CASE("the lattice and the subdivided surface: the shapes the docs promise", "[ch13]")
 {
-    const TriMesh surface = bunny();
+    const TriMesh surface = bunny_surface();
     const TetMesh lattice = enclosing_lattice(surface, 6);
     CHECK(total_volume(lattice) > 0.0);
     CHECK(lattice.T.rows() % 6 == 0);

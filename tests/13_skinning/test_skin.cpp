@@ -15,6 +15,7 @@
 #include "common/mesh_io.hpp"
 #include "common/random.hpp"
 
+#include "../common/bunny_meshes.hpp"
 #include "../common/test_support.hpp"
 
 #include <catch2/catch.hpp>
@@ -29,13 +30,12 @@
 using namespace fem;
 using namespace fem::skin;
 using Catch::Matchers::Contains;
+using fem::test::bunny_surface;
+using fem::test::bunny_tets;
 using fem::test::EntriesNear;
 using fem::test::entries_of;
 
 namespace {
-
-TetMesh bunny_tets() { return io::read_tet_mesh(data_path("bunny_coarse.node")); }
-TriMesh bunny() { return io::read_tri_mesh(data_path("bunny.obj")); }
 
 /// x = W Q by Eigen's sparse product (an independent route to the skinned positions).
 MatrixX3d eigen_product(const sparse::CsrMatrix& W, const MatrixX3d& Q)
@@ -90,7 +90,7 @@ TEST_CASE("W: four weights a row, summing to 1, between -tol and 1 + tol for ins
           "[ex13.4]")
 {
     const TetMesh mesh = bunny_tets();
-    const TriMesh surface = midpoint_subdivision(bunny(), 1);
+    const TriMesh surface = midpoint_subdivision(bunny_surface(), 1);
     const SkinOptions options;
     const Skin skin = build_skin(mesh, surface, options);
     REQUIRE(skin.W.rows == surface.V.rows());
@@ -115,7 +115,7 @@ TEST_CASE("W carries any affine motion of the coarse mesh exactly, and is the id
           "[ex13.4]")
 {
     const TetMesh mesh = bunny_tets();
-    const TriMesh surface = bunny();
+    const TriMesh surface = bunny_surface();
     const Skin skin = build_skin(mesh, surface);
     CHECK_THAT(entries_of(eigen_product(skin.W, affine(mesh.V))), EntriesNear(affine(surface.V), 1e-12 * 10.0));
     // The lattice: the bunny inside cubes, weights of all four corners.
@@ -134,7 +134,7 @@ TEST_CASE("skinning a smooth motion: the error of a quadratic field falls as h^2
 {
     // The field x(X) = X + ε (X_y², X_z X_x, X_x²): W interpolates it linearly in each tet, with an
     // error ≤ (ε/2)·|second derivative|·h² per vertex; halving h divides it by about four.
-    const TriMesh surface = bunny();
+    const TriMesh surface = bunny_surface();
     const auto field = [](const MatrixX3d& X) {
         MatrixX3d x = X;
         x.col(0) += 0.01 * X.col(1).cwiseProduct(X.col(1));
@@ -235,8 +235,8 @@ TEST_CASE("points outside a cube: the nearest tet, the distances, extrapolated w
     CHECK(*std::min_element(skin.W.A.begin(), skin.W.A.end()) < 0.0);
     CHECK_THAT(entries_of(eigen_product(skin.W, affine(cube.V))), EntriesNear(affine(V), 1e-14));
     // A surface larger than the bunny's tets: outside vertices counted, all carried affinely.
-    TriMesh grown = first_triangles(bunny(), 400);
-    const Eigen::RowVector3d centre = bunny().V.colwise().mean();
+    TriMesh grown = first_triangles(bunny_surface(), 400);
+    const Eigen::RowVector3d centre = bunny_surface().V.colwise().mean();
     grown.V = ((grown.V.rowwise() - centre) * 1.02).rowwise() + centre;
     const TetMesh tets = bunny_tets();
     const Skin large = build_skin(tets, grown, options);
@@ -287,7 +287,7 @@ TEST_CASE("normals: a flat patch points along z, a sphere's radially, and they t
 TEST_CASE("bad input: an empty surface, NaN coordinates, an inverted or flat coarse tet are named", "[ch13]")
 {
     const TetMesh cube = box_mesh(1, 1, 1);
-    const TriMesh surface = bunny();
+    const TriMesh surface = bunny_surface();
     CHECK_THROWS_WITH(build_skin(cube, TriMesh{}), Contains("empty"));
     TriMesh nan_surface = surface;
     nan_surface.V(17, 1) = std::nan("");
@@ -316,7 +316,7 @@ TEST_CASE("skinning a coarse simulation: the skinned lattice approaches the fine
     // Chapter 10's rubber bunny (9.7 cm), pushed sideways, four steps of corotational backward Euler
     // on TetGen's tets (whose surface is the bunny: the reference) and on lattices of 8 and 16 cubes,
     // each skinned: the finer lattice's surface is closer to the reference (the executable's sweep).
-    TriMesh surface = bunny();
+    TriMesh surface = bunny_surface();
     surface.V *= 0.01;
     TetMesh fine = bunny_tets();
     fine.V *= 0.01;

@@ -8,8 +8,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace fem::test {
+
+/// One degree in radians: the slopes' angles are given in degrees (17.0 * degree).
+inline constexpr double degree = std::numbers::pi / 180.0;
 
 /// What a sticking block's creep came to: the last step's move along the slope [m] and the largest
 /// |move| of a step once the lagged normal force has settled (from step 5 on) [m].

@@ -26,10 +26,9 @@
 
 using namespace fem;
 using namespace fem::contact;
+using fem::test::degree;
 
 namespace {
-
-constexpr double degree = std::numbers::pi / 180.0;
 
 /// The plane z = 0 as a mesh: square_mesh(cells, jitter) scaled to side × side, turned by `angle`
 /// about z and moved so that its vertex `vertex` stands at `at` [m].

@@ -28,10 +28,9 @@
 
 using namespace fem;
 using namespace fem::contact;
+using fem::test::degree;
 
 namespace {
-
-constexpr double degree = std::numbers::pi / 180.0;
 
 /// A contact potential that records the smallest distance of every configuration the line search
 /// and the step start evaluate: none of them may be inside an obstacle.

@@ -1,6 +1,7 @@
 // Model "auto": the deformation measures, the level they choose, and where a run switches.
 // docs/scenes.md#model-auto
 #include "scenes/runner.hpp"
+#include "scenes/scene_text.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -12,10 +13,9 @@
 
 using namespace fem;
 using namespace fem::scenes;
+using testing::gallery;
 
 namespace {
-
-const std::filesystem::path gallery = FEM_SCENES_DIR;
 
 /// The cantilever of the gallery, small and short, one frame per step.
 SceneSpec small_cantilever(std::vector<std::string> overrides)

@@ -3,6 +3,7 @@
 // defects found in review. docs/scenes.md#the-runner
 #include "scenes/compare.hpp"
 #include "scenes/runner.hpp"
+#include "scenes/scene_text.hpp"
 
 #include "12_hyperelastic_newton/materials.hpp"
 
@@ -17,21 +18,10 @@
 using namespace fem;
 using namespace fem::scenes;
 using Catch::Matchers::Contains;
+using testing::scene_from;
+using testing::gallery;
 
 namespace {
-
-const std::filesystem::path gallery = FEM_SCENES_DIR;
-
-/// A scene from its text, written into the tests' output folder first.
-SceneSpec scene_from(const std::string& name, const std::string& text, const std::vector<std::string>& overrides = {})
-{
-    const std::filesystem::path output = FEM_TEST_OUTPUT_DIR;
-    std::filesystem::create_directories(output);
-    const std::filesystem::path file = output / (name + ".toml");
-    std::ofstream(file) << text;
-    return read_scene(file, overrides);
-}
-
 
 /// A 0.2 m bar of 8 × 2 × 2 cubes along x, clamped at x = 0, with the extra TOML text given.
 std::string bar(const std::string& model, const std::string& extra)

@@ -3,6 +3,7 @@
 #include "scenes/live_view.hpp"
 #include "scenes/runner.hpp"
 #include "scenes/scene_contact.hpp"
+#include "scenes/scene_text.hpp"
 
 #include "12_hyperelastic_newton/force_models.hpp"
 
@@ -22,11 +23,10 @@
 
 using namespace fem;
 using namespace fem::scenes;
+using testing::gallery;
+using testing::output;
 
 namespace {
-
-const std::filesystem::path gallery = FEM_SCENES_DIR;
-const std::filesystem::path output = FEM_TEST_OUTPUT_DIR;
 
 /// A 10 cm cube (2 cells) dropped from 2 cm onto the floor z = 0 (μ = 0.5), Δt = 1/100, a frame per
 /// step, model auto; obstacle lines replace the floor when given.

@@ -24,10 +24,9 @@
 
 using namespace fem;
 using namespace fem::scenes;
+using testing::output;
 
 namespace {
-
-const std::filesystem::path output = FEM_TEST_OUTPUT_DIR;
 
 
 /// A 0.1 m cube 5 cm above the floor z = 0 (or with no obstacle, or above a ball), for `duration`

@@ -36,11 +36,10 @@
 
 using namespace fem;
 using namespace fem::scenes;
+using testing::gallery;
+using testing::output;
 
 namespace {
-
-const std::filesystem::path gallery = FEM_SCENES_DIR;
-const std::filesystem::path output = FEM_TEST_OUTPUT_DIR;
 
 using testing::scene_from;
 

@@ -1,6 +1,7 @@
 // The scene file: every bad scene is a clear error naming file, line, column and field; overrides
 // are checked like the file; selectors and prescribed motions. docs/scenes.md#the-scene-file
 #include "scenes/scene_file.hpp"
+#include "scenes/scene_text.hpp"
 
 #include "13_skinning/skinning.hpp"
 
@@ -20,11 +21,11 @@
 
 using namespace fem;
 using namespace fem::scenes;
+using testing::gallery;
 
 namespace {
 
 const std::filesystem::path bad = FEM_SCENE_BAD_DIR;
-const std::filesystem::path gallery = FEM_SCENES_DIR;
 
 /// The message of the fem::Error read_scene throws (fails the test when it throws none).
 std::string error_of(const std::filesystem::path& file, const std::vector<std::string>& overrides = {},
