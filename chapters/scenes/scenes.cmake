@@ -25,9 +25,7 @@ if(FEM_BUILD_TESTS)
                              FEM_SCENES_DIR="${FEM_ROOT}/scenes" FEM_SCENE_EXE="$<TARGET_FILE:fem_scene>"
                              FEM_SCENE_BAD_DIR="${FEM_ROOT}/tests/scenes/bad_scenes")
   add_dependencies(test_scenes fem_scene)
-  fem_test_pch_for(test_scenes)
-  fem_test_unity_for(test_scenes)
-  fem_test_code(test_scenes)
+  fem_test_sources(test_scenes)
   fem_discover_tests(test_scenes "scenes" ${scene_test_sources})
   add_dependencies(fem_tests test_scenes)
 
