@@ -18,8 +18,8 @@ namespace fem::contact {
 /// A chapter 09 LinearSolver, timed: seconds sums the wrapped solver's own prepare_seconds (its
 /// factorisation or preconditioner, with the symbolic analysis of a new pattern) and solve_seconds
 /// of every prepare and solve, and the time of each prepare that failed (fem::Error, passed on: a
-/// Cholesky factorization of a matrix that is not positive definite); new_patterns counts the prepares with a new sparsity pattern (a new
-/// fill-reducing ordering and symbolic analysis). Answers as the wrapped solver: it starts with the
+/// Cholesky factorization of a matrix that is not positive definite); new_patterns counts the
+/// prepares with a new sparsity pattern (a new fill-reducing ordering and symbolic analysis). Answers as the wrapped solver: it starts with the
 /// wrapped solver's options, and each solve passes on the relative tolerance set on it
 /// (set_relative_tolerance, which inexact Newton sets per solve).
 class TimedSolver final : public cg::LinearSolver {

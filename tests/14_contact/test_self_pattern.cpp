@@ -4,6 +4,7 @@
 // the contact potential's clocks (ContactClocks) that split such a step's time.
 // docs/14_contact.md#bodies-against-bodies-the-cost
 #include "14_contact/contact.hpp"
+#include "14_contact/timed_solver.hpp"
 
 #include "contact_bodies.hpp"
 
@@ -32,30 +33,6 @@ using fem::test::two_bodies;
 
 namespace {
 
-/// Chapter 09's default solver, counting the prepares whose matrix had a new sparsity pattern.
-class PatternCountingSolver final : public cg::LinearSolver {
-public:
-    explicit PatternCountingSolver(std::unique_ptr<cg::LinearSolver> inner)
-        : LinearSolver(inner->name()), inner_(std::move(inner))
-    {
-    }
-    bool is_direct() const override { return inner_->is_direct(); }
-    int new_patterns = 0;
-
-private:
-    void do_prepare(const Eigen::SparseMatrix<double>& A, bool same_pattern) override
-    {
-        new_patterns += same_pattern ? 0 : 1;
-        inner_->prepare(A);
-    }
-    int do_solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) override
-    {
-        inner_->solve(b, x);
-        return inner_->stats().iterations;
-    }
-    std::unique_ptr<cg::LinearSolver> inner_;
-};
-
 /// The (row, column) of every stored entry of A, explicit zeros included.
 std::set<std::pair<Eigen::Index, Eigen::Index>> pattern(const Eigen::SparseMatrix<double>& A)
 {
@@ -71,7 +48,7 @@ std::set<std::pair<Eigen::Index, Eigen::Index>> pattern(const Eigen::SparseMatri
 /// step's Newton iterations), with self-contact, the Hessian's pattern reaching reach × d̂, and
 /// Newton's solver counting new patterns.
 struct Approach : test::ContactRun {
-    PatternCountingSolver* solver = nullptr;
+    TimedSolver* solver = nullptr;  // counts the matrices with a new pattern
 
     explicit Approach(double reach) : ContactRun(test::free_scene(mesh()), options(reach), {}, {}, thrown())
     {
@@ -79,7 +56,7 @@ struct Approach : test::ContactRun {
         newton_options.relative_tolerance = 1e-9;
         newton_options.max_iterations = 200;
         newton_options.make_solver = [this] {
-            auto counting = std::make_unique<PatternCountingSolver>(cg::make_solver("default"));
+            auto counting = std::make_unique<TimedSolver>(cg::make_solver("default"));
             solver = counting.get();
             return counting;
         };
