@@ -1,8 +1,9 @@
-# fem_add_chapter(NN name [DEPENDS MM ...])
+# fem_add_chapter(NN name [DEPENDS MM ...] [OWN file.cpp ...])
 #
 # Registers chapter NN_name, the one way a chapter enters the build:
 #   fem_chNN            its library: the chapter's functions, compiled from solutions/NN_name
 #                       (default) or exercises/NN_name (when NN is in FEM_EXERCISES or it is "all");
+#   fem_chNN_own        with OWN files: those files, on top of fem_chNN (below);
 #   fem_chNN_reference  what later chapters link: always the reference solution, so a student
 #                       working on chapter 05 keeps chapters 06+ running;
 #   chNN_name           its executable in <build>/bin, from chapters/NN_name/main.cpp;
@@ -22,6 +23,10 @@
 #                       bad command line of that table before it computes or writes anything
 #                       (tools/check_bad_options.py says the table's form; label chNN, run).
 # DEPENDS lists earlier chapters whose headers this chapter includes; a later one is an error.
+# OWN lists the chapter's source files (names in solutions/NN_name) that only its own executable and
+# tests call, never a later chapter: they compile into a library of their own, fem_chNN_own (linking
+# fem_chNN), which later chapters do not link, so that a student's build of a later chapter does not
+# compile them (chapter 10's modes.cpp, Spectra's eigensolvers: 13 s of a core).
 
 set(FEM_ALL_CHAPTERS "" CACHE INTERNAL "registered chapters")
 add_custom_target(fem_tests)
@@ -86,7 +91,7 @@ function(fem_reference_code target)
 endfunction()
 
 function(fem_add_chapter number name)
-  cmake_parse_arguments(PARSE_ARGV 2 CH "" "" "DEPENDS")
+  cmake_parse_arguments(PARSE_ARGV 2 CH "" "" "DEPENDS;OWN")
   set(id ${number}_${name})
   set(lib fem_ch${number})
   foreach(dep IN LISTS CH_DEPENDS)
@@ -124,6 +129,21 @@ function(fem_add_chapter number name)
   else()
     set(sources ${solution_sources})
   endif()
+  # The OWN files apart: `own_sources` for fem_chNN_own, the rest for fem_chNN (and its reference).
+  set(own_sources "")
+  set(shared_solution_sources ${solution_sources})
+  foreach(file_name IN LISTS CH_OWN)
+    if(NOT EXISTS ${FEM_ROOT}/solutions/${id}/${file_name})
+      message(FATAL_ERROR "chapter ${id}: OWN ${file_name} is not a file of solutions/${id}")
+    endif()
+    list(FILTER sources EXCLUDE REGEX "/${file_name}$")
+    list(FILTER shared_solution_sources EXCLUDE REGEX "/${file_name}$")
+    if(from_exercises AND EXISTS ${FEM_ROOT}/exercises/${id}/${file_name})
+      list(APPEND own_sources ${FEM_ROOT}/exercises/${id}/${file_name})
+    else()
+      list(APPEND own_sources ${FEM_ROOT}/solutions/${id}/${file_name})
+    endif()
+  endforeach()
 
   add_library(${lib} STATIC ${sources})
   target_include_directories(${lib} PUBLIC ${FEM_ROOT}/chapters)
@@ -131,12 +151,21 @@ function(fem_add_chapter number name)
   foreach(dep IN LISTS CH_DEPENDS)
     target_link_libraries(${lib} PUBLIC fem_ch${dep}_reference)
   endforeach()
+  # What the chapter's executable and tests link: fem_chNN, or fem_chNN_own on top of it.
+  set(user ${lib})
+  if(own_sources)
+    set(user ${lib}_own)
+    add_library(${user} STATIC ${own_sources})
+    target_link_libraries(${user} PUBLIC ${lib} PRIVATE fem_flags)
+  endif()
   if(from_exercises)
     # A stub leaves its parameters and the helpers its solution used unused.
-    target_compile_options(${lib} PRIVATE -Wno-unused-parameter -Wno-unused-variable
-                           -Wno-unused-but-set-variable -Wno-unused-function)
+    foreach(target IN ITEMS ${lib} ${user})
+      target_compile_options(${target} PRIVATE -Wno-unused-parameter -Wno-unused-variable
+                             -Wno-unused-but-set-variable -Wno-unused-function)
+    endforeach()
     # Later chapters keep running on the reference solution of this one.
-    add_library(${lib}_reference STATIC ${solution_sources})
+    add_library(${lib}_reference STATIC ${shared_solution_sources})
     target_include_directories(${lib}_reference PUBLIC ${FEM_ROOT}/chapters)
     target_link_libraries(${lib}_reference PUBLIC fem_common PRIVATE fem_flags)
     foreach(dep IN LISTS CH_DEPENDS)
@@ -145,13 +174,15 @@ function(fem_add_chapter number name)
     fem_reference_code(${lib}_reference)
   else()
     add_library(${lib}_reference ALIAS ${lib})
-    fem_reference_code(${lib})
+    foreach(target IN ITEMS ${lib} ${user})
+      fem_reference_code(${target})
+    endforeach()
   endif()
   add_dependencies(fem_chapter_libs ${lib})
 
   set(exe ch${number}_${name})
   add_executable(${exe} ${FEM_ROOT}/chapters/${id}/main.cpp)
-  target_link_libraries(${exe} PRIVATE ${lib} fem_flags)
+  target_link_libraries(${exe} PRIVATE ${user} fem_flags)
 
   if(FEM_BUILD_TESTS)
     file(GLOB test_sources CONFIGURE_DEPENDS ${FEM_ROOT}/tests/${id}/*.cpp)
@@ -167,7 +198,7 @@ function(fem_add_chapter number name)
     target_compile_definitions(${test_exe}_objects PRIVATE FEM_TEST_OUTPUT_DIR="${CMAKE_BINARY_DIR}/test_output/${id}")
     fem_test_sources(${test_exe}_objects)  # tests/common/CMakeLists.txt
     add_executable(${test_exe})
-    target_link_libraries(${test_exe} PRIVATE ${test_exe}_objects ${lib} fem_test_main fem_flags)
+    target_link_libraries(${test_exe} PRIVATE ${test_exe}_objects ${user} fem_test_main fem_flags)
     fem_discover_tests(${test_exe} "ch${number}" ${test_sources})
     add_dependencies(fem_tests ${test_exe})
     if(FEM_GRADING)
@@ -229,10 +260,13 @@ function(fem_add_chapter number name)
   # executable) go in chapters/NN_name/chapter.cmake, included here, where ${lib}, ${exe} and
   # ${test_exe} name its targets (the test sources compile in ${test_exe}_objects: a compile
   # option or definition for them goes there) and ${chapter_libraries} lists every library built
-  # from its sources: ${lib}, in a student build also its reference twin ${lib}_reference, and with
-  # FEM_GRADING its graded twin ${lib}_graded. A package the chapter's code needs is linked to
+  # from its sources: ${lib}, with OWN files ${lib}_own, in a student build also the reference twin
+  # ${lib}_reference, and with FEM_GRADING the graded twin ${lib}_graded. A package the chapter's code needs is linked to
   # each of them.
   set(chapter_libraries ${lib})
+  if(own_sources)
+    list(APPEND chapter_libraries ${user})
+  endif()
   get_target_property(reference_aliased ${lib}_reference ALIASED_TARGET)
   if(NOT reference_aliased)
     list(APPEND chapter_libraries ${lib}_reference)
