@@ -140,8 +140,8 @@ private:
         } catch (const Error&) {
             // A new pattern whose values are not positive definite: keep its ordering and analysis
             // for the next matrix of the pattern (Newton's definite Hessian after a failed exact one)
-            // by analysing a stand-in of the same pattern that is (diagonally dominant), then fail
-            // on A's values as before.
+            // by analysing a positive definite stand-in of the same pattern, then fail on A's values
+            // as before.
             factor_.emplace(diagonally_dominant(A));
             factor_->factorize(sparse::csc_from_eigen(A));
         }
