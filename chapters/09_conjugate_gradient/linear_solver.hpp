@@ -75,7 +75,10 @@ public:
     /// Factor A (direct) or build the preconditioner (iterative); call it again whenever A changes.
     /// The solver keeps a copy of A (for the residual check). fem::Error if A is empty, not square,
     /// not finite or not symmetric (symmetry_tolerance), and for a direct solver if A is not
-    /// positive definite; after an error the solver is unprepared.
+    /// positive definite; after an error the solver is unprepared (solve refuses), but after a
+    /// factorization that failed on A's values it keeps A's pattern and its analysis: the next
+    /// matrix of that pattern (Newton's definite Hessian after an exact one that failed) is only
+    /// factored, not ordered and analysed anew.
     void prepare(const Eigen::SparseMatrix<double>& A);
 
     /// x with A x = b, starting an iterative solver from x = 0.
@@ -96,7 +99,7 @@ public:
     /// fem::Error before the first solve after prepare().
     double relative_residual() const;
     /// n of the prepared matrix (0 before prepare()).
-    Eigen::Index size() const { return A_.rows(); }
+    Eigen::Index size() const { return prepared_ ? A_.rows() : 0; }
 
     /// The tolerance and cap of an iterative solver (a direct one ignores them).
     const SolverOptions& options() const { return options_; }
@@ -124,6 +127,7 @@ private:
     SolverOptions options_;
     Eigen::SparseMatrix<double> A_;  // for the residual check and the pattern comparison
     std::vector<std::pair<int, int>> mirror_;  // the entry pairs (k, m) the symmetry check compares
+    bool prepared_ = false;                    // the last prepare() succeeded
     SolveStats stats_;
     // The last solve's residual (< 0: none yet), or its b and x while relative_residual() has not
     // computed it (pending).

@@ -48,6 +48,11 @@ struct NewtonOptions {
     double armijo = 1e-4;              ///< c: accept α when E(v + αd) ≤ E(v) + c α ∇Eᵀd
     double shrink = 0.5;               ///< α ← shrink · α after a rejected trial
     double smallest_step = 1e-10;      ///< a line search that needs α below this fails (fem::Error)
+    /// Also converged when the Newton direction d is this small: ‖d‖∞ ≤ step_tolerance (x's units;
+    /// for a step, a velocity: a fraction of d̂ / Δt bounds every vertex's last move), after taking
+    /// its step, beside the gradient's test (IPC's test on the step's length). 0: the gradient's
+    /// test alone (the default). docs/14_contact.md#bodies-against-bodies-the-cost
+    double step_tolerance = 0.0;
     bool line_search = true;           ///< false: plain Newton, α = 1 always (to show what it risks)
     HessianChoice hessian = HessianChoice::exact_then_definite;
     /// Inexact Newton: an iterative solver solves H d = −∇E only to the relative residual
@@ -194,7 +199,8 @@ struct NewtonProblem {
 struct NewtonResult {
     Eigen::VectorXd x;
     int iterations = 0, solver_iterations = 0, definite_fallbacks = 0;
-    std::vector<double> gradient_history;  ///< ‖gradient‖ / scale at each iterate (the first: at x₀)
+    std::vector<double> gradient_history;  ///< ‖gradient‖ / scale at each iterate (the first: at x₀;
+                                           ///< none at the last one when step_tolerance stopped it)
     std::vector<double> step_lengths;      ///< the α the line search accepted
 };
 
@@ -203,7 +209,8 @@ struct NewtonResult {
 /// largest α = shrinkᵏ with objective(x + αd) ≤ objective(x) + c α ∇ᵀd (+ its round-off; where the
 /// change is below objective_resolution × E's terms, the same test by the trapezoid rule on
 /// slopes), until
-/// ‖∇‖ ≤ tolerance × scale (or ≤ smallest_measurable_norm). fem::Error naming problem.what when
+/// ‖∇‖ ≤ tolerance × scale (or ≤ smallest_measurable_norm), or, with options.step_tolerance > 0,
+/// until the step of a direction with ‖d‖∞ ≤ step_tolerance is taken. fem::Error naming problem.what when
 /// the cap is reached, the line search fails, or no Hessian gives a descent direction. When the
 /// problem has a largest_step, the trials start at α = largest_step(x, d) instead of 1.
 /// docs/12_hyperelastic_newton.md#newton-with-line-search
@@ -221,7 +228,7 @@ Eigen::VectorXd solve_static(dynamics::Body& body, const NewtonOptions& options 
 class NewtonBackwardEuler final : public dynamics::Integrator {
 public:
     /// fem::Error for a tolerance outside (0, 1), a cap < 1, c outside (0, ½), shrink outside (0, 1),
-    /// a smallest step outside (0, 1), or an unknown solver.
+    /// a smallest step outside (0, 1), a step tolerance < 0 or not finite, or an unknown solver.
     explicit NewtonBackwardEuler(NewtonOptions options = {});
 
     std::string name() const override { return "Newton backward Euler"; }

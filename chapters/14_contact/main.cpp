@@ -72,7 +72,7 @@ int main(int argc, char** argv)
         ->check(check::real(0.0, 5.0, check::Ends::open_closed))->capture_default_str();
     bool hessian_variants = false;
     cli.app.add_flag("--hessian-variants", hessian_variants,
-                     "Also run the two bunnies with the barrier's Hessian and kappa changed (five more runs, minutes): "
+                     "Also run the two bunnies with the barrier's Hessian, kappa and Newton's stopping test changed (eight more runs, minutes): "
                      "two_bunnies_hessian_table.csv");
     std::vector<std::string> ccd_files;
     cli.app.add_option("--ccd-queries", ccd_files,

@@ -6,8 +6,8 @@
 // collision check) against the time in the linear solves,
 // with the momentum kept and the surface checked for intersections at every step; then the contact
 // run again with Newton's tolerance loosened, its iterations against the end state's offset; and
-// again (on request) with the barrier's Hessian projected otherwise or tried exact first, and κ
-// doubled or fixed.
+// again (on request) with the barrier's Hessian projected otherwise or tried exact first, κ
+// doubled or fixed, and Newton stopped by the length of its step as well (IPC's test).
 // docs/14_contact.md#bodies-against-bodies-the-cost
 #include "14_contact/contact.hpp"
 #include "14_contact/intersections.hpp"
@@ -101,12 +101,15 @@ void bodies_study(const RunContext& run, bool hessian_variants)
     options.self_contact = true;
     options.activation_distance = 1e-3;
 
-    const auto one_run = [&](bool with_contact, double tolerance, const ContactOptions& run_options) {
+    // step_fraction > 0: Newton also stops when its direction moves no vertex coordinate by more than
+    // step_fraction × d̂ (NewtonOptions::step_tolerance = step_fraction d̂ / Δt).
+    const auto one_run = [&](bool with_contact, double tolerance, const ContactOptions& run_options, double step_fraction = 0.0) {
         dynamics::Body body(scene, hyper::make_force_model("stable-neo-hookean", scene.mesh, scene.material));
         TimedSolver* solver = nullptr;
         hyper::NewtonOptions newton_options;
         newton_options.max_iterations = 200;
         newton_options.relative_tolerance = tolerance;
+        newton_options.step_tolerance = step_fraction * options.activation_distance / scene.time_step;
         newton_options.make_solver = [&solver] {
             auto timed = std::make_unique<TimedSolver>(cg::make_solver("default"));
             solver = timed.get();
@@ -219,7 +222,9 @@ void bodies_study(const RunContext& run, bool hessian_variants)
     // (ContactOptions::barrier_projection), the exact barrier Hessian tried first
     // (ContactOptions::exact_barrier_hessian, under chapter 12's HessianChoice::exact_then_definite),
     // and κ: doubled at a step's start while the bunnies are within 0.1 d̂ and closing (the adaptive
-    // rule with ε_d = 0.1 d̂ over the bounding-box diagonal), or fixed at 100 times the adaptive run's.
+    // rule with ε_d = 0.1 d̂ over the bounding-box diagonal), or fixed at 100 times the adaptive run's;
+    // and Newton also stopped once its direction moves no coordinate by more than 10⁻² or 10⁻³ d̂
+    // (NewtonOptions::step_tolerance), which ends the linear tail of an impact step early.
     const double diagonal = (scene.mesh.V.colwise().maxCoeff() - scene.mesh.V.colwise().minCoeff()).norm();
     const double kappa = contact_run.stiffness;
     struct Variant {
@@ -227,11 +232,13 @@ void bodies_study(const RunContext& run, bool hessian_variants)
         hyper::Projection projection;
         bool exact;
         double stiffness, doubling_distance;
+        double step_fraction;  ///< Newton's step test at this × d̂ (0: the gradient's test alone)
     };
     const double ipc = ContactOptions{}.doubling_distance;
     Table variants(str(run.quick ? "Two blocks" : "Two coarse bunnies",
                        " with self-contact at Newton tolerance 1e-6: the barrier's Hessian and kappa against the iterations"),
-                   {{"barrier Hessian", Format::text}, {"kappa", Format::text}, {"Newton iterations", Format::integer},
+                   {{"barrier Hessian", Format::text}, {"kappa", Format::text}, {"Newton stops", Format::text},
+                    {"Newton iterations", Format::integer},
                     {"most in a step", Format::integer}, {"exact Hessian failed", Format::integer},
                     {"factorizations", Format::integer}, {"new matrix patterns", Format::integer},
                     {"time per step [ms]", Format::fixed, 1},
@@ -240,24 +247,30 @@ void bodies_study(const RunContext& run, bool hessian_variants)
                     {"largest offset from the first row / dhat", Format::scientific, 1},
                     {"momentum drift [round-off]", Format::scientific, 1}, {"intersection-free", Format::text}});
     for (const Variant& variant :
-         {Variant{"clamp", hyper::Projection::clamp, false, 0.0, ipc},
-          Variant{"absolute values", hyper::Projection::absolute, false, 0.0, ipc},
-          Variant{"exact, else clamp", hyper::Projection::clamp, true, 0.0, ipc},
-          Variant{"clamp", hyper::Projection::clamp, false, 0.0, 0.1 * options.activation_distance / diagonal},
-          Variant{"clamp", hyper::Projection::clamp, false, 100.0 * kappa, ipc},
-          Variant{"exact, else clamp", hyper::Projection::clamp, true, 100.0 * kappa, ipc}}) {
+         {Variant{"clamp", hyper::Projection::clamp, false, 0.0, ipc, 0.0},
+          Variant{"absolute values", hyper::Projection::absolute, false, 0.0, ipc, 0.0},
+          Variant{"exact, else clamp", hyper::Projection::clamp, true, 0.0, ipc, 0.0},
+          Variant{"clamp", hyper::Projection::clamp, false, 0.0, 0.1 * options.activation_distance / diagonal, 0.0},
+          Variant{"clamp", hyper::Projection::clamp, false, 100.0 * kappa, ipc, 0.0},
+          Variant{"exact, else clamp", hyper::Projection::clamp, true, 100.0 * kappa, ipc, 0.0},
+          Variant{"clamp", hyper::Projection::clamp, false, 0.0, ipc, 1e-2},
+          Variant{"clamp", hyper::Projection::clamp, false, 0.0, ipc, 1e-3},
+          Variant{"exact, else clamp", hyper::Projection::clamp, true, 0.0, ipc, 1e-3}}) {
         ContactOptions variant_options = options;
         variant_options.barrier_projection = variant.projection;
         variant_options.exact_barrier_hessian = variant.exact;
         variant_options.stiffness = variant.stiffness;
         variant_options.doubling_distance = variant.doubling_distance;
         const bool as_default = variant.projection == options.barrier_projection && variant.exact == options.exact_barrier_hessian &&
-                                variant.stiffness == options.stiffness && variant.doubling_distance == ipc;
-        const BunnyRun r = as_default ? contact_run : one_run(true, tolerance, variant_options);
+                                variant.stiffness == options.stiffness && variant.doubling_distance == ipc &&
+                                variant.step_fraction == 0.0;
+        const BunnyRun r = as_default ? contact_run : one_run(true, tolerance, variant_options, variant.step_fraction);
         variants.add_row({std::string(variant.name),
                           std::string(variant.stiffness > 0.0           ? "fixed, 100 x adaptive"
                                       : variant.doubling_distance != ipc ? "adaptive, doubled below 0.1 dhat"
                                                                          : "adaptive"),
+                          variant.step_fraction > 0.0 ? str("gradient, or step < ", variant.step_fraction, " dhat")
+                                                      : std::string("gradient"),
                           double(r.newton_iterations), double(r.most_iterations), double(r.fallbacks),
                           double(r.factorizations), double(r.orderings), 1e3 * r.seconds / r.steps, 1e3 * r.solve_seconds / r.steps,
                           r.seconds / free_run.seconds, r.smallest_distance / options.activation_distance,

@@ -131,10 +131,30 @@ public:
 private:
     void do_prepare(const SparseMatrix& A, bool same) override
     {
-        if (same && factor_)
+        if (same && factor_) {
             factor_->factorize(sparse::csc_from_eigen(A));
-        else
+            return;
+        }
+        try {
             factor_.emplace(A);
+        } catch (const Error&) {
+            // A new pattern whose values are not positive definite: keep its ordering and analysis
+            // for the next matrix of the pattern (Newton's definite Hessian after a failed exact one)
+            // by analysing a positive definite stand-in of the same pattern, then fail on A's values
+            // as before.
+            factor_.emplace(diagonally_dominant(A));
+            factor_->factorize(sparse::csc_from_eigen(A));
+        }
+    }
+    /// A's pattern with |a_ij| off the diagonal and 1 + Σ_j |a_ij| on it: positive definite.
+    static SparseMatrix diagonally_dominant(const SparseMatrix& A)
+    {
+        SparseMatrix D = A;
+        const Eigen::VectorXd row_sums = Eigen::VectorXd(A.cwiseAbs() * Eigen::VectorXd::Ones(A.cols()));
+        for (int j = 0; j < D.outerSize(); ++j)
+            for (SparseMatrix::InnerIterator it(D, j); it; ++it)
+                it.valueRef() = it.row() == it.col() ? 1.0 + row_sums[j] : std::abs(it.value());
+        return D;
     }
     int do_solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) override
     {
@@ -266,10 +286,12 @@ void LinearSolver::set_relative_tolerance(double tolerance)
 
 void LinearSolver::prepare(const Eigen::SparseMatrix<double>& A)
 {
+    prepared_ = false;
     const double largest = check_square_and_finite(A);
     const bool same = A_.rows() > 0 && A.isCompressed() && same_pattern(A, A_);
     // The solver keeps its own copy: Eigen's iterative solvers hold a reference to their matrix,
-    // and the residual check needs it too. After a failed prepare the solver is unprepared.
+    // and the residual check needs it too. After a failed prepare the solver is unprepared, but
+    // keeps the pattern (and a direct solver its analysis) when A itself was valid.
     if (same) {
         std::copy(A.valuePtr(), A.valuePtr() + A.nonZeros(), A_.valuePtr());  // the pattern is A_'s already
     } else {
@@ -284,12 +306,13 @@ void LinearSolver::prepare(const Eigen::SparseMatrix<double>& A)
         if (!same)
             mirror_ = mirror_pairs(A_);
         check_symmetric(A_, mirror_, largest);
-        do_prepare(A_, same);
     } catch (...) {
         A_ = Eigen::SparseMatrix<double>();
         mirror_.clear();
         throw;
     }
+    do_prepare(A_, same);  // a failure (not positive definite) leaves it unprepared, the pattern kept
+    prepared_ = true;
     stats_.prepare_seconds = timer.seconds();
 }
 
@@ -302,8 +325,9 @@ Eigen::VectorXd LinearSolver::solve(const Eigen::VectorXd& b)
 
 void LinearSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x)
 {
-    if (A_.rows() == 0)
-        throw Error(str(name_, ": solve() before prepare(); give the solver its matrix first"));
+    if (!prepared_)
+        throw Error(str(name_, ": solve() before prepare() (or after a prepare() that failed); give the solver ",
+                        "its matrix first"));
     if (b.size() != A_.rows())
         throw Error(str(name_, ": b has ", b.size(), " entries, the matrix is ", A_.rows(), "×", A_.cols()));
     if (!b.allFinite())

@@ -126,6 +126,8 @@ NewtonBackwardEuler::NewtonBackwardEuler(NewtonOptions options)
         throw Error(str("Newton: the forcing term must lie in [0, 1), got ", options_.forcing));
     if (options_.max_iterations < 1)
         throw Error(str("Newton: the iteration cap must be >= 1, got ", options_.max_iterations));
+    if (!(options_.step_tolerance >= 0.0 && std::isfinite(options_.step_tolerance)))
+        throw Error(str("Newton: the step tolerance must be a finite number >= 0 (0: off), got ", options_.step_tolerance));
 }
 
 namespace {
@@ -234,6 +236,8 @@ NewtonResult newton_minimize(const NewtonProblem& problem, Eigen::VectorXd x0, c
         result.step_lengths.push_back(alpha);
         x += alpha * direction;
         ++result.iterations;
+        if (direction.lpNorm<Eigen::Infinity>() <= options.step_tolerance)
+            return result;  // the step's length test (never with step_tolerance = 0: d ≠ 0 here)
     }
 }
 

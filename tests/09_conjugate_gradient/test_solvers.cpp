@@ -221,6 +221,60 @@ TEST_CASE("prepare again with new values on the same pattern", "[ex09.5]")
     }
 }
 
+namespace {
+
+/// A direct solver wrapped to record, per prepare, whether the interface saw the pattern of the
+/// last prepare (the flag it hands to do_prepare).
+class PatternRecorder final : public LinearSolver {
+public:
+    explicit PatternRecorder(std::unique_ptr<LinearSolver> inner) : LinearSolver(inner->name()), inner_(std::move(inner)) {}
+    bool is_direct() const override { return inner_->is_direct(); }
+    std::vector<bool> same_patterns;
+
+private:
+    void do_prepare(const Eigen::SparseMatrix<double>& A, bool same_pattern) override
+    {
+        same_patterns.push_back(same_pattern);
+        inner_->prepare(A);
+    }
+    int do_solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) override
+    {
+        inner_->solve(b, x);
+        return 0;
+    }
+    std::unique_ptr<LinearSolver> inner_;
+};
+
+}  // namespace
+
+TEST_CASE("a factorization that fails keeps the pattern: the next matrix of it solves correctly", "[solvers]")
+{
+    // Newton's exact Hessian that is not positive definite, then its definite one with the same
+    // pattern: the second prepare is a same-pattern one, and the solve after it is right.
+    const Eigen::SparseMatrix<double> A = fem::sparse::to_eigen(fem::direct::laplacian_3d(4));
+    Eigen::SparseMatrix<double> identity(A.rows(), A.cols());
+    identity.setIdentity();
+    // A diagonal entry below 0: not positive definite (the pattern stays A's: the diagonal is stored).
+    const Eigen::SparseMatrix<double> indefinite = A - 1.5 * A.diagonal().maxCoeff() * identity;
+    const Eigen::VectorXd b = random_vector(A.rows(), 7u);
+    const Eigen::VectorXd expected = Eigen::MatrixXd(A).llt().solve(b);
+    for (const std::string& name : solver_names()) {
+        if (!make_solver(name)->is_direct())
+            continue;
+        CAPTURE(name);
+        PatternRecorder solver(make_solver(name));
+        CHECK_THROWS_WITH(solver.prepare(indefinite), Contains("positive definite"));
+        CHECK(solver.size() == 0);
+        CHECK_THROWS_WITH(solver.solve(b), Contains("before prepare"));
+        solver.prepare(A);
+        CHECK(relative_error(solver.solve(b), expected) <= 1e-10);
+        CHECK_THROWS_AS(solver.prepare(indefinite), fem::Error);  // once more, after a success
+        solver.prepare(2.0 * A);
+        CHECK(relative_error(solver.solve(b), 0.5 * expected) <= 1e-10);
+        CHECK(solver.same_patterns == std::vector<bool>{false, true, true, true});
+    }
+}
+
 TEST_CASE("the tolerance of an iterative solver can change between solves (inexact Newton's need)", "[ex09.5]")
 {
     const Eigen::SparseMatrix<double> A = fem::sparse::to_eigen(fem::direct::laplacian_2d(30));

@@ -26,6 +26,8 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
+#include <memory>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -697,6 +699,46 @@ TEST_CASE("extreme density: a free body of rho = 1e200 falls as one of rho = 100
     CHECK_THAT(entries_of(heavy), EntriesNear(light, 1e-9 * light.norm()));
 }
 
+TEST_CASE("the step-length test: Newton stops at the first direction no larger than step_tolerance", "[ex12.9]")
+{
+    // E = ½ xᵀA x − bᵀx with the Hessian handed to Newton twice too large (2A, as a projection that
+    // adds to the true Hessian): d = −(2A)⁻¹∇E halves the error at every full step, a linear rate of
+    // ½, so ‖d_k‖∞ = 2⁻ᵏ⁻¹ ‖x₀ − x*‖∞, and the test stops after the first k with that ≤ τ, at
+    // x_{k+1} with ‖x_{k+1} − x*‖∞ = ‖d_k‖∞ ≤ τ; the gradient's test alone goes on to its tolerance.
+    Eigen::Matrix3d dense;
+    dense << 4.0, 1.0, 0.0, 1.0, 3.0, 1.0, 0.0, 1.0, 2.0;
+    const Eigen::SparseMatrix<double> A = dense.sparseView();
+    const Eigen::SparseMatrix<double> twice = 2.0 * A;
+    const Eigen::Vector3d b(1.0, -2.0, 0.5), solution = dense.llt().solve(b);
+    NewtonProblem problem;
+    problem.objective = [&](const Eigen::VectorXd& x, double* magnitude) {
+        if (magnitude != nullptr)
+            *magnitude = std::abs(0.5 * x.dot(A * x)) + std::abs(b.dot(x));
+        return 0.5 * x.dot(A * x) - b.dot(x);
+    };
+    problem.gradient = [&](const Eigen::VectorXd& x) { return Eigen::VectorXd(A * x - b); };
+    problem.hessian = [&](const Eigen::VectorXd&, bool) -> const dynamics::SparseMatrix& { return twice; };
+    problem.scale = b.norm();
+    problem.what = "the quadratic";
+    const Eigen::VectorXd start = Eigen::VectorXd::Zero(3);
+    const double first = 0.5 * solution.lpNorm<Eigen::Infinity>();  // ‖d₀‖∞
+    NewtonOptions options;
+    options.relative_tolerance = 1e-10;
+    const std::unique_ptr<cg::LinearSolver> solver = cg::make_solver("eigen-llt");
+    const NewtonResult gradient_only = newton_minimize(problem, start, options, *solver);
+    for (const double tolerance : {1e-2, 1e-4, 1e-6}) {
+        CAPTURE(tolerance);
+        options.step_tolerance = tolerance;
+        const NewtonResult stopped = newton_minimize(problem, start, options, *solver);
+        const int k = static_cast<int>(std::ceil(std::log2(first / tolerance) - 1e-9));  // first k: 2⁻ᵏ ‖d₀‖∞ ≤ τ
+        CHECK(stopped.iterations == k + 1);
+        CHECK(stopped.iterations < gradient_only.iterations);
+        CHECK((stopped.x - solution).lpNorm<Eigen::Infinity>() <= tolerance * (1.0 + 1e-9));
+        CHECK((stopped.x - solution).lpNorm<Eigen::Infinity>() > 0.25 * tolerance);  // not run on to the end
+        CHECK(stopped.gradient_history.size() == static_cast<std::size_t>(stopped.iterations));
+    }
+}
+
 TEST_CASE("Newton backward Euler: bad options are refused", "[ch12]")
 {
     NewtonOptions bad;
@@ -715,6 +757,11 @@ TEST_CASE("Newton backward Euler: bad options are refused", "[ch12]")
     bad.forcing = 1.0;
     CHECK_THROWS_WITH(NewtonBackwardEuler(bad), Contains("forcing"));
     bad.forcing = -0.1;
+    CHECK_THROWS_AS(NewtonBackwardEuler(bad), Error);
+    bad = {};
+    bad.step_tolerance = -1e-3;
+    CHECK_THROWS_WITH(NewtonBackwardEuler(bad), Contains("step tolerance"));
+    bad.step_tolerance = std::numeric_limits<double>::infinity();
     CHECK_THROWS_AS(NewtonBackwardEuler(bad), Error);
 }
 

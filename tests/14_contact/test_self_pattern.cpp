@@ -1,9 +1,11 @@
 // Chapter 14: the self-contact Hessian's anticipated pattern (ContactOptions::pattern_reach,
 // SelfContactBarrier::anticipate): the same values as the Hessian of the pairs within d̂ alone, in a
-// pattern that holds that one's, and one pattern over a step's Newton iterations while pairs arrive;
+// pattern that holds that one's, and one pattern over a step's Newton iterations while pairs arrive
+// (also where the exact barrier Hessian fails to factor); Newton's step-length test in the impact;
 // the contact potential's clocks (ContactClocks) that split such a step's time.
 // docs/14_contact.md#bodies-against-bodies-the-cost
 #include "14_contact/contact.hpp"
+#include "14_contact/intersections.hpp"
 #include "14_contact/timed_solver.hpp"
 
 #include "contact_bodies.hpp"
@@ -46,15 +48,18 @@ std::set<std::pair<Eigen::Index, Eigen::Index>> pattern(const Eigen::SparseMatri
 /// Two blocks of 2³ cells of 1 cm, 1.5 mm apart along x and offset in y and z, thrown at each other
 /// at ±0.5 m/s (2.5 mm closer a step of 1/400 s: pairs come within d̂ = 1 mm during the first
 /// step's Newton iterations), with self-contact, the Hessian's pattern reaching reach × d̂, and
-/// Newton's solver counting new patterns.
+/// Newton's solver counting new patterns; Newton also stopped by its step's length at step_fraction
+/// × d̂ (0: the gradient's test alone), the barrier's Hessian tried exact first when exact.
 struct Approach : test::ContactRun {
     TimedSolver* solver = nullptr;  // counts the matrices with a new pattern
 
-    explicit Approach(double reach) : ContactRun(test::free_scene(mesh()), options(reach), {}, {}, thrown())
+    explicit Approach(double reach, double step_fraction = 0.0, bool exact = false)
+        : ContactRun(test::free_scene(mesh()), options(reach, exact), {}, {}, thrown())
     {
         hyper::NewtonOptions newton_options;
         newton_options.relative_tolerance = 1e-9;
         newton_options.max_iterations = 200;
+        newton_options.step_tolerance = step_fraction * contact->options().activation_distance / time_step;
         newton_options.make_solver = [this] {
             auto counting = std::make_unique<TimedSolver>(cg::make_solver("default"));
             solver = counting.get();
@@ -68,11 +73,12 @@ struct Approach : test::ContactRun {
         return two_bodies(box_at(Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(0.01), 2),
                           box_at(Eigen::Vector3d(0.0115, 0.002, -0.003), Eigen::Vector3d::Constant(0.01), 2));
     }
-    static ContactOptions options(double reach)
+    static ContactOptions options(double reach, bool exact = false)
     {
         ContactOptions options;
         options.self_contact = true;
         options.pattern_reach = reach;
+        options.exact_barrier_hessian = exact;
         return options;
     }
     static Eigen::VectorXd thrown()
@@ -135,6 +141,69 @@ TEST_CASE("self-contact's anticipated pattern: one matrix pattern a step while p
     CHECK(plain_most > 1);         // pairs arrived within a step: the plain Hessian changed its pattern
     CHECK(anticipated_most == 1);  // the anticipated one kept the step's first
     CHECK(anticipated.contact->smallest_distance(anticipated.state.u) < 1e-3);  // they met, within d̂
+}
+
+namespace {
+
+/// Σ m v (3) of a run's state [kg m/s].
+Eigen::Vector3d momentum_of(const test::ContactRun& run)
+{
+    Eigen::Vector3d momentum = Eigen::Vector3d::Zero();
+    for (Eigen::Index k = 0; k < run.state.v.size(); ++k)
+        momentum[k % 3] += run.body->dof_masses()[k] * run.state.v[k];
+    return momentum;
+}
+
+}  // namespace
+
+TEST_CASE("Newton's step-length test in an impact: fewer iterations, the end state within a fraction of dhat",
+          "[self][ex14.9]")
+{
+    // The two blocks meet over 4 steps, solved to Newton's gradient tolerance (10⁻⁹) and again
+    // stopped once a Newton direction moves no coordinate by more than 10⁻³ d̂: the same contact
+    // (no surface crossed), momentum kept to round-off (internal forces only), and every vertex
+    // within 5·10⁻³ d̂ of the tight run's.
+    const double dhat = ContactOptions{}.activation_distance;
+    Approach tight(1.0), stopped(1.0, 1e-3);
+    const SurfacePrimitives surface = surface_primitives(Approach::mesh());
+    const Eigen::Vector3d start = momentum_of(tight);
+    double scale = 0.0;
+    for (Eigen::Index k = 0; k < tight.state.v.size(); ++k)
+        scale += tight.body->dof_masses()[k] * std::abs(tight.state.v[k]);
+    int tight_iterations = 0, stopped_iterations = 0;
+    for (int step = 0; step < 4; ++step) {
+        INFO("step " << step);
+        tight.step();
+        stopped.step();
+        tight_iterations += tight.newton->last().iterations;
+        stopped_iterations += stopped.newton->last().iterations;
+        CHECK((stopped.state.u - tight.state.u).lpNorm<Eigen::Infinity>() <= 5e-3 * dhat);
+        CHECK((momentum_of(stopped) - start).norm() <= 1e-12 * scale);
+        CHECK_FALSE(first_edge_through_triangle(stopped.body->positions(stopped.state.u), surface.edges,
+                                                surface.triangles)
+                        .found());
+    }
+    CHECK(stopped.contact->smallest_distance(stopped.state.u) < dhat);  // they met
+    INFO(tight_iterations << " Newton iterations to the gradient's tolerance, " << stopped_iterations
+                          << " with the step test");
+    CHECK(stopped_iterations < tight_iterations);
+}
+
+TEST_CASE("the exact barrier Hessian that fails to factor costs no new matrix pattern (the solver keeps it)",
+          "[self][ex14.9]")
+{
+    // Newton tries M + Δt² (K + ∇²P) first and, where it fails to factor, factors the clamped one of
+    // the same anticipated pattern: chapter 09's solver keeps the failed one's ordering for it.
+    Approach exact(1.0, 0.0, true);
+    int fallbacks = 0;
+    for (int step = 0; step < 4; ++step) {
+        const int before = exact.solver ? exact.solver->new_patterns : 0;
+        exact.step();
+        fallbacks += exact.newton->last().definite_fallbacks;
+        INFO("step " << step);
+        CHECK(exact.solver->new_patterns - before <= 1);  // the step's pattern, once
+    }
+    CHECK(fallbacks > 0);  // some exact Hessians did fail
 }
 
 TEST_CASE("the contact potential's clocks: parts of its steps' time, its broad phases, zero after a reset",
