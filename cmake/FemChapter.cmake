@@ -26,7 +26,7 @@
 # OWN lists the chapter's source files (names in solutions/NN_name) that only its own executable and
 # tests call, never a later chapter: they compile into a library of their own, fem_chNN_own (linking
 # fem_chNN), which later chapters do not link, so that a student's build of a later chapter does not
-# compile them (chapter 10's modes.cpp, Spectra's eigensolvers: 13 s of a core).
+# compile them (chapter 10's modes.cpp and mode_solvers.cpp, Spectra's eigensolvers: 13 s of a core).
 
 set(FEM_ALL_CHAPTERS "" CACHE INTERNAL "registered chapters")
 add_custom_target(fem_tests)

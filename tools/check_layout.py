@@ -13,8 +13,8 @@ import re
 import sys
 from pathlib import Path
 
-REGISTER = re.compile(r"^fem_add_chapter\((?P<number>\d\d)\s+(?P<name>\w+)(?:\s+DEPENDS(?P<deps>[\s\d]+))?\)",
-                      re.M)
+REGISTER = re.compile(r"^fem_add_chapter\((?P<number>\d\d)\s+(?P<name>\w+)(?:\s+DEPENDS(?P<deps>[\s\d]+))?"
+                      r"(?:\s+OWN[\s\w.]+)?\)", re.M)
 INCLUDE = re.compile(r'^\s*#\s*include\s+"(?P<chapter>\d\d)_\w+/', re.M)
 # TEST_CASE( followed by one or more adjacent string literals: the test name, then its tags.
 TEST_NAME = re.compile(r'\bTEST_CASE\(\s*((?:"(?:[^"\\]|\\.)*"\s*)+)(?:,\s*"(?P<tags>[^"]*)")?')

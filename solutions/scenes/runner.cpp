@@ -317,7 +317,8 @@ void step_group(GroupRun& g)
 }
 
 /// The record of a group's last step when it has contact (else none): its split from its
-/// ContactIntegrator, its pairs at the step's end (counted outside the step's time).
+/// ContactIntegrator, its pairs at the step's end (counted outside the step's time; none after a
+/// step out of contact, whose end ContactPotential::out_of_contact proved d̂ away from every pair).
 void record_contact(const GroupRun& g, std::vector<ContactStepRecord>& records)
 {
     if (g.contact == nullptr)
@@ -333,7 +334,8 @@ void record_contact(const GroupRun& g, std::vector<ContactStepRecord>& records)
     r.seconds = g.simulation->last().seconds;
     r.newton_iterations = g.simulation->last().newton_iterations;
     r.cost = g.contact->last_cost();
-    r.pairs = g.contact->pairs(state.u, state.time);
+    if (r.contact)
+        r.pairs = g.contact->pairs(state.u, state.time);
     records.push_back(std::move(r));
 }
 

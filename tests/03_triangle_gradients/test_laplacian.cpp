@@ -4,10 +4,9 @@
 #include "03_triangle_gradients/laplacian.hpp"
 
 #include "common/error.hpp"
-#include "common/files.hpp"
 #include "common/mesh.hpp"
-#include "common/mesh_io.hpp"
 #include "meshes.hpp"
+#include "common/bunny_meshes.hpp"
 #include "common/test_support.hpp"
 
 #include <catch2/catch.hpp>
@@ -64,8 +63,6 @@ void check_laplacian_properties(const SparseMatrix& L)
     }
 }
 
-fem::TriMesh bunny() { return fem::io::read_tri_mesh(fem::data_path("bunny.obj")); }
-
 /// Two triangles sharing the edge (0, 1) from (0,0) to (2,0), their apexes at (1, ±height): the
 /// angles opposite the edge are 2·atan(1/height), obtuse for height < 1.
 fem::TriMesh kite(double height)
@@ -82,7 +79,7 @@ fem::TriMesh kite(double height)
 
 TEST_CASE("GᵀAG is symmetric, with zero row sums, and equals the cotangent formula", "[ex03.6]")
 {
-    for (const fem::TriMesh& mesh : {fem::square_mesh(8, 0.24, 9), fem::test::bumpy_sphere(), bunny()}) {
+    for (const fem::TriMesh& mesh : {fem::square_mesh(8, 0.24, 9), fem::test::bumpy_sphere(), fem::test::bunny_surface()}) {
         const SparseMatrix L = fem_laplacian(mesh.V, mesh.F);
         REQUIRE(L.rows() == mesh.V.rows());
         check_laplacian_properties(L);
@@ -100,7 +97,7 @@ TEST_CASE("uᵀ L u is the Dirichlet energy ∫|∇u|², exact for linear functi
 
 TEST_CASE("the classical cotangent Laplacian: the independent formula and the FEM properties", "[ex03.7]")
 {
-    for (const fem::TriMesh& mesh : {fem::square_mesh(8, 0.24, 9), fem::test::bumpy_sphere(), bunny()}) {
+    for (const fem::TriMesh& mesh : {fem::square_mesh(8, 0.24, 9), fem::test::bumpy_sphere(), fem::test::bunny_surface()}) {
         const SparseMatrix L = cotangent_laplacian(mesh.V, mesh.F);
         check_laplacian_properties(L);
         check_is_cotangent_laplacian(L, mesh);
@@ -157,7 +154,7 @@ TEST_CASE("lumped mass: a third of each area per corner, the row sums of the con
     CHECK(m[n] == Approx(h * h / 6).epsilon(1e-13));              // corner (1,0): 1 triangle
 
     // The consistent mass ∫ φ_i φ_j = A/12 (1 + δ_ij) per triangle; its row sums are the lumped mass.
-    for (const fem::TriMesh& mesh : {fem::square_mesh(6, 0.2, 2), bunny()}) {
+    for (const fem::TriMesh& mesh : {fem::square_mesh(6, 0.2, 2), fem::test::bunny_surface()}) {
         Eigen::VectorXd row_sums = Eigen::VectorXd::Zero(mesh.V.rows());
         for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
             const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)), c = mesh.V.row(mesh.F(f, 2));
@@ -181,7 +178,7 @@ TEST_CASE("boundary vertices: the square's outline, none on a closed surface", "
         CHECK((x == 0.0 || x == 1.0 || y == 0.0 || y == 1.0));
     }
     CHECK(boundary_vertices(fem::test::bumpy_sphere().F, 2 + 12 * 24).empty());
-    CHECK(boundary_vertices(bunny().F, 1839).empty());
+    CHECK(boundary_vertices(fem::test::bunny_surface().F, 1839).empty());
     fem::MatrixX3i three(3, 3);
     three << 0, 1, 2, 1, 0, 3, 0, 1, 4;
     CHECK_THROWS_WITH(boundary_vertices(three, 5), Contains("more than two triangles"));

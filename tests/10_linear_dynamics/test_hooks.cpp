@@ -1,6 +1,7 @@
 // Chapter 10: the step hook and moving pins. A hook before each step may move the pins, change the
 // loads or switch the model; the loop books the energy that puts in, and the books must balance.
 // docs/10_linear_dynamics.md#the-step-hook, docs/10_linear_dynamics.md#moving-pins
+#include "10_linear_dynamics/modes.hpp"
 #include "dynamics_fixtures.hpp"
 
 #include "common/error.hpp"

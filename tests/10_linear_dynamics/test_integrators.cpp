@@ -1,6 +1,7 @@
 // Chapter 10: integrators and the time loop on whole bodies: energy bookkeeping, statics, free
 // fall, pinned dofs two ways, solvers, and the stability hard cases.
 // docs/10_linear_dynamics.md#the-pieces-of-a-simulation
+#include "10_linear_dynamics/modes.hpp"
 #include "dynamics_fixtures.hpp"
 
 #include "../common/test_support.hpp"

@@ -1,5 +1,6 @@
 // Chapter 10: modes and the scalar oscillator they reduce every step to. The simulated body must
 // follow the closed-form modal recurrence to round-off. docs/10_linear_dynamics.md#modes
+#include "10_linear_dynamics/modes.hpp"
 #include "dynamics_fixtures.hpp"
 
 #include "common/error.hpp"
