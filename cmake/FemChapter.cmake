@@ -151,16 +151,19 @@ function(fem_add_chapter number name)
   foreach(dep IN LISTS CH_DEPENDS)
     target_link_libraries(${lib} PUBLIC fem_ch${dep}_reference)
   endforeach()
-  # What the chapter's executable and tests link: fem_chNN, or fem_chNN_own on top of it.
+  # What the chapter's executable and tests link (`user`): fem_chNN, or fem_chNN_own on top of it;
+  # `code_libraries`: the one or two libraries of the chapter's code (a student's, in a student build).
   set(user ${lib})
+  set(code_libraries ${lib})
   if(own_sources)
     set(user ${lib}_own)
     add_library(${user} STATIC ${own_sources})
     target_link_libraries(${user} PUBLIC ${lib} PRIVATE fem_flags)
+    list(APPEND code_libraries ${user})
   endif()
   if(from_exercises)
     # A stub leaves its parameters and the helpers its solution used unused.
-    foreach(target IN ITEMS ${lib} ${user})
+    foreach(target IN LISTS code_libraries)
       target_compile_options(${target} PRIVATE -Wno-unused-parameter -Wno-unused-variable
                              -Wno-unused-but-set-variable -Wno-unused-function)
     endforeach()
@@ -174,7 +177,7 @@ function(fem_add_chapter number name)
     fem_reference_code(${lib}_reference)
   else()
     add_library(${lib}_reference ALIAS ${lib})
-    foreach(target IN ITEMS ${lib} ${user})
+    foreach(target IN LISTS code_libraries)
       fem_reference_code(${target})
     endforeach()
   endif()
@@ -261,12 +264,9 @@ function(fem_add_chapter number name)
   # ${test_exe} name its targets (the test sources compile in ${test_exe}_objects: a compile
   # option or definition for them goes there) and ${chapter_libraries} lists every library built
   # from its sources: ${lib}, with OWN files ${lib}_own, in a student build also the reference twin
-  # ${lib}_reference, and with FEM_GRADING the graded twin ${lib}_graded. A package the chapter's code needs is linked to
-  # each of them.
-  set(chapter_libraries ${lib})
-  if(own_sources)
-    list(APPEND chapter_libraries ${user})
-  endif()
+  # ${lib}_reference, and with FEM_GRADING the graded twin ${lib}_graded. A package the chapter's
+  # code needs is linked to each of them.
+  set(chapter_libraries ${code_libraries})
   get_target_property(reference_aliased ${lib}_reference ALIASED_TARGET)
   if(NOT reference_aliased)
     list(APPEND chapter_libraries ${lib}_reference)
