@@ -179,16 +179,14 @@ void FeatureBarrier::add_hessian(const Eigen::VectorXd& u, double time, double s
                                  std::optional<hyper::Projection> projection) const
 {
     const bool apart = for_each_pair(u, time, activation_distance_, true, [&](const Pair& pair) {
-        // Each pair's block is made PSD on its own (a sum of PSD blocks is PSD), or left as it is.
+        // Each pair's block is made PSD on its own (a sum of PSD blocks is PSD), or left as it is; a
+        // two-vertex pair (count 2) uses the top-left 6×6 only.
         Eigen::Matrix<double, 9, 9> block = pair.hessian;
-        if (projection && pair.count == 2) {
-            block.setZero();
+        if (projection && pair.count == 2)
             block.topLeftCorner<6, 6>() =
-                hyper::project_to_psd<6>(Eigen::Matrix<double, 6, 6>(pair.hessian.topLeftCorner<6, 6>()),
-                                         *projection);
-        } else if (projection) {
+                hyper::project_to_psd<6>(Eigen::Matrix<double, 6, 6>(pair.hessian.topLeftCorner<6, 6>()), *projection);
+        else if (projection)
             block = hyper::project_to_psd<9>(pair.hessian, *projection);
-        }
         for (int a = 0; a < pair.count; ++a)
             for (int b = 0; b < pair.count; ++b)
                 for (int i = 0; i < 3; ++i)
