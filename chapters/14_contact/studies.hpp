@@ -55,9 +55,10 @@ void self_contact_study(const RunContext& run);
 /// the linear solves, the barrier (with its broad phase) and the collision check, the momentum's
 /// drift, intersection-free or not; two_bunnies_table.csv (study_bodies.cpp). Then the contact run
 /// with Newton's tolerance 10⁻³: its iterations and how far it ends from the default's;
-/// two_bunnies_tolerance_table.csv. With hessian_variants (ch14_contact --hessian-variants; five more
+/// two_bunnies_tolerance_table.csv. With hessian_variants (ch14_contact --hessian-variants; eight more
 /// runs of the bunnies, minutes), the contact run again with the barrier's Hessian projected
-/// otherwise or tried exact first, and κ doubled or fixed: two_bunnies_hessian_table.csv.
+/// otherwise or tried exact first, κ doubled or fixed, and Newton also stopped by its step's length
+/// (NewtonOptions::step_tolerance): two_bunnies_hessian_table.csv.
 void bodies_study(const RunContext& run, bool hessian_variants = false);
 /// test_stack.cpp's three blocks settled on the floor for each d̂ and Newton tolerance: the force
 /// between blocks against the weight above, the gaps against d̂, the height against the tightest
