@@ -81,4 +81,15 @@ struct ContactRun {
     void step() { contact::contact_step(*newton, *contact, *body, time_step, state); }
 };
 
+/// Σ m_v v_v over vertices first … first + count − 1 (3) [kg m/s]; a body's momentum with first 0,
+/// count n.
+inline Eigen::Vector3d momentum(const dynamics::Body& body, const Eigen::VectorXd& v, Eigen::Index first,
+                                Eigen::Index count)
+{
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    for (Eigen::Index i = first; i < first + count; ++i)
+        p += body.dof_masses()[3 * i] * v.segment<3>(3 * i);
+    return p;
+}
+
 }  // namespace fem::test

@@ -37,6 +37,7 @@ using namespace fem;
 using namespace fem::contact;
 using fem::test::box_at;
 using fem::test::entries_of;
+using fem::test::momentum;
 using fem::test::EntriesNear;
 using fem::test::two_bodies;
 
@@ -96,15 +97,6 @@ struct Bodies : test::ContactRun {
         return distance;
     }
 };
-
-/// Σ m_v v_v over vertices first … first + count − 1 (3) [kg m/s].
-Eigen::Vector3d momentum(const dynamics::Body& body, const Eigen::VectorXd& v, Eigen::Index first, Eigen::Index count)
-{
-    Eigen::Vector3d p = Eigen::Vector3d::Zero();
-    for (Eigen::Index i = first; i < first + count; ++i)
-        p += body.dof_masses()[3 * i] * v.segment<3>(3 * i);
-    return p;
-}
 
 /// Two one-cell cubes face to face 0.4 mm apart, the second turned 0.3 rad about x (the faces'
 /// normal) and shifted, so that vertices stand over the other's face and edges cross at angles:

@@ -143,19 +143,6 @@ TEST_CASE("self-contact's anticipated pattern: one matrix pattern a step while p
     CHECK(anticipated.contact->smallest_distance(anticipated.state.u) < 1e-3);  // they met, within d̂
 }
 
-namespace {
-
-/// Σ m v (3) of a run's state [kg m/s].
-Eigen::Vector3d momentum_of(const test::ContactRun& run)
-{
-    Eigen::Vector3d momentum = Eigen::Vector3d::Zero();
-    for (Eigen::Index k = 0; k < run.state.v.size(); ++k)
-        momentum[k % 3] += run.body->dof_masses()[k] * run.state.v[k];
-    return momentum;
-}
-
-}  // namespace
-
 TEST_CASE("Newton's step-length test in an impact: fewer iterations, the end state within a fraction of dhat",
           "[self][ex14.9]")
 {
@@ -166,7 +153,8 @@ TEST_CASE("Newton's step-length test in an impact: fewer iterations, the end sta
     const double dhat = ContactOptions{}.activation_distance;
     Approach tight(1.0), stopped(1.0, 1e-3);
     const SurfacePrimitives surface = surface_primitives(Approach::mesh());
-    const Eigen::Vector3d start = momentum_of(tight);
+    const Eigen::Index n = tight.state.v.size() / 3;
+    const Eigen::Vector3d start = test::momentum(*tight.body, tight.state.v, 0, n);
     double scale = 0.0;
     for (Eigen::Index k = 0; k < tight.state.v.size(); ++k)
         scale += tight.body->dof_masses()[k] * std::abs(tight.state.v[k]);
@@ -178,7 +166,7 @@ TEST_CASE("Newton's step-length test in an impact: fewer iterations, the end sta
         tight_iterations += tight.newton->last().iterations;
         stopped_iterations += stopped.newton->last().iterations;
         CHECK((stopped.state.u - tight.state.u).lpNorm<Eigen::Infinity>() <= 5e-3 * dhat);
-        CHECK((momentum_of(stopped) - start).norm() <= 1e-12 * scale);
+        CHECK((test::momentum(*stopped.body, stopped.state.v, 0, n) - start).norm() <= 1e-12 * scale);
         CHECK_FALSE(first_edge_through_triangle(stopped.body->positions(stopped.state.u), surface.edges,
                                                 surface.triangles)
                         .found());
