@@ -6,7 +6,7 @@
 #   fem_chNN_own        with OWN files: those files, on top of fem_chNN (below);
 #   fem_chNN_reference  what later chapters link: always the reference solution, so a student
 #                       working on chapter 05 keeps chapters 06+ running;
-#   chNN_name           its executable in <build>/bin, from chapters/NN_name/main.cpp;
+#   chNN_name           its executable in <build>/bin, from programs/NN_name/*.cpp (main.cpp, study_*.cpp);
 #   test_chNN           its Catch2 tests from tests/NN_name/*.cpp (ctest label chNN); a target of
 #                       its own: `cmake --build --preset student --target test_chNN`;
 #   fem_chNN_graded,    with FEM_GRADING=ON, built by the target fem_graded_tests only: the
@@ -184,7 +184,13 @@ function(fem_add_chapter number name)
   add_dependencies(fem_chapter_libs ${lib})
 
   set(exe ch${number}_${name})
-  add_executable(${exe} ${FEM_ROOT}/chapters/${id}/main.cpp)
+  # The executable: every .cpp of programs/NN_name (main.cpp and its studies, study_*.cpp, with
+  # their program-only headers beside them), never a file of another chapter's programs.
+  file(GLOB program_sources CONFIGURE_DEPENDS ${FEM_ROOT}/programs/${id}/*.cpp)
+  if(NOT EXISTS ${FEM_ROOT}/programs/${id}/main.cpp)
+    message(FATAL_ERROR "chapter ${id}: no programs/${id}/main.cpp")
+  endif()
+  add_executable(${exe} ${program_sources})
   target_link_libraries(${exe} PRIVATE ${user} fem_flags)
 
   if(FEM_BUILD_TESTS)
@@ -260,7 +266,7 @@ function(fem_add_chapter number name)
   endif()
 
   # A chapter's own additions to the build (e.g. an optional reference library for its
-  # executable) go in chapters/NN_name/chapter.cmake, included here, where ${lib}, ${exe} and
+  # executable) go in programs/NN_name/chapter.cmake, included here, where ${lib}, ${exe} and
   # ${test_exe} name its targets (the test sources compile in ${test_exe}_objects: a compile
   # option or definition for them goes there) and ${chapter_libraries} lists every library built
   # from its sources: ${lib}, with OWN files ${lib}_own, in a student build also the reference twin
@@ -274,8 +280,8 @@ function(fem_add_chapter number name)
   if(TARGET ${lib}_graded)
     list(APPEND chapter_libraries ${lib}_graded)
   endif()
-  if(EXISTS ${FEM_ROOT}/chapters/${id}/chapter.cmake)
-    include(${FEM_ROOT}/chapters/${id}/chapter.cmake)
+  if(EXISTS ${FEM_ROOT}/programs/${id}/chapter.cmake)
+    include(${FEM_ROOT}/programs/${id}/chapter.cmake)
   endif()
 
   set(FEM_ALL_CHAPTERS ${FEM_ALL_CHAPTERS} ${id} CACHE INTERNAL "registered chapters")

@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """Checks the course layout (a ctest test): every chapter registered in CMakeLists.txt has its
-header(s), main.cpp, solutions, tests, stored quick-run expectations and docs; a chapter includes
-only its own and earlier chapters' headers, each of them listed in its DEPENDS; common/ includes no
+header(s), programs/NN_name/main.cpp, solutions, tests, stored quick-run expectations and docs; its
+contract folder chapters/NN_name holds headers only (programs, studies and build files live in
+programs/NN_name); a chapter includes only its own and earlier chapters' headers, each of them
+listed in its DEPENDS; common/ includes no
 chapter at all; no Catch2 test name contains a character that ctest cannot carry (';' splits a
 CMake list, so the ctest entry would run no test case; a leading '-' makes Catch2 read it as an
 option); no test case carries more than one exercise
@@ -56,7 +58,7 @@ def main():
         problems.append("CMakeLists.txt registers no chapter with fem_add_chapter")
     for number, (name, deps) in sorted(registered.items()):
         chapter = f"{number}_{name}"
-        required = [root / "chapters" / chapter / "main.cpp", root / "docs" / f"{chapter}.md",
+        required = [root / "programs" / chapter / "main.cpp", root / "docs" / f"{chapter}.md",
                     root / "tests" / chapter / "expected" / "files.txt"]
         for path in required:
             if not path.is_file():
@@ -65,7 +67,11 @@ def main():
                                 ("tests", "*.cpp")]:
             if not list((root / folder / chapter).glob(pattern)):
                 problems.append(f"chapter {chapter}: no {pattern} in {folder}/{chapter}")
-        for folder in ["chapters", "solutions", "tests"]:
+        for entry in sorted((root / "chapters" / chapter).iterdir()):
+            if entry.suffix != ".hpp":
+                problems.append(f"chapter {chapter}: {entry.relative_to(root)} is not a header: the contract "
+                                f"folder holds the public headers only (programs go in programs/{chapter})")
+        for folder in ["chapters", "solutions", "tests", "programs"]:
             for source in sorted((root / folder / chapter).glob("*.?pp")):
                 for m in INCLUDE.finditer(source.read_text()):
                     used = m["chapter"]

@@ -13,7 +13,7 @@ import re
 import sys
 from pathlib import Path
 
-TOP_LEVEL = ("chapters", "solutions", "exercises", "tests", "docs", "scenes", "common", "data", "tools", "fuzz")
+TOP_LEVEL = ("chapters", "solutions", "programs", "exercises", "tests", "docs", "scenes", "common", "data", "tools", "fuzz")
 
 
 def tree_counts(root: Path) -> dict:

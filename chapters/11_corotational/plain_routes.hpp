@@ -6,8 +6,8 @@
 // triplets (setFromTriplets), and factors the step matrix afresh with Eigen's SimplicialLLT
 // (compute(): ordering, symbolic and numeric factorization every step). The step itself is chapter
 // 10's ThetaMethod, so the plain route and ours differ only in those three parts, and agree to
-// round-off (tests/11_corotational/test_plain_route.cpp). Not part of the chapter's library: the
-// executable and the tests compile it.
+// round-off (tests/11_corotational/test_plain_route.cpp). Code in solutions/11_corotational/
+// plain_routes.cpp, part of the chapter's library: chapter 12's plain route factors with it.
 
 #include "10_linear_dynamics/body.hpp"
 #include "10_linear_dynamics/time_integration.hpp"

@@ -9,7 +9,8 @@
 // iteration, corot::plain::plain_cholesky), so the line search, the stopping rule and the step
 // matrix are ours by construction and the plain route differs only in the element loops, the
 // assembly and the factorization: its steps agree with ours to round-off
-// (tests/12_hyperelastic_newton/test_plain_route.cpp). Not part of the chapter's library.
+// (tests/12_hyperelastic_newton/test_plain_route.cpp). Code in solutions/12_hyperelastic_newton/
+// plain_routes.cpp, an OWN file of the chapter (CMakeLists.txt): only its executable and tests use it.
 
 #include "12_hyperelastic_newton/materials.hpp"
 #include "12_hyperelastic_newton/newton.hpp"

@@ -1,6 +1,6 @@
 // A scene's [[body]]: its name, mesh, material, mass, damping, initial velocity, pins and loads.
 // docs/scenes.md#the-scene-file
-#include "scenes/scene_parts.hpp"
+#include "scene_parts.hpp"
 
 #include <algorithm>
 #include <iomanip>

@@ -2,7 +2,7 @@
 // steps, in order (the parts' readers: scene_parts.hpp). docs/scenes.md#the-scene-file
 #include "scenes/scene_file.hpp"
 
-#include "scenes/scene_parts.hpp"
+#include "scene_parts.hpp"
 
 #include "12_hyperelastic_newton/force_models.hpp"
 #include "12_hyperelastic_newton/materials.hpp"

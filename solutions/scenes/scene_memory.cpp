@@ -1,6 +1,6 @@
 // The memory a scene's run needs: the estimate of one body's run, and the budget the bodies of a
 // scene share, checked as each body is read. docs/scenes.md#limits
-#include "scenes/scene_parts.hpp"
+#include "scene_parts.hpp"
 
 #include <cmath>
 #include <fstream>

@@ -1,7 +1,7 @@
 // A scene body's rest mesh: a generated box, a file's tets, a surface tetrahedralised by TetGen or
 // the lattice that encloses it (chapter 13), checked for size, memory and unused vertices.
 // docs/scenes.md#the-scene-file
-#include "scenes/scene_parts.hpp"
+#include "scene_parts.hpp"
 
 #include "13_skinning/skinning.hpp"
 

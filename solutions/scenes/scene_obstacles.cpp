@@ -1,7 +1,7 @@
 // The scene file's obstacles: the registry of [[obstacle]] types (one entry a type: its name, its
 // own fields, and how they are read, checked and built into chapter 14's obstacle), the bodies'
 // start clear of them. docs/scenes.md#obstacles
-#include "scenes/scene_parts.hpp"
+#include "scene_parts.hpp"
 
 #include "14_contact/mesh_obstacle.hpp"
 

@@ -1,7 +1,7 @@
 // The overrides of a scene file: the [quick] table's fields and each --set key=value, applied to
 // the file's tree before it is read, so an override is checked like the file itself.
 // docs/scenes.md#the-scene-file
-#include "scenes/scene_parts.hpp"
+#include "scene_parts.hpp"
 
 #include <algorithm>
 #include <sstream>

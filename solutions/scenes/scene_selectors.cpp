@@ -1,6 +1,6 @@
 // The scene file's selectors of vertices and the pins' prescribed motions: read, resolved on a
 // mesh, and evaluated in time. docs/scenes.md#selecting-vertices
-#include "scenes/scene_parts.hpp"
+#include "scene_parts.hpp"
 
 #include <Eigen/Geometry>
 
