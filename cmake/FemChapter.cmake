@@ -17,6 +17,9 @@
 #                       tests/NN_name/expected (label chNN, run);
 #   chNN_docs           ctest: docs/NN_name.md names only functions and exercises that exist and
 #                       quotes the numbers the executable prints (label chNN, docs).
+#   chNN_exercise_table ctest: the same page's exercise headings and its exercise table (stub file,
+#                       tagged test files, builds-on) against the code, without the executable, in
+#                       a second (label chNN, docs).
 #   chNN_test_target    ctest: building test_chNN alone builds no later chapter (label chNN, layout),
 #                       the student's one-chapter loop (README, "A student's loop").
 #   chNN_bad_options    ctest, when tests/NN_name/bad_options.txt exists: the executable refuses each
@@ -253,6 +256,10 @@ function(fem_add_chapter number name)
                      --chapter ${id} --bin ${CMAKE_BINARY_DIR}/bin
                      --out ${CMAKE_BINARY_DIR}/check_docs/${id})
     set_tests_properties(ch${number}_docs PROPERTIES LABELS "ch${number};docs" COST 100)
+    add_test(NAME ch${number}_exercise_table
+             COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/check_docs.py --root ${FEM_ROOT}
+                     --chapter ${id} --exercises-only)
+    set_tests_properties(ch${number}_exercise_table PROPERTIES LABELS "ch${number};docs")
     add_test(NAME ch${number}_test_target
              COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/check_targets.py --build ${CMAKE_BINARY_DIR}
                      --chapter ${id})

@@ -20,7 +20,17 @@ Checks:
      executable's value rounded to the significant digits the sentence shows (see
      csv_compare.quoted_number), or agrees with it by the column's rules (csv_compare.cells_differ:
      iteration counts within one, a "[±X]" column within X);
-  5. every image the page shows exists.
+  5. every image the page shows exists;
+  6. the page's "## Exercises" section opens with the exercise table (check_exercise_table), one row
+     per exercise of the chapter, before its first "### Exercise" heading:
+         | exercise | stub file | tests | builds on |
+         |---|---|---|---|
+         | [05.8 `element_stiffness`](#exercise-058-element_stiffness) | `exercises/05_strain_stress/material.cpp` | `tests/05_strain_stress/test_stiffness.cpp` | 05.3, 05.6 |
+     the stub file holds the exercise's stub, the tests are every file of tests/NN_name holding a
+     test case tagged [exNN.k], the builds-on cell repeats the "Builds on:" line (— for nothing), and
+     the first paragraph after that line names the stub file. --exercise-table prints the table the
+     check expects; --exercises-only runs checks 1 and 6 alone (no executable needed: ctest
+     chNN_exercise_table).
 
 The check runs the executable with --no-figures: it compares numbers, and the figures are drawn by
 the chapter's quick run (chNN_quick_run) and checked by figures_current; drawing them at full size
@@ -43,7 +53,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from csv_compare import as_number, cells_differ, is_measured, quoted_number, read_csv, rounded  # noqa: E402
-from exercises import EXERCISE_HEADING, all_exercises, builds_on, exercise_key  # noqa: E402
+from exercises import BUILDS_ON, EXERCISE_HEADING, all_exercises, builds_on, exercise_key  # noqa: E402
 
 RUN = re.compile(r"<!-- fem:run (?P<exe>\S+)(?P<args>[^>]*?)\s*-->")
 TABLE = re.compile(r"(<!-- fem:table (?P<csv>\S+) -->\n)(?P<body>.*?)(<!-- /fem:table -->)", re.S)
@@ -213,6 +223,144 @@ def check_exercises(text, root, chapter):
     return problems
 
 
+EXERCISE_TABLE_HEADER = ["exercise", "stub file", "tests", "builds on"]
+TAG_STRING = re.compile(r'"((?:\[[^\]"]+\])+)"')  # a Catch2 tag string, e.g. "[ex05.8][slow]"
+EXERCISE_TAG = re.compile(r"\[ex(?P<id>\d\d\.\d+)\]")
+
+
+def tagged_test_files(root, chapter):
+    """{exercise id: the files of tests/NN_name (paths from the root, sorted) with a test case
+    tagged [exNN.k]}; tags are read from the test cases' tag strings only, not from comments."""
+    found = {}
+    folder = root / "tests" / chapter
+    for path in sorted(folder.rglob("*.cpp")) if folder.is_dir() else []:
+        for tags in TAG_STRING.findall(path.read_text()):
+            for m in EXERCISE_TAG.finditer(tags):
+                files = found.setdefault(m["id"], [])
+                relative = path.relative_to(root).as_posix()
+                if relative not in files:
+                    files.append(relative)
+    return found
+
+
+def exercise_table_row(e, heading, tests, listed):
+    """The exercise table's row of exercise e (see check 6 of the module's docstring): heading is
+    the text of its "### Exercise" heading, tests its tagged test files, listed its Builds-on ids."""
+    link = f"[{e.id} `{e.function}`](#{slug(heading)})"
+    stub = f"`exercises/{e.chapter}/{e.path.name}`"
+    test_cell = " ".join(f"`{t}`" for t in tests)
+    builds = ", ".join(listed) if listed else "—"
+    return [link, stub, test_cell, builds]
+
+
+def expected_exercise_table(text, root, chapter):
+    """The exercise table (lines of markdown) the page must hold, from the chapter's exercise markers,
+    its tests' tags and the page's headings and Builds-on lines."""
+    headings = {m["id"]: line for line in text.splitlines() for m in [EXERCISE_HEADING.match(line)] if m}
+    listed = builds_on(text)
+    tests = tagged_test_files(root, chapter)
+    lines = ["| " + " | ".join(EXERCISE_TABLE_HEADER) + " |", "|---|---|---|---|"]
+    for e in all_exercises(root):
+        if e.chapter == chapter:
+            heading = headings.get(e.id, f"### Exercise {e.id}: {e.function}").lstrip("#").strip()
+            lines.append("| " + " | ".join(exercise_table_row(e, heading, tests.get(e.id, []),
+                                                              listed.get(e.id))) + " |")
+    return lines
+
+
+def check_exercise_table(text, root, chapter):
+    """Check 6 of the module's docstring: the table under "## Exercises", row by row."""
+    exercises = [e for e in all_exercises(root) if e.chapter == chapter]
+    if not exercises:
+        return []
+    lines = text.splitlines()
+    start = next((i for i, l in enumerate(lines) if l.strip() == "## Exercises"), None)
+    if start is None:
+        return [f"docs/{chapter}.md has no '## Exercises' section for its {len(exercises)} exercises"]
+    # The table sits between the section's heading and the next heading (the first "### Exercise").
+    end = next((i for i in range(start + 1, len(lines)) if lines[i].startswith("#")), len(lines))
+    section = lines[start + 1:end]
+    table = [l.strip() for l in section if l.strip().startswith("|")]
+    if not table or parse_markdown_table(table[0] + "\n|-|\n")[0] != EXERCISE_TABLE_HEADER:
+        return [f"the '## Exercises' section of docs/{chapter}.md does not open with the exercise table "
+                f"'| {' | '.join(EXERCISE_TABLE_HEADER)} |' before its first '### Exercise' heading "
+                f"(python3 tools/check_docs.py --chapter {chapter} --exercise-table prints it)"]
+    _, rows = parse_markdown_table("\n".join(table))
+    problems = []
+    headings = {m["id"]: line.lstrip("#").strip() for line in lines for m in [EXERCISE_HEADING.match(line)] if m}
+    listed = builds_on(text)
+    tests = tagged_test_files(root, chapter)
+    by_id = {}
+    for number, row in enumerate(rows, start=1):
+        m = re.match(r"\[(?P<id>\d\d\.\d+) ", row[0]) if row else None
+        if len(row) != 4 or not m:
+            problems.append(f"exercise table, row {number}: expected 4 cells, the first "
+                            f"'[NN.k `function`](#anchor)'; found {row}")
+            continue
+        if m["id"] in by_id:
+            problems.append(f"exercise table: exercise {m['id']} has two rows")
+        by_id[m["id"]] = row
+    known = {e.id for e in exercises}
+    for extra in sorted(set(by_id) - known, key=exercise_key):
+        problems.append(f"exercise table: a row for exercise {extra}, which chapter {chapter} does not have")
+    for e in exercises:
+        row = by_id.get(e.id)
+        where = f"exercise table, row of {e.id}"
+        if row is None:
+            problems.append(f"exercise table: no row for exercise {e.id} ({e.function})")
+            continue
+        heading = headings.get(e.id)
+        want = exercise_table_row(e, heading or "", tests.get(e.id, []), listed.get(e.id))
+        if heading and row[0] != want[0]:
+            problems.append(f"{where}: the link is {row[0]}, expected {want[0]} (the heading's anchor)")
+        stub_path = re.fullmatch(r"`(?P<path>[^`]+)`", row[1])
+        stub = root / stub_path["path"] if stub_path else None
+        marker = f"// EXERCISE {e.id} ({e.function}):"
+        if stub is None or not stub.is_file():
+            problems.append(f"{where}: the stub file {row[1]} does not exist; the stub is {want[1]}")
+        elif stub.parent != root / "exercises" / chapter or marker not in stub.read_text():
+            problems.append(f"{where}: {row[1]} does not hold the stub of {e.id} ('{marker}'); {want[1]} does")
+        cited = re.findall(r"`([^`]+)`", row[2])
+        for path in cited:
+            if not (root / path).is_file():
+                problems.append(f"{where}: the test file {path} does not exist")
+            elif path not in tests.get(e.id, []):
+                problems.append(f"{where}: {path} holds no test case tagged [ex{e.id}]")
+        for path in tests.get(e.id, []):
+            if path not in cited:
+                problems.append(f"{where}: {path} holds test cases tagged [ex{e.id}] but is not listed")
+        if not tests.get(e.id):
+            problems.append(f"{where}: no file of tests/{chapter} holds a test case tagged [ex{e.id}]")
+        if listed.get(e.id) is not None and row[3] != want[3]:
+            problems.append(f"{where}: builds on '{row[3]}', but its Builds-on line says '{want[3]}'")
+    for e in exercises:
+        stub = f"exercises/{e.chapter}/{e.path.name}"
+        paragraph = first_paragraph_after_builds_on(lines, e.id)
+        if paragraph is not None and stub not in paragraph:
+            problems.append(f"the first paragraph under the Builds-on line of exercise {e.id} does not "
+                            f"name its stub file `{stub}`")
+    return problems
+
+
+def first_paragraph_after_builds_on(lines, exercise_id):
+    """The first paragraph after the "Builds on:" line under exercise_id's heading (one string), or
+    None when there is no such heading or line."""
+    index = next((i for i, l in enumerate(lines)
+                  if (m := EXERCISE_HEADING.match(l)) and m["id"] == exercise_id), None)
+    if index is None:
+        return None
+    index = next((i for i in range(index + 1, len(lines)) if lines[i].strip()), None)
+    if index is None or not BUILDS_ON.match(lines[index].strip()):
+        return None
+    paragraph = []
+    for line in lines[index + 1:]:
+        if line.strip():
+            paragraph.append(line)
+        elif paragraph:
+            break
+    return "\n".join(paragraph)
+
+
 def run_executable(text, bin_dir, out, root, figures):
     match = RUN.search(text)
     if not match:
@@ -283,6 +431,10 @@ def main():
     parser.add_argument("--bin", type=Path, help="the build's bin/ folder (for the tables)")
     parser.add_argument("--out", type=Path, help="a scratch folder for the executable's output")
     parser.add_argument("--update", action="store_true")
+    parser.add_argument("--exercises-only", action="store_true",
+                        help="check the exercise headings, Builds-on lines and table only (no executable)")
+    parser.add_argument("--exercise-table", action="store_true",
+                        help="print the exercise table the page must hold under '## Exercises'")
     args = parser.parse_args()
 
     doc = args.root / "docs" / f"{args.chapter}.md"
@@ -290,7 +442,17 @@ def main():
         print(f"FAIL docs/{args.chapter}.md does not exist")
         return 1
     text = doc.read_text()
-    problems = check_exercises(text, args.root, args.chapter) + check_names(text, args.root, args.chapter)
+    if args.exercise_table:
+        print("\n".join(expected_exercise_table(text, args.root, args.chapter)))
+        return 0
+    problems = check_exercises(text, args.root, args.chapter) + check_exercise_table(text, args.root, args.chapter)
+    if args.exercises_only:
+        for problem in problems:
+            print(f"FAIL {problem}")
+        if not problems:
+            print(f"OK: docs/{args.chapter}.md's exercise headings and table name what exists")
+        return 1 if problems else 0
+    problems += check_names(text, args.root, args.chapter)
     for m in IMAGE.finditer(text):
         if not (doc.parent / m["path"]).is_file():
             problems.append(f"the docs show {m['path']}, which does not exist")
