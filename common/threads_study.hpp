@@ -5,9 +5,10 @@
 //
 // Why a busy core: on a student's laptop or a shared server another program often holds a core.
 // OpenMP threads that spin while they wait for each other then compete with it for that core, and
-// 2 threads can take several times as long as 1 (README, "Threads on a busy machine"). The course
-// makes its threads wait asleep (fem::wait_passively); the "one core busy" columns show what that
-// buys, measured by the study itself: it starts the spinning process (BusyCore) for its second run.
+// 2 threads can take several times as long as 1 (docs/engineering.md, "Threads on a busy
+// machine"). The course makes its threads wait asleep (fem::wait_passively); the "one core busy"
+// columns show what that buys, measured by the study itself: it starts the spinning process
+// (BusyCore) for its second run.
 
 #include "common/table.hpp"
 

@@ -5,7 +5,7 @@
 // (fuzz/read_by_extension.hpp). Expected: the read succeeds, or it raises an fem::Error whose
 // message names the file. A finding: a crash, a sanitizer report, another exception, an fem::Error
 // that does not name the file, a timeout, or memory beyond libFuzzer's -malloc_limit_mb.
-// tools/fuzz.sh runs these (README.md, "Fuzzing the readers").
+// tools/fuzz.sh runs these (docs/engineering.md, "Fuzzing the readers").
 
 #include "fuzz/read_by_extension.hpp"
 

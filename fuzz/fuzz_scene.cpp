@@ -7,7 +7,7 @@
 // terms (each input must take well under the 10 s of tools/fuzz.sh, on a busy machine too). Expected: the read succeeds, or it raises
 // an fem::Error whose message names the scene file. A finding: a crash, a sanitizer report, another
 // exception, an fem::Error that does not name the file, a timeout, or memory beyond libFuzzer's
-// -malloc_limit_mb. tools/fuzz.sh runs it (README.md, "Fuzzing the readers").
+// -malloc_limit_mb. tools/fuzz.sh runs it (docs/engineering.md, "Fuzzing the readers").
 
 #include "scenes/scene_file.hpp"
 

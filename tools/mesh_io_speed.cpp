@@ -1,6 +1,6 @@
-// mesh_io_speed: how fast a TetGen .node/.ele pair is read, side by side in one run (README.md,
-// "Reading meshes"). It writes a box mesh of --cells³ cubes (6 tets each) with fem::io's writer,
-// then reads it back three ways and prints MB/s (MB = 10^6 bytes of both files):
+// mesh_io_speed: how fast a TetGen .node/.ele pair is read, side by side in one run
+// (docs/engineering.md, "Reading meshes"). It writes a box mesh of --cells³ cubes (6 tets each)
+// with fem::io's writer, then reads it back three ways and prints MB/s (MB = 10^6 bytes of both files):
 //   1. the floor: the two files' bytes into memory, nothing parsed;
 //   2. the plain route: std::getline per line, std::istringstream >> per value (no checks);
 //   3. fem::io::read_tet_mesh: one pass over the file in memory, std::from_chars, every check
