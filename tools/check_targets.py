@@ -18,8 +18,8 @@ UNITY_INCLUDE = re.compile(r'^#include "(?P<path>[^"]+)"$', re.MULTILINE)
 
 
 def with_unity_sources(build, inputs):
-    """The inputs, each unity source CMake generated (FEM_UNITY_TESTS: <target>.dir/Unity/unity_N_cxx.cxx,
-    relative to the build folder) followed by the sources it includes."""
+    """The inputs, each unity source CMake generated (a unity build, FEM_UNITY_TEST_BATCH ≠ 1:
+    <target>.dir/Unity/unity_N_cxx.cxx, relative to the build folder) followed by the sources it includes."""
     expanded = []
     for path in inputs:
         expanded.append(path)
