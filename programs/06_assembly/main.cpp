@@ -21,6 +21,7 @@
 #include "common/cli.hpp"
 #include "common/error.hpp"
 #include "common/figures.hpp"
+#include "common/memory.hpp"
 #include "common/mesh.hpp"
 #include "common/table.hpp"
 #include "common/timer.hpp"
@@ -32,7 +33,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <fstream>
 #include <iostream>
 #include <optional>
 #include <string>
@@ -64,43 +64,12 @@ std::size_t sparse_bytes(const Sparse& A)
     return sparse_bytes(A.nonZeros(), A.outerSize());
 }
 
-// The process's resident memory from /proc/self/status: VmRSS (now) or VmHWM (the peak), in bytes;
-// nullopt where the file does not exist (not Linux).
-std::optional<double> status_bytes(const std::string& key)
+// The memory a route took, for the table: MB, or "-" where it cannot be measured.
+Cell rise_mb(const PeakMemoryRise& peak)
 {
-    std::ifstream status("/proc/self/status");
-    std::string line;
-    while (std::getline(status, line))
-        if (line.rfind(key + ":", 0) == 0)
-            return 1024.0 * std::stod(line.substr(key.size() + 1));  // "VmHWM:   13476 kB"
-    return std::nullopt;
+    const std::optional<double> rise = peak.rise_bytes();
+    return rise ? Cell(*rise * mb) : Cell(std::string("-"));
 }
-
-// Measures how far the resident memory rises above its level at construction while a route runs:
-// the kernel's peak counter (VmHWM) is reset by writing 5 to /proc/self/clear_refs (Linux ≥ 4.0).
-// Process-wide: it counts everything the process touches meanwhile, allocator slack included.
-class PeakMemory {
-public:
-    PeakMemory()
-    {
-        std::ofstream clear("/proc/self/clear_refs");
-        clear << "5";
-        clear.close();
-        reset_ok_ = static_cast<bool>(clear);
-        start_ = status_bytes("VmRSS");
-    }
-    Cell rise_mb() const
-    {
-        const std::optional<double> peak = status_bytes("VmHWM");
-        if (!reset_ok_ || !peak || !start_)
-            return std::string("-");
-        return std::max(0.0, *peak - *start_) * mb;
-    }
-
-private:
-    bool reset_ok_ = false;
-    std::optional<double> start_;
-};
 
 double rel_difference(const SparseMatrix& A, const SparseMatrix& B) { return (A - B).norm() / B.norm(); }
 
@@ -226,7 +195,7 @@ void throughput(const RunContext& run, const elastic::Lame& material, const Sett
         Cell b_rss;
         SparseMatrix K_b;
         {
-            const PeakMemory peak;
+            const PeakMemoryRise peak;
             t_fill = time_it(m.tets, [&] {
                 const auto triplets = element_triplets(mesh, K_e);
                 b_bytes = triplets.capacity() * sizeof(Eigen::Triplet<double>);
@@ -237,7 +206,7 @@ void throughput(const RunContext& run, const elastic::Lame& material, const Sett
                 K_b.setFromTriplets(triplets.begin(), triplets.end());
             });
             b_bytes += sparse_bytes(K_b);
-            b_rss = peak.rise_mb();
+            b_rss = rise_mb(peak);
         }
         add_phase("(b) triplets", "fill 144 triplets per tet", t_fill);
         add_phase("(b) triplets", "setFromTriplets (sort, sum, compress)", t_convert);
@@ -250,11 +219,11 @@ void throughput(const RunContext& run, const elastic::Lame& material, const Sett
         double t_build = 0.0, t_scatter = 0.0;
         Cell c_rss;
         {
-            const PeakMemory peak;
+            const PeakMemoryRise peak;
             t_build = time_it(m.tets, [&] { pattern.emplace(mesh); });
             K_c = pattern->zero_matrix();
             t_scatter = best_time([&] { pattern->assemble(K_e, K_c); }, m.tets < 20000 ? 0.05 : 0.3, 20);
-            c_rss = peak.rise_mb();
+            c_rss = rise_mb(peak);
         }
         add_phase("(c) pattern", "build the pattern (once)", t_build);
         add_phase("(c) pattern", "scatter into the values", t_scatter);
@@ -275,7 +244,7 @@ void throughput(const RunContext& run, const elastic::Lame& material, const Sett
             Cell a_rss;
             SparseMatrix K_a;
             {
-                const PeakMemory peak;
+                const PeakMemoryRise peak;
                 SparseMatrix S, blocks, SK, St;
                 t_s = time_it(m.tets, [&] {
                     S = scatter_matrix(mesh);
@@ -286,7 +255,7 @@ void throughput(const RunContext& run, const elastic::Lame& material, const Sett
                 t_right = time_it(m.tets, [&] { K_a = SK * St; });
                 a_bytes = sparse_bytes(S) + sparse_bytes(St) + sparse_bytes(blocks) + sparse_bytes(SK) +
                           sparse_bytes(K_a);
-                a_rss = peak.rise_mb();
+                a_rss = rise_mb(peak);
             }
             if (rel_difference(K_a, K_b) > 1e-12)
                 throw Error(str("route (a) disagrees with route (b) on the ", m.tets, "-tet mesh"));
