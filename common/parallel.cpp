@@ -3,9 +3,22 @@
 #include <cerrno>  // program_invocation_name (GNU)
 #include <cstdlib>
 
+#include <dlfcn.h>
 #include <unistd.h>
 
 namespace fem {
+
+bool set_blas_threads(int threads)
+{
+    if (threads < 1)
+        throw Error(str("set_blas_threads: needs at least 1 thread, got ", threads));
+    using SetThreads = void (*)(int);
+    if (void* symbol = dlsym(RTLD_DEFAULT, "openblas_set_num_threads")) {
+        reinterpret_cast<SetThreads>(symbol)(threads);
+        return true;
+    }
+    return false;
+}
 
 void wait_passively(char** argv)
 {

@@ -64,14 +64,21 @@ private:
     int previous_;
 };
 
+/// Asks the process's BLAS for `threads` threads: OpenBLAS's openblas_set_num_threads(threads),
+/// looked up at run time (dlsym), since a BLAS is in the process only when CHOLMOD is (chapters 08
+/// and 09; OpenBLAS on Debian, which may start a thread per core) and another BLAS has no such
+/// switch. The course's comparisons use 1: one core against our one core. Returns whether the BLAS
+/// took it (false: no OpenBLAS in the process, nothing done). fem::Error for threads < 1.
+bool set_blas_threads(int threads);
+
 /// Makes OpenMP's threads wait for the next loop asleep instead of spinning, unless the user chose
 /// (OMP_WAIT_POLICY set): sets OMP_WAIT_POLICY=passive and starts the program again, the same
 /// process (execv of /proc/self/exe with the same argv), since libgomp reads the variable once,
 /// when it is loaded, before main(). Why: between two loops a spinning thread keeps its core busy;
 /// beside another busy process it competes with it for that core and waits its turn for every loop
 /// (chapter 12's element loops on 2 threads took 2.5-30x as long as on 1 beside a spinning process,
-/// and 0.6-1.06x with passive waiting; README, "Threads on a busy machine"). On a quiet machine
-/// waking a sleeping thread costs a few microseconds per loop. ChapterCli::run calls it first; it
+/// and 0.6-1.06x with passive waiting; docs/engineering.md, "Threads on a busy machine"). On a
+/// quiet machine waking a sleeping thread costs a few microseconds per loop. ChapterCli::run calls it first; it
 /// returns at once without OpenMP, when the variable is set, for an argv that is not main()'s own
 /// (a test calling ChapterCli::run), or if execv fails (nothing is lost but speed).
 void wait_passively(char** argv);

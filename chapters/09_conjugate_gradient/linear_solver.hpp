@@ -154,10 +154,4 @@ std::string default_solver_name();
 /// Whether this build found SuiteSparse's CHOLMOD (compile definition FEM_HAVE_CHOLMOD).
 bool cholmod_available();
 
-/// CHOLMOD does its dense work in the BLAS (OpenBLAS on Debian), which may start a thread per
-/// core; every other solver here runs on one. This asks the BLAS for `threads` threads (the
-/// chapter's comparisons use 1: one core against one core). Returns false, and does nothing, in a
-/// build without CHOLMOD or with a BLAS that has no such switch. fem::Error for threads < 1.
-bool set_blas_threads(int threads);
-
 }  // namespace fem::cg

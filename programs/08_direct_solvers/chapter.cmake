@@ -6,7 +6,7 @@ find_library(FEM_CHOLMOD_LIBRARY cholmod)
 if(FEM_CHOLMOD_INCLUDE_DIR AND FEM_CHOLMOD_LIBRARY)
   message(STATUS "Chapter 08: CHOLMOD found (${FEM_CHOLMOD_LIBRARY}); ch08 compares against it")
   target_include_directories(${exe} SYSTEM PRIVATE ${FEM_CHOLMOD_INCLUDE_DIR})
-  # dlsym finds OpenBLAS's thread setting at run time, if CHOLMOD's BLAS is OpenBLAS.
+  # dlsym finds the BLAS's dgemm at run time (study_speed.cpp).
   target_link_libraries(${exe} PRIVATE ${FEM_CHOLMOD_LIBRARY} ${CMAKE_DL_LIBS})
   target_compile_definitions(${exe} PRIVATE FEM_HAVE_CHOLMOD)
 else()

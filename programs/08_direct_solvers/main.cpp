@@ -42,11 +42,7 @@ int main(int argc, char** argv)
                        "Threads of CHOLMOD's BLAS (1: one core against our one core)")
         ->check(check::integer(1, 256))->capture_default_str();
     return cli.run(argc, argv, [&](const RunContext& run) {
-#ifdef FEM_HAVE_CHOLMOD
-        study::set_blas_threads(blas_threads);
-#else
-        (void)blas_threads;
-#endif
+        set_blas_threads(blas_threads);
         study::dense_study(run);
         study::hilbert_study(run);
         study::ordering_study(run, settings);

@@ -85,10 +85,6 @@ struct CholmodResult {
 };
 
 #ifdef FEM_HAVE_CHOLMOD
-/// CHOLMOD's BLAS (OpenBLAS on Debian) may start a thread per core; the comparison is one core
-/// against one core, so ask it for `threads` (default 1) when the library offers the switch.
-void set_blas_threads(int threads);
-
 /// A (lower triangle read) factored by CHOLMOD with its own ordering choice (natural = false), or
 /// in the given numbering (natural = true: A is already permuted). analyse_only skips the
 /// numeric work (for the ordering table).

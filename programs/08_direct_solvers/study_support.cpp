@@ -11,9 +11,6 @@
 #ifdef FEM_HAVE_CHOLMOD
 #include <Eigen/CholmodSupport>
 #endif
-#if __has_include(<dlfcn.h>)
-#include <dlfcn.h>
-#endif
 
 #include <algorithm>
 #include <tuple>
@@ -84,13 +81,6 @@ std::pair<double, double> alternating_best_times(const std::function<void()>& a,
 }
 
 #ifdef FEM_HAVE_CHOLMOD
-void set_blas_threads(int threads)
-{
-    using SetThreads = void (*)(int);
-    if (void* symbol = dlsym(RTLD_DEFAULT, "openblas_set_num_threads"))
-        reinterpret_cast<SetThreads>(symbol)(threads);
-}
-
 namespace {
 
 std::string cholmod_ordering_name(int ordering)

@@ -5,7 +5,7 @@
 if(FEM_CHOLMOD_INCLUDE_DIR AND FEM_CHOLMOD_LIBRARY)
   foreach(target IN LISTS chapter_libraries)
     target_include_directories(${target} SYSTEM PRIVATE ${FEM_CHOLMOD_INCLUDE_DIR})
-    target_link_libraries(${target} PUBLIC ${FEM_CHOLMOD_LIBRARY} ${CMAKE_DL_LIBS})  # dl: set_blas_threads
+    target_link_libraries(${target} PUBLIC ${FEM_CHOLMOD_LIBRARY})
     target_compile_definitions(${target} PRIVATE FEM_HAVE_CHOLMOD)
   endforeach()
   message(STATUS "Chapter 09: the solver interface offers \"cholmod\"")

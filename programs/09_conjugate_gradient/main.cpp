@@ -31,6 +31,7 @@
 
 #include "common/cli.hpp"
 #include "common/error.hpp"
+#include "common/parallel.hpp"
 
 #include <iostream>
 #include <string>

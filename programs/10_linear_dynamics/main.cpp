@@ -33,6 +33,7 @@
 
 #include "common/cli.hpp"
 #include "common/error.hpp"
+#include "common/parallel.hpp"
 
 #include <iostream>
 
@@ -74,7 +75,7 @@ int main(int argc, char** argv)
             settings.cost_cells = {10, 20};
             settings.seconds = std::min(settings.seconds, 0.02);
         }
-        cg::set_blas_threads(1);
+        set_blas_threads(1);
         std::cout << "Solver of the implicit steps: " << cg::default_solver_name() << "\n\n";
         study::modes_study(run, settings);
         study::recurrence_study(run, settings);

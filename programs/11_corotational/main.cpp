@@ -26,6 +26,7 @@
 
 #include "common/cli.hpp"
 #include "common/error.hpp"
+#include "common/parallel.hpp"
 
 #include <algorithm>
 
@@ -61,7 +62,7 @@ int main(int argc, char** argv)
             settings.cost_cells = {10, 20};
             settings.seconds = std::min(settings.seconds, 0.02);
         }
-        cg::set_blas_threads(1);
+        set_blas_threads(1);
         study::rotation_study(run, settings);
         study::swing_study(run, settings);
         study::cost_study(run, settings);

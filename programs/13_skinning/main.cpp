@@ -27,6 +27,7 @@
 
 #include "common/cli.hpp"
 #include "common/error.hpp"
+#include "common/parallel.hpp"
 
 #include <algorithm>
 
@@ -73,7 +74,7 @@ int main(int argc, char** argv)
             settings.duration = std::min(settings.duration, 0.25);
             settings.seconds = std::min(settings.seconds, 0.02);
         }
-        cg::set_blas_threads(1);
+        set_blas_threads(1);
         study::location_study(run, settings);
         study::outside_study(run, settings);
         study::simulation_study(run, settings);

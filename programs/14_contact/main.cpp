@@ -44,6 +44,7 @@
 
 #include "common/cli.hpp"
 #include "common/error.hpp"
+#include "common/parallel.hpp"
 
 #include <algorithm>
 
@@ -119,7 +120,7 @@ int main(int argc, char** argv)
             settings.mesh_queries = 2000;
             settings.grid_spacings = {0.01};
         }
-        cg::set_blas_threads(1);
+        set_blas_threads(1);
         study::drop_study(run, settings);
         study::slope_study(run, settings);
         study::mesh_study(run, settings);

@@ -21,6 +21,7 @@
 
 #include "common/cli.hpp"
 #include "common/error.hpp"
+#include "common/parallel.hpp"
 #include "common/interrupt.hpp"
 
 #include <csignal>
@@ -128,7 +129,7 @@ int main(int argc, char** argv)
     });
     bool stopped = false;
     const int code = cli.run(argc, argv, [&](const RunContext& run) {
-        cg::set_blas_threads(1);
+        set_blas_threads(1);
         catch_stop_signals();  // a stop signal ends a run or a comparison after its current step
         for (const SceneSpec& scene : scenes) {
             std::cout << scene.title << " (" << scene.file.filename().string() << "): " << scene.bodies.size()

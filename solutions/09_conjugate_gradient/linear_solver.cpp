@@ -14,8 +14,6 @@
 #include <Eigen/SparseCholesky>
 #ifdef FEM_HAVE_CHOLMOD
 #include <Eigen/CholmodSupport>
-
-#include <dlfcn.h>
 #endif
 
 #include <algorithm>
@@ -432,21 +430,6 @@ bool cholmod_available()
 #else
     return false;
 #endif
-}
-
-bool set_blas_threads(int threads)
-{
-    if (threads < 1)
-        throw Error(str("set_blas_threads: needs at least 1 thread, got ", threads));
-#ifdef FEM_HAVE_CHOLMOD
-    // OpenBLAS's switch, looked up at run time: another BLAS simply does not have it.
-    using SetThreads = void (*)(int);
-    if (void* symbol = dlsym(RTLD_DEFAULT, "openblas_set_num_threads")) {
-        reinterpret_cast<SetThreads>(symbol)(threads);
-        return true;
-    }
-#endif
-    return false;
 }
 
 }  // namespace fem::cg
