@@ -14,6 +14,18 @@
 
 namespace fem::hyper::plain {
 
+namespace {
+
+// fem::Error unless u holds one displacement per vertex of mesh (3n entries).
+void require_displacement_of(const TetMesh& mesh, const Eigen::VectorXd& u)
+{
+    if (u.size() != 3 * mesh.V.rows())
+        throw Error(str("plain hyperelastic model: the displacement has ", u.size(), " entries, expected 3n = ",
+                        3 * mesh.V.rows()));
+}
+
+}  // namespace
+
 PlainHyperelastic::PlainHyperelastic(const TetMesh& mesh, std::unique_ptr<Material> material)
     : mesh_(mesh), material_(std::move(material)), volumes_(mesh.T.rows())
 {
@@ -37,9 +49,7 @@ Eigen::Matrix3d PlainHyperelastic::displacement_gradient(const Eigen::VectorXd& 
 
 double PlainHyperelastic::evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& forces)
 {
-    if (u.size() != 3 * mesh_.V.rows())
-        throw Error(str("plain hyperelastic model: the displacement has ", u.size(), " entries, expected 3n = ",
-                        3 * mesh_.V.rows()));
+    require_displacement_of(mesh_, u);
     forces = Eigen::VectorXd::Zero(u.size());
     double energy = 0.0;
     for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t) {
@@ -55,9 +65,7 @@ double PlainHyperelastic::evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& fo
 
 double PlainHyperelastic::energy(const Eigen::VectorXd& u)
 {
-    if (u.size() != 3 * mesh_.V.rows())
-        throw Error(str("plain hyperelastic model: the displacement has ", u.size(), " entries, expected 3n = ",
-                        3 * mesh_.V.rows()));
+    require_displacement_of(mesh_, u);
     double energy = 0.0;
     for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t)
         energy += volumes_[t] * material_->energy_density(displacement_gradient(u, t));
@@ -66,9 +74,7 @@ double PlainHyperelastic::energy(const Eigen::VectorXd& u)
 
 const dynamics::SparseMatrix& PlainHyperelastic::hessian(const Eigen::VectorXd& u, bool definite)
 {
-    if (u.size() != 3 * mesh_.V.rows())
-        throw Error(str("plain hyperelastic model: the displacement has ", u.size(), " entries, expected 3n = ",
-                        3 * mesh_.V.rows()));
+    require_displacement_of(mesh_, u);
     std::vector<Eigen::Triplet<double>> triplets;
     triplets.reserve(static_cast<std::size_t>(144 * mesh_.T.rows()));
     for (Eigen::Index t = 0; t < mesh_.T.rows(); ++t) {
