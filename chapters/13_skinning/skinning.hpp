@@ -80,6 +80,10 @@ enum class LocateMethod {
     tree,         ///< an AABB tree over the tets' (padded) boxes
 };
 
+/// fem::Error naming `where` unless 0 ≤ tolerance < 0.5 (a fraction of a tet's heights): the check of
+/// every locator and of build_skin.
+void require_location_tolerance(double tolerance, const char* where);
+
 /// "brute-force", "grid", "tree".
 std::string method_name(LocateMethod method);
 /// The method called `name` (as method_name writes it); fem::Error listing the names otherwise.
