@@ -63,6 +63,13 @@ inline std::vector<double> central_difference_errors(const std::function<Eigen::
     return errors;
 }
 
+/// The smallest error of a sweep of central_difference_errors: what a correct derivative has far
+/// below 1e-6.
+inline double best_error(const std::vector<double>& errors)
+{
+    return *std::min_element(errors.begin(), errors.end());
+}
+
 /// Central differences of a potential (anything with energy(u) and gradient(u), u of n entries) at
 /// u with step h along each coordinate eᵢ: gradient[i] = (E(u + h eᵢ) − E(u − h eᵢ))/(2h) (n) and
 /// hessian's column i = (∇E(u + h eᵢ) − ∇E(u − h eᵢ))/(2h) (n×n, not symmetrised).
