@@ -17,6 +17,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <Eigen/Cholesky>
 #include <Eigen/SparseCore>
 
 #include <algorithm>
