@@ -228,7 +228,7 @@ std::unique_ptr<GroupRun> start_group(std::vector<BodyRun>& bodies, const std::v
         g->body = g->members.front()->body.get();
     }
     for (BodyRun* b : g->members)
-        if ((!obstacles.empty() || self_contact) && b->forces->level_model() == "linear" && !b->automatic)
+        if ((!obstacles.empty() || self_contact) && b->forces->level_model() == hyper::linear_model && !b->automatic)
             throw Error(str("body '", b->spec->name, "': model linear cannot meet obstacles or bodies (its energy of a "
                             "body at rest far from where it started is round-off; docs/scenes.md#obstacles): use auto, "
                             "corotational or a hyperelastic model"));
