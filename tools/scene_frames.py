@@ -50,7 +50,7 @@ MOMENTS = {
 
 
 WEB_PAGE_SCENE = "bunny_drop"   # the web page's picture: this scene's page at its moment
-PULLED_STEP = 90                 # the step of the test's picture with the button held (test_runner.cpp)
+PULLED_STEP = 90                 # the step of the test's picture with the button held (test_live_view.cpp)
 
 
 def stamp_version(png, root):

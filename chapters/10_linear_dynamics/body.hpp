@@ -164,7 +164,9 @@ public:
     /// K = assembly::stiffness_matrix(mesh, Lamé(Y, ν)). fem::Error as that function.
     LinearElasticity(const TetMesh& mesh, const Material& material);
 
-    std::string name() const override { return "linear"; }
+    /// Its name, as tables and chapter 12's registry of models by name (force_models.hpp) write it.
+    static constexpr const char* model_name = "linear";
+    std::string name() const override { return model_name; }
     double evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& forces) override;
     const SparseMatrix& stiffness(const Eigen::VectorXd&) override { return K_; }
     bool constant_stiffness() const override { return true; }

@@ -160,7 +160,9 @@ public:
                            RotationFit fit = RotationFit::polar, PolarAlgorithm algorithm = PolarAlgorithm::newton,
                            ForceForm form = ForceForm::stiffness_matrix);
 
-    std::string name() const override { return "corotational"; }
+    /// Its name, as tables and chapter 12's registry of models by name (force_models.hpp) write it.
+    static constexpr const char* model_name = "corotational";
+    std::string name() const override { return model_name; }
     /// Rotations at u, then U = Σ U_e and f = Σ E_eᵀ f_e. fem::Error if u has not 3n entries.
     double evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& forces) override;
     /// K_R at u (3n×3n, CSC with both triangles), assembled into the pattern.

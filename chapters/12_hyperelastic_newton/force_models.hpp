@@ -8,9 +8,12 @@
 // hyperelastic material of material_names() (HyperelasticElasticity). A new material registered in
 // materials.cpp is a new name here without any edit.
 
+#include "12_hyperelastic_newton/newton.hpp"
+
+#include "11_corotational/corotational.hpp"
+
 #include "10_linear_dynamics/body.hpp"
 #include "10_linear_dynamics/time_integration.hpp"
-#include "12_hyperelastic_newton/newton.hpp"
 
 #include "common/mesh.hpp"
 
@@ -21,7 +24,14 @@
 
 namespace fem::hyper {
 
-/// "linear", "corotational", then material_names() in the registry's order.
+/// The name of chapter 10's LinearElasticity ("linear"), the first of force_model_names(): the one
+/// definition every chapter and the scenes runner compare a model's name with.
+inline constexpr std::string_view linear_model = dynamics::LinearElasticity::model_name;
+
+/// The name of chapter 11's CorotationalElasticity ("corotational"), the second of force_model_names().
+inline constexpr std::string_view corotational_model = corot::CorotationalElasticity::model_name;
+
+/// linear_model, corotational_model, then material_names() in the registry's order.
 std::vector<std::string> force_model_names();
 
 /// True for a name of material_names() (a model stepped by NewtonBackwardEuler), false for

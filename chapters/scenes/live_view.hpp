@@ -1,7 +1,9 @@
 #pragma once
-// How a scene's frames are drawn, and the live view of --view that plays a run as it computes.
+// The live view of --view: a window that plays a run as it computes, its frames drawn as the PNG
+// frames are (frame_look.hpp).
 // docs/scenes.md#the-live-view
 
+#include "scenes/frame_look.hpp"
 #include "scenes/scene_conditions.hpp"
 #include "scenes/scene_file.hpp"
 
@@ -9,7 +11,6 @@
 #include "common/timer.hpp"
 #include "common/vtk_io.hpp"
 
-#include <array>
 #include <cstddef>
 #include <map>
 #include <filesystem>
@@ -17,35 +18,6 @@
 #include <vector>
 
 namespace fem::scenes {
-
-/// How a scene's frames are drawn: title, colour field, camera, size, and the frame box and colour
-/// range when the scene fixes them. The PNG frames and the live view use it alike.
-fig::RenderOptions frame_view(const SceneSpec& scene);
-
-/// How a model is named on a frame: a material's label (chapter 12's material_descriptions(), e.g.
-/// "StVK", "stable neo-Hookean"); any other name ("linear", "corotational") as it is.
-std::string model_label(const std::string& model);
-
-/// How many times slower than real time the run's frames play: the video's (make_video) frames per
-/// second are fewer than output.frame_rate when the run's frames (frame_count) would last less than
-/// min_video_seconds; 1 when they last long enough. The live view plays at the same pace.
-double slow_motion(const SceneSpec& scene);
-
-/// The caption of the frame at time t: "<scene file's stem> · <models> · t = 0.5 s" and, when the
-/// frames play slower than real time (slow_motion), " · slow motion ×5" (rounded to 0.1). models:
-/// what each body uses at that frame, e.g. "stable neo-Hookean" (frame_models in runner.cpp).
-std::string frame_caption(const SceneSpec& scene, const std::string& models, double time);
-
-/// The title of the frame at time t, as the PNG frames and the live view both write it: the scene's
-/// title, frame_caption under it, and when the displacement is drawn exaggerated a line saying so.
-std::string frame_title(const SceneSpec& scene, const std::string& models, double time);
-
-/// The shapes the scene's obstacles are drawn as at time t (fig::Prop, grey): each one's own
-/// triangles (chapter 14's Obstacle::surface_at), moved by t·w; a solid whole, a mesh as its
-/// triangles, a half-space as the square of its plane under body_box (the floor or slope where the
-/// body moves). body_box: (xmin, xmax, ymin, ymax, zmin, zmax) of the body's motion [m].
-/// docs/scenes.md#outputs
-std::vector<fig::Prop> obstacle_props(const SceneSpec& scene, const std::array<double, 6>& body_box, double time);
 
 /// The live view of --view: a window that plays the run's frames as they come, one frame interval of
 /// the video (slow_motion/frame_rate) apart at least, drawn as the PNG frames are. Keys: space pauses and resumes, the

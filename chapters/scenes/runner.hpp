@@ -15,8 +15,9 @@
 // every body into one mesh; a skin (chapter 13) is one more observer of its body's frames.
 
 #include "scenes/contact_cost.hpp"
-#include "scenes/live_view.hpp"
+#include "scenes/frame_look.hpp"
 #include "scenes/model_auto.hpp"
+#include "scenes/scene_conditions.hpp"
 #include "scenes/scene_file.hpp"
 #include "scenes/skin_observer.hpp"
 
@@ -63,11 +64,6 @@ struct RunResult {
     int frame_count = 0;
 };
 
-/// Called with every frame written (the merged mesh of every body), its step and time, and the
-/// models the bodies use at that frame (as frame_caption writes them).
-using FrameObserver =
-    std::function<void(const io::MeshData& frame, int step, double time, const std::string& models)>;
-
 /// How to run a scene.
 struct RunOptions {
     FrameObserver on_frame;            ///< e.g. the live view; may throw to abandon the run
@@ -98,13 +94,6 @@ struct RunOptions {
 /// file so far valid. fem::Error when a step fails or the run diverges (naming body, step, time and
 /// model). docs/scenes.md#the-runner
 RunResult run_scene(const SceneSpec& scene, const RunOptions& options);
-
-/// The steps between two frames: 1/(frame_rate Δt) rounded, at least 1 (a frame at every multiple
-/// of it, and at the last step).
-int steps_per_frame(const SceneSpec& scene);
-
-/// The frames a whole run writes: one at step 0, at every steps_per_frame-th step and at the last.
-int frame_count(const SceneSpec& scene);
 
 /// run_scene writing nothing and printing nothing, keeping every frame's positions (and every step's
 /// record): the run a comparison or a test looks at. model (when set) replaces every body's model.

@@ -99,7 +99,7 @@ struct BodySpec {
     std::string name;                   ///< names its files and table rows (default body0, body1, …)
     MeshSpec mesh_spec;
     TetMesh mesh;                       ///< the rest mesh, built when the scene is read
-    std::string model = "linear";       ///< one of model_names()
+    std::string model = dynamics::LinearElasticity::model_name;  ///< one of model_names(); "linear" unless given
     dynamics::Material material;
     dynamics::MassModel mass = dynamics::MassModel::lumped;
     dynamics::Damping damping;

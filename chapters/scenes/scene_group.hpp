@@ -9,7 +9,8 @@
 // are each body's, and whose contact couples them through chapter 14's self-contact barrier of the
 // joined mesh (SelfContactBarrier: every surface point–triangle and edge–edge pair sharing no
 // vertex). Bodies that cannot reach each other stay separate solves (contact_groups decides, once,
-// before the first step; the runner checks after every step that it held).
+// before the first step; the runner checks after every step that it held). BodyGroups is what the
+// runner builds, once: the start check, the groups, and the chapter 10 Scene of each body and group.
 
 #include "scenes/scene_file.hpp"
 
@@ -21,6 +22,7 @@
 
 #include <Eigen/Core>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -64,6 +66,34 @@ TetMesh joined_mesh(const SceneSpec& scene, const std::vector<int>& members);
 /// volume-weighted mean Young's modulus and the mean density (what chapter 10's divergence check
 /// reads: Y V is the sum of the bodies' Y_i V_i).
 dynamics::Scene joined_scene(const SceneSpec& scene, const std::vector<int>& members);
+
+/// The bodies of a scene as the solves that step them, built once before the first step: the start
+/// check (check_start_gaps), the groups (contact_groups), chapter 10's Scene of every body
+/// (dynamics_scene) and of every group of several (joined_scene); after every step, check_apart.
+/// The scene must outlive it. docs/scenes.md#bodies-against-bodies
+class BodyGroups {
+public:
+    /// fem::Error as check_start_gaps and contact_groups.
+    explicit BodyGroups(const SceneSpec& scene);
+
+    /// The groups: each one's bodies (indices into scene.bodies, increasing), as contact_groups.
+    const std::vector<std::vector<int>>& members() const { return members_; }
+    /// Chapter 10's Scene of body i alone (its mesh, pins, material, the scene's gravity and Δt).
+    const dynamics::Scene& body_scene(std::size_t i) const { return body_scenes_[i]; }
+    /// Chapter 10's Scene of group g's joined mesh (joined_scene); null for a group of one body.
+    const dynamics::Scene* joint_scene(std::size_t g) const { return joint_scenes_[g] ? &*joint_scenes_[g] : nullptr; }
+    /// Whether bodies of separate solves could meet, so that check_apart has work after each step
+    /// ([contact] bodies with more than one group).
+    bool checks_apart() const { return scene_.contact.bodies && members_.size() > 1; }
+    /// check_groups_apart at positions x (per body, #V×3) after a step.
+    void check_apart(const std::vector<MatrixX3d>& positions) const;
+
+private:
+    const SceneSpec& scene_;
+    std::vector<std::vector<int>> members_;
+    std::vector<dynamics::Scene> body_scenes_;
+    std::vector<std::optional<dynamics::Scene>> joint_scenes_;
+};
 
 /// A force model over the joined unknowns of several bodies: body i's model on its slice u_i of u
 /// (3n_i entries from 3 offset_i): U(u) = Σ U_i(u_i), f = (f_1, f_2, …), K = blockdiag(K_i).

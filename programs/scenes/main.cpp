@@ -14,6 +14,7 @@
 // newton_iterations; with --html, <scene>.html (a web page that plays the run); with --compare,
 // models.csv. docs/scenes.md
 #include "scenes/compare.hpp"
+#include "scenes/live_view.hpp"
 #include "scenes/runner.hpp"
 #include "scenes/web_page.hpp"
 

@@ -21,7 +21,7 @@ if(FEM_BUILD_TESTS)
   add_executable(test_scenes ${scene_test_sources})
   target_link_libraries(test_scenes PRIVATE fem_scenes fem_test_main fem_flags
                         VTK::CommonCore VTK::CommonDataModel VTK::IOImage  # test_frames.cpp reads the PNG frames
-                        X11::X11 X11::Xtst)  # test_runner.cpp drives the live view's keys and mouse
+                        X11::X11 X11::Xtst)  # test_live_view.cpp drives the live view's keys and mouse
   target_compile_definitions(test_scenes PRIVATE FEM_TEST_OUTPUT_DIR="${CMAKE_BINARY_DIR}/test_output/scenes"
                              FEM_SCENES_DIR="${FEM_ROOT}/scenes" FEM_SCENE_EXE="$<TARGET_FILE:fem_scene>"
                              FEM_SCENE_BAD_DIR="${FEM_ROOT}/tests/scenes/bad_scenes")

@@ -33,7 +33,7 @@ std::unique_ptr<cg::LinearSolver> make_frozen_factor_solver()
 
 std::vector<std::string> force_model_names()
 {
-    std::vector<std::string> names{"linear", "corotational"};
+    std::vector<std::string> names{std::string(linear_model), std::string(corotational_model)};
     for (std::string& material : material_names())
         names.push_back(std::move(material));
     return names;
@@ -48,9 +48,9 @@ bool is_hyperelastic(std::string_view name)
 std::unique_ptr<dynamics::ForceModel> make_force_model(std::string_view name, const TetMesh& mesh,
                                                        const dynamics::Material& material)
 {
-    if (name == "linear")
+    if (name == linear_model)
         return std::make_unique<dynamics::LinearElasticity>(mesh, material);
-    if (name == "corotational")
+    if (name == corotational_model)
         return std::make_unique<corot::CorotationalElasticity>(mesh, material, corot::RotationFit::polar,
                                                                corot::PolarAlgorithm::newton,
                                                                corot::ForceForm::shape_gradients);
@@ -79,7 +79,7 @@ std::unique_ptr<dynamics::Integrator> make_integrator_for(std::string_view model
                             "': chapter 12's Newton steps backward Euler only; use backward-euler"));
         return std::make_unique<NewtonBackwardEuler>(newton_options_for(settings));
     }
-    if (model != "linear" && model != "corotational")
+    if (model != linear_model && model != corotational_model)
         throw unknown_model(model);
     dynamics::ImplicitOptions options;
     if (settings.solver == frozen_factor_solver)

@@ -3,6 +3,7 @@
 
 #include "13_skinning/skinning.hpp"
 
+#include "12_hyperelastic_newton/force_models.hpp"
 #include "12_hyperelastic_newton/materials.hpp"
 
 #include "common/error.hpp"
@@ -73,7 +74,8 @@ ModelComparison compare_models(const SceneSpec& scene, const RunContext* run)
     }
 
     // The reference's model at the scene's Δt, then every other model the comparison runs, then auto.
-    std::vector<std::string> models{reference_model, "linear", "corotational"};
+    std::vector<std::string> models{reference_model, std::string(hyper::linear_model),
+                                    std::string(hyper::corotational_model)};
     for (const hyper::MaterialNames& material : hyper::material_descriptions())
         if (material.compared && material.name != reference_model)
             models.push_back(material.name);

@@ -1,10 +1,5 @@
-// How a scene's frames are drawn, and the live view. docs/scenes.md#the-live-view
+// The live view: the run's frames in a window as they come, its keys and mouse. docs/scenes.md#the-live-view
 #include "scenes/live_view.hpp"
-
-#include "scenes/run_outputs.hpp"
-#include "scenes/runner.hpp"
-
-#include "12_hyperelastic_newton/materials.hpp"
 
 #include "common/error.hpp"
 #include "common/interrupt.hpp"
@@ -17,89 +12,6 @@
 #include <thread>
 
 namespace fem::scenes {
-
-namespace {
-
-/// The unit of a frame field (scene_file.hpp's OutputSpec::fields), for the colour bar.
-std::string unit_of(const std::string& field)
-{
-    return field == "displacement" ? "m" : field == "velocity" ? "m/s" : field == "von Mises stress" ? "Pa" : "";
-}
-
-/// The percentile a frame field's colour range is clipped at (RenderOptions::clip_percentile): the
-/// stress at 99, as it concentrates in the few tets at a pin or a contact, whose peak would set the
-/// scale and leave the rest of the body one colour (the hanging cube's corners: 6.65·10⁴ Pa); the
-/// others at 100 (not clipped).
-double clip_percentile_of(const std::string& field)
-{
-    return field == "von Mises stress" ? 99.0 : 100.0;
-}
-
-}  // namespace
-
-fig::RenderOptions frame_view(const SceneSpec& scene)
-{
-    const OutputSpec& out = scene.output;
-    fig::RenderOptions view;
-    view.title = scene.title;
-    view.field = out.colour;
-    view.unit = unit_of(out.colour);
-    view.clip_percentile = clip_percentile_of(out.colour);
-    view.view_direction = {out.view_direction.x(), out.view_direction.y(), out.view_direction.z()};
-    view.view_up = {out.view_up.x(), out.view_up.y(), out.view_up.z()};
-    view.width = out.width;
-    view.height = out.height;
-    view.scale = 1;  // the scene file's pixels: the live window must fit the screen and match the PNGs
-    view.frame_bounds = out.frame_box;
-    view.range = out.colour_range;
-    view.data_under_title = true;  // a title of two or three lines (frame_title) over the body
-    return view;
-}
-
-std::string model_label(const std::string& model)
-{
-    for (const hyper::MaterialNames& material : hyper::material_descriptions())
-        if (material.name == model)
-            return material.label;
-    return model;
-}
-
-double slow_motion(const SceneSpec& scene)
-{
-    return scene.output.frame_rate / video_frame_rate(frame_count(scene), scene.output);
-}
-
-std::string frame_caption(const SceneSpec& scene, const std::string& models, double time)
-{
-    std::string caption = str(scene.file.stem().string(), " \u00B7 ", models, " \u00B7 ", io::time_label(time));
-    const double slow = std::round(10.0 * slow_motion(scene)) / 10.0;
-    if (slow > 1.0)
-        caption += str(" \u00B7 slow motion \u00D7", slow);
-    return caption;
-}
-
-std::string frame_title(const SceneSpec& scene, const std::string& models, double time)
-{
-    std::string title = str(scene.title, "\n", frame_caption(scene, models, time));
-    if (scene.output.warp != 1.0)
-        title += "\n" + io::warp_note(scene.output.warp);
-    return title;
-}
-
-std::vector<fig::Prop> obstacle_props(const SceneSpec& scene, const std::array<double, 6>& body_box, double time)
-{
-    std::vector<fig::Prop> props;
-    for (const ObstacleSpec& spec : scene.obstacles) {
-        const TriMesh drawn = spec.obstacle->surface_at(body_box, time);
-        fig::Prop prop;
-        prop.shape.points = drawn.V;
-        prop.shape.cells = drawn.F;
-        props.push_back(std::move(prop));
-    }
-    return props;
-}
-
-// --- LiveView -------------------------------------------------------------------------------------
 
 LiveView::LiveView(const SceneSpec& scene, std::map<int, std::filesystem::path> screenshots)
     : scene_(scene), window_(frame_view(scene), str("fem_scene: ", scene.title)), screenshots_(std::move(screenshots)),
@@ -142,9 +54,7 @@ void LiveView::frame(const io::MeshData& frame, int step, double time, const std
     const io::MeshData shown = io::warped(frame, scene_.output.warp);
     const auto draw = [&] {
         fig::RenderOptions view = frame_view(scene_);
-        view.field = fields_[field_];
-        view.unit = unit_of(view.field);
-        view.clip_percentile = clip_percentile_of(view.field);
+        colour_by(view, fields_[field_]);
         if (field_ != 0)
             view.range.reset();  // the fixed range belongs to the scene's colour field
         view.title = frame_title(scene_, models, time);
@@ -217,7 +127,7 @@ void LiveView::frame(const io::MeshData& frame, int step, double time, const std
         }
         if (paused_ && !advance && !announced) {
             // Said once per frame it waits on, when this frame's files are written and it is shown:
-            // a script driving the window waits for the line (tests/scenes/test_runner.cpp).
+            // a script driving the window waits for the line (tests/scenes/test_live_view.cpp).
             std::cout << "paused at step " << step << " (t = " << time << " s)" << std::endl;
             announced = true;
         }

@@ -15,9 +15,9 @@ namespace fem::scenes {
 
 Level level_of(const std::string& model)
 {
-    if (model == "linear")
+    if (model == hyper::linear_model)
         return Level::linear;
-    if (model == "corotational")
+    if (model == hyper::corotational_model)
         return Level::corotational;
     return Level::hyperelastic;
 }
@@ -25,8 +25,8 @@ Level level_of(const std::string& model)
 std::string level_name(Level level, const std::string& hyperelastic)
 {
     switch (level) {
-    case Level::linear: return "linear";
-    case Level::corotational: return "corotational";
+    case Level::linear: return std::string(hyper::linear_model);
+    case Level::corotational: return std::string(hyper::corotational_model);
     case Level::hyperelastic: return hyperelastic;
     }
     return "?";

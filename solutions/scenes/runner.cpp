@@ -1,23 +1,24 @@
-// The scenes runner: one chapter 10 Simulation per body, stepped together. docs/scenes.md#the-runner
+// The scenes runner: one chapter 10 Simulation per solve (a body, or bodies that can meet), stepped
+// together. run_scene is set-up (the output sink, BodyGroups, RunningScene), loop (step_solves,
+// take_frame) and output (SceneOutput::finish, scene_output.hpp). docs/scenes.md#the-runner
 #include "scenes/runner.hpp"
+
+#include "scene_output.hpp"
 
 #include "scenes/run_outputs.hpp"
 #include "scenes/scene_contact.hpp"
 #include "scenes/scene_conditions.hpp"
 #include "scenes/scene_group.hpp"
-#include "scenes/web_page.hpp"
 
 #include "12_hyperelastic_newton/force_models.hpp"
 
 #include "common/error.hpp"
 #include "common/interrupt.hpp"
-#include "common/motion.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <iostream>
-#include <optional>
 
 namespace fem::scenes {
 
@@ -130,8 +131,10 @@ dynamics::State BodyRun::state() const
     return s;
 }
 
-/// A body of the scene: its force model (auto's levels), its own Body, its segments.
-BodyRun start_body(const BodySpec& spec, const SceneSpec& scene, const std::string& model)
+/// A body of the scene: its force model (auto's levels), its own Body (over its chapter 10 Scene,
+/// BodyGroups::body_scene), its segments.
+BodyRun start_body(const BodySpec& spec, const dynamics::Scene& body_scene, const SceneSpec& scene,
+                   const std::string& model)
 {
     BodyRun b;
     b.spec = &spec;
@@ -141,7 +144,7 @@ BodyRun start_body(const BodySpec& spec, const SceneSpec& scene, const std::stri
     auto forces = std::make_unique<SceneForces>(spec.mesh, spec.material, hyperelastic,
                                                 b.automatic ? Level::linear : level_of(chosen));
     b.forces = forces.get();
-    b.body = std::make_unique<dynamics::Body>(dynamics_scene(scene, spec), std::move(forces));
+    b.body = std::make_unique<dynamics::Body>(body_scene, std::move(forces));
     b.segments.push_back({0, 0, b.forces->level(), b.forces->level_model()});
     return b;
 }
@@ -190,10 +193,10 @@ private:
 };
 
 /// The solve of a group of bodies (indices into bodies): its Body (the member's own, or the joint
-/// one of scene_group.hpp), its integrator, contact (obstacles; the bodies against each other and
-/// themselves in a group of several; a lone body's self_contact) and step hook.
+/// one over joint_scene, BodyGroups::joint_scene), its integrator, contact (obstacles; the bodies
+/// against each other and themselves in a group of several; a lone body's self_contact) and step hook.
 std::unique_ptr<GroupRun> start_group(std::vector<BodyRun>& bodies, const std::vector<int>& members,
-                                      const SceneSpec& scene,
+                                      const dynamics::Scene* joint_scene, const SceneSpec& scene,
                                       const std::vector<std::shared_ptr<const contact::Obstacle>>& obstacles)
 {
     auto g = std::make_unique<GroupRun>();
@@ -219,14 +222,13 @@ std::unique_ptr<GroupRun> start_group(std::vector<BodyRun>& bodies, const std::v
             parts.push_back(b->forces);
             counts.push_back(b->spec->mesh.V.rows());
         }
-        g->joint = std::make_unique<dynamics::Body>(joined_scene(scene, members),
-                                                    std::make_unique<JointForces>(parts, counts));
+        g->joint = std::make_unique<dynamics::Body>(*joint_scene, std::make_unique<JointForces>(parts, counts));
         g->body = g->joint.get();
     } else {
         g->body = g->members.front()->body.get();
     }
     for (BodyRun* b : g->members)
-        if ((!obstacles.empty() || self_contact) && b->forces->level_model() == "linear" && !b->automatic)
+        if ((!obstacles.empty() || self_contact) && b->forces->level_model() == hyper::linear_model && !b->automatic)
             throw Error(str("body '", b->spec->name, "': model linear cannot meet obstacles or bodies (its energy of a "
                             "body at rest far from where it started is round-off; docs/scenes.md#obstacles): use auto, "
                             "corotational or a hyperelastic model"));
@@ -363,14 +365,16 @@ void update_pulls(std::vector<BodyRun>& bodies, const PullRequest& request, doub
     }
 }
 
-/// The frame of every body, merged, with the fields the scene asks for (and "model": each tet's level).
-io::MeshData scene_frame(const std::vector<BodyRun>& bodies, const OutputSpec& output)
+/// The frame of every body at its state, merged, with the fields the scene asks for (and "model":
+/// each tet's level).
+io::MeshData scene_frame(const std::vector<BodyRun>& bodies, const std::vector<dynamics::State>& states,
+                         const OutputSpec& output)
 {
     std::vector<io::MeshData> parts;
-    for (const BodyRun& b : bodies) {
-        io::MeshData frame = dynamics::body_frame(*b.body, b.state());
-        frame.cell_data.push_back(
-            {"model", Eigen::MatrixXd::Constant(frame.cells.rows(), 1, static_cast<double>(b.forces->level()))});
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+        io::MeshData frame = dynamics::body_frame(*bodies[i].body, states[i]);
+        frame.cell_data.push_back({"model", Eigen::MatrixXd::Constant(frame.cells.rows(), 1,
+                                                                      static_cast<double>(bodies[i].forces->level()))});
         parts.push_back(std::move(frame));
     }
     return merged_frame(parts, output);
@@ -388,83 +392,107 @@ std::string frame_models(const std::vector<BodyRun>& bodies)
     return out;
 }
 
-/// The lattice of a skinned body drawn around its skin: the body's frame k (warped as the skin is),
-/// its surface's edges coloured by the skin's field on the skin's colour scale.
-fig::Prop lattice_prop(const io::MotionRecorder& bodies, std::size_t k, double warp)
+/// A scene's bodies and the solves that step them, started: the run's set-up. Each body's force
+/// model and own Body (over its Scene in groups), the obstacles, and each group's Body, integrator,
+/// contact and step hook. The scene and groups must outlive it; it is not copied or moved (each
+/// solve points at its bodies).
+struct RunningScene {
+    RunningScene(const SceneSpec& scene, const BodyGroups& groups, const std::string& model)
+    {
+        for (std::size_t i = 0; i < scene.bodies.size(); ++i)
+            bodies.push_back(start_body(scene.bodies[i], groups.body_scene(i), scene, model));
+        const auto obstacles = scene_obstacles(scene);
+        for (std::size_t g = 0; g < groups.members().size(); ++g)
+            solves.push_back(start_group(bodies, groups.members()[g], groups.joint_scene(g), scene, obstacles));
+    }
+    RunningScene(const RunningScene&) = delete;
+    RunningScene& operator=(const RunningScene&) = delete;
+
+    std::vector<BodyRun> bodies;  // in the scene's order
+    std::vector<std::unique_ptr<GroupRun>> solves;
+};
+
+/// One step of every solve in turn (step_group), each one's contact record into records; then, with
+/// solves that could meet, that they stayed apart (BodyGroups::check_apart). The Newton iterations
+/// the step took, summed over the solves.
+int step_solves(RunningScene& running, const BodyGroups& groups, std::vector<ContactStepRecord>& records)
 {
-    fig::Prop lattice;
-    lattice.shape = io::warped(bodies.kept_frame(k), warp);
-    lattice.by_field = true;
-    lattice.wireframe = true;
-    return lattice;
+    int newton = 0;
+    for (std::unique_ptr<GroupRun>& g : running.solves) {
+        step_group(*g);
+        record_contact(*g, records);
+        newton += g->simulation->last().newton_iterations;
+    }
+    if (groups.checks_apart()) {
+        std::vector<MatrixX3d> positions;
+        for (const BodyRun& b : running.bodies)
+            positions.push_back(b.body->positions(b.state().u));
+        groups.check_apart(positions);
+    }
+    return newton;
+}
+
+/// Each body's last record to the output (a row of steps.csv each), with its model's name now.
+void log_steps(const std::vector<BodyRun>& bodies, SceneOutput& output)
+{
+    for (const BodyRun& b : bodies)
+        output.add_step(b.spec->name, b.body->model().name(), b.records.back());
+}
+
+/// The frame of the bodies' state now, handed to the output; with keep_positions each body's
+/// positions kept in result.frames.
+void take_frame(const std::vector<BodyRun>& bodies, const OutputSpec& spec, bool keep_positions,
+                SceneOutput& output, RunResult& result)
+{
+    std::vector<dynamics::State> states;
+    for (const BodyRun& b : bodies)
+        states.push_back(b.state());
+    SceneFrame frame;
+    frame.step = states.front().step;
+    frame.time = states.front().time;
+    frame.models = frame_models(bodies);
+    if (output.takes_mesh())
+        frame.mesh = scene_frame(bodies, states, spec);
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+        if (keep_positions)
+            result.frames[i].push_back(bodies[i].body->positions(states[i].u));
+        frame.displacements.push_back(std::move(states[i].u));
+    }
+    output.add_frame(frame);
+    ++result.frame_count;
+}
+
+/// "body a: linear 0-3, corotational 4-120 (steps per model); contact in 80 of 120 steps; one solve
+/// with bodies 'a', 'b'" for each body.
+void print_models(const std::vector<BodyRun>& bodies, int steps)
+{
+    for (const BodyRun& b : bodies)
+        std::cout << "body " << b.spec->name << ": " << describe_segments(b.segments) << " (steps per model)"
+                  << (b.group->contact ? str("; contact in ", b.group->contact->contact_steps(), " of ", steps, " steps") : "")
+                  << (b.group->members.size() > 1 ? str("; one solve with ", b.group->names()) : "") << "\n";
 }
 
 }  // namespace
 
 RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
 {
-    // The skin (chapter 13) is bound before anything runs or is written: a bad one is refused early.
-    const RunContext* run = options.run;
-    const std::size_t skinned = scene.skin ? skin_body(scene) : 0;
-    std::shared_ptr<const SkinObserver> skin = options.skin;
-    if (scene.skin && !skin && run != nullptr && scene.output.pvd)
-        skin = make_skin_observer(*scene.skin, scene.bodies[skinned]);
-    check_start_gaps(scene);
-    std::vector<BodyRun> bodies;
-    for (const BodySpec& spec : scene.bodies)
-        bodies.push_back(start_body(spec, scene, options.model));
-    const auto obstacles = scene_obstacles(scene);
-    const std::vector<std::vector<int>> group_members = contact_groups(scene);
-    std::vector<std::unique_ptr<GroupRun>> groups;
-    for (const std::vector<int>& members : group_members)
-        groups.push_back(start_group(bodies, members, scene, obstacles));
-
+    // The set-up. The output first: it binds the skin (chapter 13), so that a bad one is refused
+    // before anything runs or is written; then the groups (the start check), then the bodies.
+    SceneOutput output(scene, options.run, options.skin, options.on_frame);
+    const BodyGroups groups(scene);
+    RunningScene running(scene, groups, options.model);
     const int steps = dynamics::step_count(scene.duration, scene.time_step);
     const int frame_every = steps_per_frame(scene);
-    const std::string stem = scene.file.stem().string();
-    const bool png = run != nullptr && run->figures && scene.output.png;
-    std::optional<io::MotionRecorder> recorder;
-    if (run != nullptr && scene.output.pvd)
-        recorder.emplace(run->file(stem + ".pvd"), png ? 1 : 0);
-    std::optional<io::MotionRecorder> skin_recorder;  // the skin's .vtp frames beside the tets' .vtu
-    if (run != nullptr && scene.output.pvd && skin)
-        skin_recorder.emplace(run->file(stem + "_skin.pvd"), png ? 1 : 0, io::FrameFile::surface);
-    std::optional<WebPage> page;  // the web page <stem>.html (web_page.hpp)
-    if (run != nullptr && scene.output.html)
-        page.emplace(scene);
-    StepHistory history;
+
+    // The loop: every solve steps in turn; each step's records and every frame go to the output.
     RunResult result;
-    result.frames.resize(bodies.size());
-    std::vector<std::string> models;  // per frame, for its caption
-    const auto frame = [&] {
-        const dynamics::State first = bodies.front().state();
-        models.push_back(frame_models(bodies));
-        if (recorder || options.on_frame || page) {
-            const io::MeshData data = scene_frame(bodies, scene.output);
-            if (recorder)
-                recorder->add(first.time, data);
-            if (page)
-                page->add_frame(data, first.time, models.back());
-            if (skin_recorder)
-                skin_recorder->add(first.time, skin->frame(bodies[skinned].state().u));
-            if (options.on_frame)
-                options.on_frame(data, first.step, first.time, models.back());
-        }
-        if (options.keep_positions)
-            for (std::size_t i = 0; i < bodies.size(); ++i)
-                result.frames[i].push_back(bodies[i].body->positions(bodies[i].state().u));
-        ++result.frame_count;
-    };
-    const auto log_step = [&] {
-        for (const BodyRun& b : bodies)
-            history.add(b.spec->name, b.body->model().name(), b.records.back());
-    };
-    for (std::unique_ptr<GroupRun>& g : groups) {
+    result.frames.resize(running.bodies.size());
+    for (std::unique_ptr<GroupRun>& g : running.solves) {
         g->simulation->run(0);  // step 0's record: the energies at the start
         record_members(*g);
     }
-    log_step();
-    frame();
+    log_steps(running.bodies, output);
+    take_frame(running.bodies, scene.output, options.keep_positions, output, result);
     Progress progress(steps, options.progress);
     Timer clock;
     for (int k = 1; options.forever || k <= steps; ++k) {
@@ -473,111 +501,30 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
             break;
         }
         if (options.pull)
-            update_pulls(bodies, options.pull(), options.pull_stiffness);
-        int newton = 0;
-        for (std::unique_ptr<GroupRun>& g : groups) {
-            step_group(*g);
-            record_contact(*g, result.contact_records);
-            newton += g->simulation->last().newton_iterations;
-        }
-        if (groups.size() > 1 && scene.contact.bodies) {
-            std::vector<MatrixX3d> positions;
-            for (const BodyRun& b : bodies)
-                positions.push_back(b.body->positions(b.state().u));
-            check_groups_apart(scene, group_members, positions);
-        }
+            update_pulls(running.bodies, options.pull(), options.pull_stiffness);
+        const int newton = step_solves(running, groups, result.contact_records);
         result.newton_iterations += newton;
         result.steps = k;
-        log_step();
+        log_steps(running.bodies, output);
         if (k % frame_every == 0 || k == steps)
-            frame();
+            take_frame(running.bodies, scene.output, options.keep_positions, output, result);
         if (!options.forever)
             progress.update(k, newton);
     }
     result.seconds = clock.seconds();
     if (result.interrupted)
         progress.finish();
-    for (BodyRun& b : bodies) {
+
+    // The output: each body's books into the result, the models printed, the files of the whole run.
+    for (BodyRun& b : running.bodies) {
         result.segments.push_back(b.segments);
         result.contact_steps.push_back(b.group->contact ? b.group->contact->contact_steps() : 0);
         result.records.push_back(std::move(b.records));
     }
-
     if (options.print_models)
-        for (const BodyRun& b : bodies)
-            std::cout << "body " << b.spec->name << ": " << describe_segments(b.segments) << " (steps per model)"
-                      << (b.group->contact ? str("; contact in ", b.group->contact->contact_steps(), " of ", result.steps, " steps") : "")
-                      << (b.group->members.size() > 1 ? str("; one solve with ", b.group->names()) : "")
-                      << "\n";
-    if (run == nullptr)
-        return result;
-    if (result.interrupted)
-        std::cout << "interrupted after step " << result.steps << ": " << result.frame_count
-                  << " frames written, the .pvd lists them; no PNGs or video\n";
-    if (scene.output.csv)
-        history.write_csv(run->file("steps.csv"));
-    if (scene.output.charts)
-        history.save_charts(scene, bodies.size(), *run);
-    if (!result.contact_records.empty()) {
-        const Table cost = contact_cost_table(result.contact_records);
-        std::cout << "\n";
-        cost.print(std::cout);
-        if (scene.output.csv) {
-            contact_steps_table(result.contact_records).write_csv(run->file("contact_steps.csv"));
-            cost.write_csv(run->file("contact_cost.csv"));
-        }
-    }
-    if (page) {
-        const std::filesystem::path file = run->file(stem + ".html");
-        const Eigen::Vector3d bound = page->write(file, result.records);
-        std::cout << "web page: " << file.filename().string() << " (" << result.frame_count << " frames, "
-                  << std::lround(std::filesystem::file_size(file) / 1e4) / 100.0 << " MB; positions to within "
-                  << bound.maxCoeff() << " m)\n";
-    }
-    if (recorder && png && !result.interrupted) {
-        // Every frame captioned with the models of its moment; the obstacles drawn at its time under
-        // the box the camera frames (the scene's, as the live view takes it, or the motion's).
-        const double warp = scene.output.warp;
-        const std::array<double, 6> box = scene.output.frame_box.value_or(recorder->motion_bounds(warp));
-        io::FrameExtras extras;
-        extras.title = [&](std::size_t k, double time) { return frame_title(scene, models.at(k), time); };
-        extras.props = [&](std::size_t, double time) { return obstacle_props(scene, box, time); };
-        const int written = recorder->render_png_frames(run->file(stem), frame_view(scene), warp, extras);
-        // A skinned scene's picture is its skin (the bunny), coloured by its displacement, the one
-        // field a skin frame has besides its normals, with the lattice that carries it drawn around it
-        // as edges on the same colour scale; the video shows it.
-        int skin_written = 0;
-        if (skin_recorder) {
-            fig::RenderOptions view = frame_view(scene);
-            view.field = "displacement";
-            view.unit = "m";
-            view.clip_percentile = 100.0;
-            view.range.reset();
-            view.smooth = true;  // a render surface: shaded smooth by its normals, no facets or edges
-            view.show_edges = false;
-            io::FrameExtras skin_extras = extras;
-            skin_extras.props = [&](std::size_t k, double time) {
-                std::vector<fig::Prop> props = obstacle_props(scene, box, time);
-                props.push_back(lattice_prop(*recorder, k, warp));
-                return props;
-            };
-            skin_written = skin_recorder->render_png_frames(run->file(stem + "_skin"), view, warp, skin_extras);
-        }
-        if (written > 0 && scene.output.video != "none")
-            make_video(*run, skin_written > 0 ? stem + "_skin" : stem, scene.output);
-    }
+        print_models(running.bodies, result.steps);
+    output.finish(result.records, result.contact_records, result.steps, result.interrupted);
     return result;
-}
-
-int steps_per_frame(const SceneSpec& scene)
-{
-    return std::max(1, static_cast<int>(std::lround(1.0 / (scene.output.frame_rate * scene.time_step))));
-}
-
-int frame_count(const SceneSpec& scene)
-{
-    const int steps = dynamics::step_count(scene.duration, scene.time_step), every = steps_per_frame(scene);
-    return 1 + steps / every + (steps % every != 0 ? 1 : 0);
 }
 
 RunResult run_positions(const SceneSpec& scene, const std::string& model)

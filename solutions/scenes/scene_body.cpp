@@ -2,6 +2,8 @@
 // docs/scenes.md#the-scene-file
 #include "scene_parts.hpp"
 
+#include "12_hyperelastic_newton/force_models.hpp"
+
 #include <algorithm>
 #include <iomanip>
 #include <set>
@@ -47,7 +49,7 @@ BodySpec read_body(const toml::table& table, const std::string& name, const Sour
         fields.missing("material", "give [body.material] with model, youngs_modulus, poisson_ratio, density");
     const Fields material(*material_table, fields.field("material"), file,
                           {"model", "youngs_modulus", "poisson_ratio", "density"});
-    body.model = material.text("model", "linear", model_names());
+    body.model = material.text("model", std::string(hyper::linear_model), model_names());
     body.material.youngs_modulus = material.number(
         "youngs_modulus", body.material.youngs_modulus, [](double Y) { return Y > 0.0 && Y <= largest_youngs_modulus; },
         str("a number in (0, ", largest_youngs_modulus, "] Pa (diamond is 1.2e12 Pa; beyond the bound the stresses "

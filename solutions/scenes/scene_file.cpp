@@ -322,8 +322,8 @@ void check_bodies(const SceneSpec& scene)
 {
     for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
         const BodySpec& body = scene.bodies[i];
-        const bool hyper = body.model != "linear" && body.model != "corotational";
-        if (hyper && scene.integrator != "backward-euler")
+        const bool hyperelastic = body.model != hyper::linear_model && body.model != hyper::corotational_model;
+        if (hyperelastic && scene.integrator != "backward-euler")
             throw Error(str(scene.file.string(), ": time.integrator: '", scene.integrator, "' is not for body[", i,
                             "].material.model = '", body.model,
                             "', which steps with Newton backward Euler only: use backward-euler"));

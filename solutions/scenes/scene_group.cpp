@@ -257,6 +257,21 @@ dynamics::Scene joined_scene(const SceneSpec& scene, const std::vector<int>& mem
     return joined;
 }
 
+BodyGroups::BodyGroups(const SceneSpec& scene) : scene_(scene)
+{
+    check_start_gaps(scene);
+    members_ = contact_groups(scene);
+    for (const BodySpec& body : scene.bodies)
+        body_scenes_.push_back(dynamics_scene(scene, body));
+    for (const std::vector<int>& members : members_)
+        joint_scenes_.push_back(members.size() > 1 ? std::optional(joined_scene(scene, members)) : std::nullopt);
+}
+
+void BodyGroups::check_apart(const std::vector<MatrixX3d>& positions) const
+{
+    check_groups_apart(scene_, members_, positions);
+}
+
 // --- JointForces ---------------------------------------------------------------------------------
 
 JointForces::JointForces(std::vector<dynamics::ForceModel*> parts, std::vector<Eigen::Index> vertex_counts)

@@ -2,7 +2,7 @@
 // docs/scenes.md#the-web-page
 #include "scenes/web_page.hpp"
 
-#include "scenes/live_view.hpp"
+#include "scenes/frame_look.hpp"
 #include "scenes/run_outputs.hpp"
 
 #include "13_skinning/skinning.hpp"

@@ -1,6 +1,6 @@
 // Obstacles in a scene (chapter 14): the reader's fields, chapter 14's obstacles made from them, and
 // the rule that steps a body with contact only when it needs it. docs/scenes.md#obstacles
-#include "scenes/live_view.hpp"
+#include "scenes/frame_look.hpp"
 #include "scenes/runner.hpp"
 #include "scenes/scene_contact.hpp"
 #include "scenes/scene_text.hpp"

@@ -1,7 +1,7 @@
 // How a scene's frames are drawn: obstacles in the picture where they are, the caption of every frame
 // (scene, model, time, slow motion), and the colour range MotionRecorder gives a clipped field.
 // docs/scenes.md#outputs
-#include "scenes/live_view.hpp"
+#include "scenes/frame_look.hpp"
 #include "scenes/runner.hpp"
 #include "scenes/scene_text.hpp"
 
