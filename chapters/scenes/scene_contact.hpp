@@ -18,6 +18,7 @@
 #include "scenes/scene_file.hpp"
 
 #include "14_contact/contact.hpp"
+#include "14_contact/surface.hpp"
 #include "15_body_contact/timed_solver.hpp"
 
 #include "12_hyperelastic_newton/newton.hpp"
