@@ -6,6 +6,7 @@
 #include "14_contact/contact_scenes.hpp"
 #include "14_contact/obstacles.hpp"
 #include "fire_at.hpp"
+#include "one_thread.hpp"
 #include "rest_weight.hpp"
 #include "slope_creep.hpp"
 

@@ -14,6 +14,7 @@
 #include "15_body_contact/pair_barrier.hpp"
 #include "../14_contact/contact_delegate.hpp"
 #include "../14_contact/fire_at.hpp"
+#include "../14_contact/one_thread.hpp"
 
 #include "12_hyperelastic_newton/newton.hpp"
 
