@@ -3,7 +3,7 @@
 // so that a run can split a step into the barrier (with its broad phase) and the continuous
 // collision check (the contact potential's own clocks, ContactClocks of contact.hpp) and the linear
 // solves (study 6 of ch14_contact, the scenes runner's contact_steps.csv).
-// docs/15_body_contact.md#bodies-against-bodies-the-cost
+// docs/15_body_contact.md#the-cost-of-contact
 //
 // The wrapper changes no answer: it forwards every call to the solver it wraps and adds the wrapped
 // solver's own prepare and solve times to a sum. Read the sum before and after a step for that

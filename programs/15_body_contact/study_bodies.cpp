@@ -8,7 +8,7 @@
 // run again with Newton's tolerance loosened, its iterations against the end state's offset; and
 // again (on request) with the barrier's Hessian projected otherwise or tried exact first, κ
 // doubled or fixed, and Newton stopped by the length of its step as well (IPC's test).
-// docs/15_body_contact.md#bodies-against-bodies-the-cost
+// docs/15_body_contact.md#the-cost-of-contact
 #include "15_body_contact/body_contact.hpp"
 #include "15_body_contact/intersections.hpp"
 #include "studies.hpp"

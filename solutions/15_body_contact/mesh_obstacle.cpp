@@ -332,7 +332,7 @@ double MeshObstacle::local_time_of_impact(const Eigen::Vector3d& p, const Eigen:
     double first = infinity;
     // BEGIN EXERCISE 15.4 mesh_time_of_impact #mesh-obstacles
     // HINT: The smallest s in [0, 2] at which p + s dp meets one of the triangles whose boxes meet the
-    // HINT: path's box (triangles_meeting), in `first` (docs/15_body_contact.md#continuous-collision-detection):
+    // HINT: path's box (triangles_meeting), in `first` (docs/15_body_contact.md#time-of-impact-against-a-mesh):
     // HINT: solve for where the path crosses each triangle's plane and whether that point lies in the
     // HINT: triangle (Möller–Trumbore, as the docs name it). Count a hit on an edge as inside, with a
     // HINT: margin of 1e-9 of the barycentric range, so a path through a shared edge cannot slip between

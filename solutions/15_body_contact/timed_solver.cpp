@@ -1,4 +1,4 @@
-// Chapter 15: the linear solver, timed. docs/15_body_contact.md#bodies-against-bodies-the-cost
+// Chapter 15: the linear solver, timed. docs/15_body_contact.md#the-cost-of-contact
 #include "15_body_contact/timed_solver.hpp"
 
 #include "common/error.hpp"

@@ -3,7 +3,7 @@
 // pattern that holds that one's, and one pattern over a step's Newton iterations while pairs arrive
 // (also where the exact barrier Hessian fails to factor); Newton's step-length test in the impact;
 // the contact potential's clocks (ContactClocks) that split such a step's time.
-// docs/15_body_contact.md#bodies-against-bodies-the-cost
+// docs/15_body_contact.md#the-cost-of-contact
 #include "15_body_contact/body_contact.hpp"
 #include "15_body_contact/intersections.hpp"
 #include "15_body_contact/timed_solver.hpp"
