@@ -1,12 +1,12 @@
-// The libFuzzer target of chapter 14's reader of the CCD benchmark's query files (read_ccd_queries,
-// solutions/14_contact/ccd.cpp). Each input is written to vertex-face/fuzz-input.csv in this process's
+// The libFuzzer target of chapter 15's reader of the CCD benchmark's query files (read_ccd_queries,
+// solutions/15_body_contact/ccd.cpp). Each input is written to vertex-face/fuzz-input.csv in this process's
 // scratch folder and read; every query read then goes through both CCD methods (the inclusion
 // method with at most 10⁴ boxes, so that an input stays fast). Expected: the read succeeds, or it
 // raises an fem::Error whose message names the file. A finding: a crash, a sanitizer report, another
 // exception, an fem::Error that does not name the file, a timeout, or memory beyond the limit.
 // tools/fuzz.sh runs it (target ccd_queries).
 
-#include "14_contact/ccd.hpp"
+#include "15_body_contact/ccd.hpp"
 
 #include "common/error.hpp"
 #include "fuzz/scratch.hpp"

@@ -15,11 +15,17 @@
 
 #include <Eigen/Core>
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
 
 namespace fem::contact {
+
+/// Makes the contact terms (ContactTerm) of a body against its obstacles with the potential's
+/// options: what a later chapter adds to a block scene (chapter 15's body_contact_term_maker).
+using ContactTermMaker = std::function<std::vector<std::unique_ptr<ContactTerm>>(
+    const dynamics::Body&, const std::vector<std::shared_ptr<const Obstacle>>&, const ContactOptions&)>;
 
 /// What a block scene is made of.
 struct BlockSettings {
@@ -41,6 +47,8 @@ struct BlockSettings {
     int friction_updates = 1;           ///< lagged friction updates per step, 0: until converged (step_with_friction_updates)
     /// What the block meets; empty: the floor z = 0 (a HalfSpace with μ = friction).
     std::vector<std::shared_ptr<const Obstacle>> obstacles;
+    /// The contact potential's terms beyond the obstacles; empty: none.
+    ContactTermMaker terms;
 };
 
 /// A step with contact as a chapter 10 integrator, so that chapter 10's time loop (dynamics::Simulation:
@@ -94,6 +102,9 @@ BlockScene block_scene(const BlockSettings& settings);
 Eigen::Vector3d mean_velocity(const dynamics::Body& body, const Eigen::VectorXd& v);
 /// The lowest z of the body's vertices at u [m].
 double lowest_height(const dynamics::Body& body, const Eigen::VectorXd& u);
+
+/// Δt as the studies' tables write it: "1/100" for 0.01 s (1/Δt rounded).
+std::string time_step_label(double time_step);
 
 /// The slide's closed form: a = g (sin θ − μ cos θ) when tan θ > μ, 0 when it sticks [m/s²].
 double slope_acceleration(double gravity, double slope, double friction);

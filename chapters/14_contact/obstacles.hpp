@@ -61,7 +61,7 @@ public:
     /// piece, itself (when d₀(p) < reach); a mesh one per triangle within reach (over a flat region
     /// only the plane's one: MeshObstacle::local_pieces). Where the pieces meet at an angle (a mesh's
     /// creases) the nearest one's distance has a kink, the sum of their barriers does not.
-    /// docs/14_contact.md#mesh-obstacles
+    /// docs/15_body_contact.md#mesh-obstacles
     virtual void local_pieces(const Eigen::Vector3d& p, double reach, std::vector<DistancePiece>& pieces) const;
 
     /// Its corners and edges at the rest placement (ObstacleFeatures; default: none, a smooth shape).

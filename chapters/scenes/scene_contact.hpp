@@ -18,7 +18,8 @@
 #include "scenes/scene_file.hpp"
 
 #include "14_contact/contact.hpp"
-#include "14_contact/timed_solver.hpp"
+#include "14_contact/surface.hpp"
+#include "15_body_contact/timed_solver.hpp"
 
 #include "12_hyperelastic_newton/newton.hpp"
 

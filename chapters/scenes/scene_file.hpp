@@ -170,7 +170,7 @@ struct ContactSpec {
     /// bodies that can meet stepped as one solve: scene_group.hpp). docs/scenes.md#bodies-against-bodies
     bool bodies = false;
     /// Coulomb's μ between bodies, and of a body against itself (chapter 14's lagged friction on the
-    /// surface pairs, ContactOptions::body_friction): with bodies or a body's self_contact; 0: none.
+    /// surface pairs, BodyContactOptions::body_friction): with bodies or a body's self_contact; 0: none.
     /// docs/scenes.md#bodies-against-bodies
     double friction = 0.0;
 };

@@ -14,7 +14,7 @@
 
 #include "scenes/scene_file.hpp"
 
-#include "14_contact/broad_phase.hpp"
+#include "15_body_contact/broad_phase.hpp"
 
 #include "10_linear_dynamics/body.hpp"
 

@@ -68,11 +68,6 @@ std::vector<Case> sweep(const Settings& settings)
     return cases;
 }
 
-std::string time_step_label(double time_step)
-{
-    return str("1/", static_cast<int>(std::lround(1.0 / time_step)));
-}
-
 BlockSettings block_settings(const Case& c)
 {
     BlockSettings block;

@@ -8,7 +8,7 @@ find_package(tomlplusplus 3 REQUIRED)  # Debian's libtomlplusplus-dev (tools/set
 file(GLOB scene_sources CONFIGURE_DEPENDS ${FEM_ROOT}/solutions/scenes/*.cpp)
 add_library(fem_scenes STATIC ${scene_sources})
 target_include_directories(fem_scenes PUBLIC ${FEM_ROOT}/chapters)
-target_link_libraries(fem_scenes PUBLIC fem_ch14_reference fem_ch13_reference fem_ch12_reference fem_ch11_reference fem_ch10_reference
+target_link_libraries(fem_scenes PUBLIC fem_ch15_reference fem_ch14_reference fem_ch13_reference fem_ch12_reference fem_ch11_reference fem_ch10_reference
                       PRIVATE tomlplusplus::tomlplusplus fem_flags)
 target_compile_options(fem_scenes PRIVATE ${FEM_FUZZ_FLAGS})  # the scene reader, fuzz_scene's ground
 fem_reference_code(fem_scenes)
@@ -46,7 +46,7 @@ if(FEM_BUILD_TESTS)
                      --out ${CMAKE_BINARY_DIR}/check_runs/scenes_full/${scene})
     set_tests_properties(scenes_full_${scene} PROPERTIES LABELS "scenes;full" COST 20)
   endforeach()
-  # The block in the bowl at smaller steps (docs/14_contact.md, the block in the bowl): once, every Δt
+  # The block in the bowl at smaller steps (docs/15_body_contact.md, the block in the bowl): once, every Δt
   # from 1/400 to 1/3200 s stopped on a line search that found no decrease; --compare's reference
   # runs at Δt/16.
   foreach(divisions 800 1600)

@@ -1,11 +1,11 @@
-// Chapter 14: the contact potential of one body against its obstacles (and, with self-contact, its
-// own surface) — the barriers, lagged friction and the obstacles' motion as one term of chapter 12's
-// Newton step (value, gradient, Hessian, the largest safe step) — and contact_step, the backward Euler
-// step that runs it. docs/14_contact.md#the-contact-potential
+// Chapter 14: the contact potential of one body against its obstacles (plus its contact terms) —
+// the barriers, lagged friction and the obstacles' motion as one term of chapter 12's Newton step
+// (value, gradient, Hessian, the largest safe step) — and contact_step, the backward Euler step that
+// runs it. docs/14_contact.md#the-contact-potential
 #include "14_contact/contact.hpp"
 
 #include "14_contact/barrier.hpp"
-#include "14_contact/friction.hpp"
+#include "14_contact/surface.hpp"
 
 #include "12_hyperelastic_newton/materials.hpp"
 
@@ -26,83 +26,53 @@ namespace {
 
 constexpr double infinity = std::numeric_limits<double>::infinity();
 
-std::vector<std::shared_ptr<const Obstacle>> checked_obstacles(std::vector<std::shared_ptr<const Obstacle>> obstacles,
-                                                              bool self_contact)
-{
-    if (obstacles.empty() && !self_contact)
-        throw Error("contact: no obstacle given (and self-contact is off: nothing to hold off)");
-    for (const auto& obstacle : obstacles)
-        if (!obstacle)
-            throw Error("contact: an obstacle is null");
-    return obstacles;
-}
-
-double checked_activation_distance(double activation_distance)
-{
-    require_positive(activation_distance, "contact activation distance d̂ [m]");
-    return activation_distance;
-}
-
 }  // namespace
 
-double balancing_stiffness(const Eigen::VectorXd& g, const Eigen::VectorXd& h)
+double ContactTerm::smallest_distance(const Eigen::VectorXd& /*u*/, double /*time*/, double /*reach*/) const
 {
-    if (g.size() != h.size())
-        throw Error(str("balancing_stiffness: g and h must have one size, got ", g.size(), " and ", h.size()));
-    const double norm = h.squaredNorm();
-    return norm > 0.0 ? -g.dot(h) / norm : 0.0;
+    return infinity;
 }
 
-double smallest_stiffness(double average_mass, double time_step, double activation_distance)
+double ContactTerm::time_of_impact(const Eigen::VectorXd& /*u*/, const Eigen::VectorXd& /*du*/, double /*time*/,
+                                   double /*end_time*/) const
 {
-    require_positive(average_mass, "average vertex mass [kg]");
-    require_positive(time_step, "time step dt [s]");
-    return average_mass / (time_step * time_step * barrier(0.5 * activation_distance, activation_distance).second);
+    return infinity;
+}
+
+double ContactTerm::obstacle_time_of_impact(const Eigen::VectorXd& /*u*/, double /*time*/, double /*end_time*/) const
+{
+    return infinity;
 }
 
 ContactPotential::ContactPotential(const dynamics::Body& body, std::vector<std::shared_ptr<const Obstacle>> obstacles,
-                                   ContactOptions options)
-    : obstacles_(checked_obstacles(std::move(obstacles), options.self_contact)),
-      options_(options),
-      features_(body.mesh(), obstacles_, checked_activation_distance(options.activation_distance)),
-      body_friction_(body.mesh().V),
-      rest_(body.mesh().V)
+                                   ContactOptions options, std::vector<std::unique_ptr<ContactTerm>> terms)
+    : obstacles_(std::move(obstacles)), options_(options), terms_(std::move(terms)), rest_(body.mesh().V)
 {
+    if (obstacles_.empty() && terms_.empty())
+        throw Error("contact: no obstacle and no contact term given: nothing to hold off");
+    for (const auto& obstacle : obstacles_)
+        if (!obstacle)
+            throw Error("contact: an obstacle is null");
+    for (const auto& term : terms_)
+        if (!term)
+            throw Error("contact: a contact term is null");
+    require_positive(options_.activation_distance, "contact activation distance d̂ [m]");
     if (!(std::isfinite(options_.stiffness) && options_.stiffness >= 0.0))
         throw Error(str("contact: the barrier stiffness kappa must be >= 0 (0: adaptive), got ", options_.stiffness));
     if (!(options_.safety > 0.0 && options_.safety < 1.0))
         throw Error(str("contact: the line search's safety factor must lie in (0, 1), got ", options_.safety));
     require_positive(options_.friction_velocity, "friction velocity eps_v [m/s]");
-    if (!(std::isfinite(options_.body_friction) && options_.body_friction >= 0.0))
-        throw Error(str("contact: the friction coefficient between bodies must be >= 0, got ", options_.body_friction));
-    if (options_.body_friction > 0.0 && !options_.self_contact)
-        throw Error(str("contact: friction between bodies (", options_.body_friction,
-                        ") needs self-contact on: without it no pair of the body's surface is held"));
-    if (!(std::isfinite(options_.pattern_reach) && options_.pattern_reach >= 0.0))
-        throw Error(str("contact: the reach of the anticipated Hessian pattern must be >= 0 (a multiple of d̂; 0: none), got ",
-                        options_.pattern_reach));
     if (!(std::isfinite(options_.doubling_distance) && options_.doubling_distance >= 0.0))
         throw Error(str("contact: the doubling distance must be >= 0, got ", options_.doubling_distance));
     surface_ = surface_primitives(body.mesh()).vertices;
     double mass = 0.0;
     for (int v : surface_)
         mass += body.dof_masses()[3 * v];
-    average_mass_ = mass / static_cast<double>(surface_.size());
-    diagonal_ = (rest_.colwise().maxCoeff() - rest_.colwise().minCoeff()).norm();
+    const double average_mass = mass / static_cast<double>(surface_.size());
+    const double diagonal = (rest_.colwise().maxCoeff() - rest_.colwise().minCoeff()).norm();
     stiffness_ = options_.stiffness;
-    stiffness_set_ = options_.stiffness > 0.0;
-    if (options_.check_intersections)
-        check_ = std::make_unique<IntersectionCheck>(body.mesh(), obstacles_, options_.self_contact);
-    if (options_.self_contact) {
-        self_ = std::make_unique<SelfContactBarrier>(body.mesh(), options_.activation_distance, options_.vertex_body,
-                                                     options_.body_self_contact);
-        const double at_rest =
-            self_->smallest_distance(Eigen::VectorXd::Zero(3 * rest_.rows()), options_.activation_distance);
-        if (at_rest < options_.activation_distance)
-            throw Error(str("contact: with self-contact, two surface primitives that share no vertex are ", at_rest,
-                            " m apart at rest, closer than d̂ = ", options_.activation_distance,
-                            " m: their barrier would push the body at rest; use a d̂ below ", at_rest, " m"));
-    }
+    if (options_.stiffness == 0.0)
+        adaptive_.emplace(average_mass, diagonal, options_.activation_distance, options_.doubling_distance);
 }
 
 Eigen::Vector3d ContactPotential::position(const Eigen::VectorXd& u, int vertex) const
@@ -112,12 +82,12 @@ Eigen::Vector3d ContactPotential::position(const Eigen::VectorXd& u, int vertex)
 
 double ContactPotential::smallest_distance(const Eigen::VectorXd& u) const
 {
-    double smallest = features_.smallest_distance(u, time_, options_.activation_distance);
+    double smallest = infinity;
+    for (const auto& term : terms_)
+        smallest = std::min(smallest, term->smallest_distance(u, time_, options_.activation_distance));
     for (int v : surface_)
         for (const auto& obstacle : obstacles_)
             smallest = std::min(smallest, obstacle->distance(position(u, v), time_));
-    if (self_)
-        smallest = std::min(smallest, self_->smallest_distance(u, options_.activation_distance));
     return smallest;
 }
 
@@ -136,14 +106,8 @@ bool ContactPotential::out_of_contact(const Eigen::VectorXd& u, double time, con
                 obstacle->time_of_impact(x, x_end - x - (end_time - time) * obstacle->velocity(), time) <= 1.0)
                 return false;
     }
-    // The obstacles' edges and corners against the body's edges and triangles, likewise.
-    const double near = std::min({features_.smallest_distance(u, time, reach), features_.smallest_distance(u, end_time, reach),
-                                  features_.smallest_distance(u_end, end_time, reach)});
-    if (!(near >= reach && features_.relative_time_of_impact(u, time, u_end, end_time) > 1.0))
-        return false;
-    // The body's surface against itself, likewise (it moves with neither obstacle).
-    return !self_ || (std::min(self_->smallest_distance(u, reach), self_->smallest_distance(u_end, reach)) >= reach &&
-                      self_->time_of_impact(u, u_end - u) > 1.0);
+    return std::all_of(terms_.begin(), terms_.end(),
+                       [&](const auto& term) { return term->out_of_contact(u, time, u_end, end_time, reach); });
 }
 
 void ContactPotential::begin_step(dynamics::Body& body, const dynamics::State& state, double time_step)
@@ -155,65 +119,39 @@ void ContactPotential::begin_step(dynamics::Body& body, const dynamics::State& s
     time_ = state.time + fraction_ * time_step;
     friction_step_ = options_.friction_velocity * time_step;
     // κ (after IPC): balanced at the first contact, doubled while the distance keeps falling below ε_d.
-    if (options_.stiffness == 0.0) {
-        const double low = smallest_stiffness(average_mass_, time_step, options_.activation_distance);
-        const double high = 100.0 * low;
-        const double smallest = smallest_distance(state.u);
-        if (!stiffness_set_) {
+    if (adaptive_)
+        stiffness_ = adaptive_->next(time_step, smallest_distance(state.u), [&] {
             stiffness_ = 1.0;
-            const Eigen::VectorXd unit_barrier = body.dofs().gather(-barrier_forces(state.u));
-            const Eigen::VectorXd load = body.dofs().gather(-state.forces - body.external_forces());
-            stiffness_ = std::clamp(balancing_stiffness(load, unit_barrier), low, high);
-            stiffness_set_ = unit_barrier.norm() > 0.0;
-        } else if (smallest < options_.doubling_distance * diagonal_ && smallest < last_smallest_) {
-            stiffness_ = std::min(high, 2.0 * stiffness_);
-        }
-        stiffness_ = std::clamp(stiffness_, low, high);
-        last_smallest_ = smallest;
-    }
+            return std::pair(body.dofs().gather(-state.forces - body.external_forces()),
+                             body.dofs().gather(-barrier_forces(state.u)));
+        });
     // The friction pairs, lagged at the step's start (IPC), or where lag_friction_at said.
     const bool at_start = lag_u_.size() == 0;
     const Eigen::VectorXd& lag = at_start ? state.u : lag_u_;
-    const double lag_time = at_start ? state.time : time_;
-    pairs_.clear();
-    for (int v : surface_)
-        for (int o = 0; o < static_cast<int>(obstacles_.size()); ++o) {
-            const Obstacle& obstacle = *obstacles_[static_cast<std::size_t>(o)];
-            if (obstacle.friction() == 0.0)
-                continue;
-            const Eigen::Vector3d x = position(lag, v);
-            const double d = obstacle.distance(x, lag_time);
-            if (!(d > 0.0 && d < options_.activation_distance))
-                continue;
-            FrictionPair pair;
-            pair.vertex = v;
-            pair.obstacle = o;
-            std::vector<DistancePiece> pieces;
-            obstacle.pieces(x, lag_time, options_.activation_distance, pieces);
-            for (const DistancePiece& piece : pieces)
-                pair.normal_force += stiffness_ * std::abs(barrier(piece.distance, options_.activation_distance).first);
-            pair.coefficient = obstacle.friction();
-            pair.tangent = tangent_basis(obstacle.gradient(x, lag_time));
-            pair.start = position(state.u, v) + time_step * obstacle.velocity();
-            pairs_.push_back(pair);
-        }
-    if (self_)
-        body_friction_.lag(options_.body_friction > 0.0 ? self_->pairs(lag, false) : std::vector<SurfacePair>{}, lag,
-                           state.u, stiffness_, options_.body_friction, options_.activation_distance);
-    if (self_)
-        self_->anticipate(state.u, time_step * state.v, options_.pattern_reach * options_.activation_distance);
+    pairs_ = obstacle_friction_pairs(obstacles_, rest_, surface_, lag, at_start ? state.time : time_, state.u, time_step,
+                                     stiffness_, options_.activation_distance);
+    for (const auto& term : terms_)
+        term->begin_step({state, lag, time_step, stiffness_});
     lag_u_.resize(0);
 }
 
 ContactClocks ContactPotential::clocks() const
 {
-    return {barrier_seconds_, collision_seconds_, self_ ? self_->broad_phases() - broad_phases_before_ : 0};
+    return {barrier_seconds_, collision_seconds_, broad_phases() - broad_phases_before_};
 }
 
 void ContactPotential::reset_clocks()
 {
     barrier_seconds_ = collision_seconds_ = 0.0;
-    broad_phases_before_ = self_ ? self_->broad_phases() : 0;
+    broad_phases_before_ = broad_phases();
+}
+
+long long ContactPotential::broad_phases() const
+{
+    long long count = 0;
+    for (const auto& term : terms_)
+        count += term->broad_phases();
+    return count;
 }
 
 void ContactPotential::lag_friction_at(const Eigen::VectorXd& u)
@@ -276,21 +214,27 @@ double ContactPotential::barrier_energy(const Eigen::VectorXd& u, double time) c
             for (const DistancePiece& piece : pieces)
                 total += stiffness_ * barrier(piece.distance, options_.activation_distance).value;
         }
-    total += features_.energy(u, time, stiffness_);
-    return self_ && std::isfinite(total) ? total + self_->energy(u, stiffness_) : total;
+    for (const auto& term : terms_) {
+        if (!std::isfinite(total))
+            break;
+        total += term->barrier_energy(u, time, stiffness_);
+    }
+    return total;
 }
 
 double ContactPotential::energy(const Eigen::VectorXd& u) const
 {
     const ScopeTimer clock(barrier_seconds_);
-    if (check_)
-        check_->require_none(rest_ + u.reshaped<Eigen::RowMajor>(rest_.rows(), 3), time_);
+    for (const auto& term : terms_)
+        term->check(u, time_);
     double total = barrier_energy(u, time_);
     if (!std::isfinite(total))
         return total;
     for (const FrictionPair& pair : pairs_)
         total += pair_friction(pair, u).value;
-    return total + body_friction_.energy(u, friction_step_);
+    for (const auto& term : terms_)
+        total += term->friction_energy(u, friction_step_);
+    return total;
 }
 
 Eigen::Vector3d ContactPotential::barrier_force(const Obstacle& obstacle, const Eigen::Vector3d& x) const
@@ -315,11 +259,10 @@ Eigen::VectorXd ContactPotential::barrier_forces(const Eigen::VectorXd& u) const
     for (int v : surface_)
         for (const auto& obstacle : obstacles_)
             forces.segment<3>(3 * v) += barrier_force(*obstacle, position(u, v));
-    Eigen::VectorXd feature_gradient = Eigen::VectorXd::Zero(u.size());
-    features_.add_gradient(u, time_, stiffness_, feature_gradient);
-    if (self_)
-        self_->add_gradient(u, stiffness_, feature_gradient);
-    return forces - feature_gradient;
+    Eigen::VectorXd term_gradient = Eigen::VectorXd::Zero(u.size());
+    for (const auto& term : terms_)
+        term->add_barrier_gradient(u, time_, stiffness_, term_gradient);
+    return forces - term_gradient;
 }
 
 Eigen::VectorXd ContactPotential::gradient(const Eigen::VectorXd& u) const
@@ -328,7 +271,8 @@ Eigen::VectorXd ContactPotential::gradient(const Eigen::VectorXd& u) const
     Eigen::VectorXd gradient = -barrier_forces(u);
     for (const FrictionPair& pair : pairs_)
         gradient.segment<3>(3 * pair.vertex) += pair_friction(pair, u).gradient;
-    body_friction_.add_gradient(u, friction_step_, gradient);
+    for (const auto& term : terms_)
+        term->add_friction_gradient(u, friction_step_, gradient);
     return gradient;
 }
 
@@ -344,7 +288,9 @@ double ContactPotential::obstacle_work(const Eigen::VectorXd& u, double time_ste
     }
     for (const FrictionPair& pair : pairs_)
         work -= obstacles_[static_cast<std::size_t>(pair.obstacle)]->velocity().dot(pair_friction(pair, u).gradient);
-    return time_step * (work + features_.obstacle_power(u, time_, stiffness_));
+    for (const auto& term : terms_)
+        work += term->obstacle_power(u, time_, stiffness_);
+    return time_step * work;
 }
 
 dynamics::SparseMatrix ContactPotential::hessian(const Eigen::VectorXd& u) const
@@ -390,14 +336,15 @@ dynamics::SparseMatrix ContactPotential::assembled_hessian(const Eigen::VectorXd
             for (int j = 0; j < 3; ++j)
                 triplets.emplace_back(3 * vertex + i, 3 * vertex + j, projected(i, j));
     }
-    features_.add_hessian(u, time_, stiffness_, triplets, projection);
-    if (self_)
-        self_->add_hessian(u, stiffness_, triplets, projection);
-    body_friction_.add_hessian(u, friction_step_, triplets);
+    for (const auto& term : terms_)
+        term->add_barrier_hessian(u, time_, stiffness_, triplets, projection);
+    for (const auto& term : terms_)
+        term->add_friction_hessian(u, friction_step_, triplets);
     dynamics::SparseMatrix H(u.size(), u.size());
     H.setFromTriplets(triplets.begin(), triplets.end());
-    if (self_ && self_->anticipated_pattern().nonZeros() > 0)
-        H += self_->anticipated_pattern();  // explicit zeros: the step's pattern, every value as it was
+    for (const auto& term : terms_)
+        if (const dynamics::SparseMatrix* pattern = term->pattern(); pattern != nullptr && pattern->nonZeros() > 0)
+            H += *pattern;  // explicit zeros: the step's pattern, every value as it was
     return H;
 }
 
@@ -412,8 +359,9 @@ double ContactPotential::largest_safe_step(const Eigen::VectorXd& u, const Eigen
         for (const auto& obstacle : obstacles_)
             step = std::min(step, options_.safety * obstacle->time_of_impact(position(u, v), change, time_));
     }
-    step = std::min(step, options_.safety * features_.time_of_impact(u, du, time_));
-    return self_ ? std::min(step, options_.safety * self_->time_of_impact(u, du)) : step;
+    for (const auto& term : terms_)
+        step = std::min(step, options_.safety * term->time_of_impact(u, du, time_, time_));
+    return step;
 }
 
 double ContactPotential::obstacle_advance(const Eigen::VectorXd& u, double time, double time_step, double from) const
@@ -427,7 +375,8 @@ double ContactPotential::obstacle_advance(const Eigen::VectorXd& u, double time,
         for (int v : surface_)
             earliest = std::min(earliest, obstacle->time_of_impact(position(u, v), travel, time + from * time_step));
     }
-    earliest = std::min(earliest, features_.relative_time_of_impact(u, time + from * time_step, u, time + time_step));
+    for (const auto& term : terms_)
+        earliest = std::min(earliest, term->obstacle_time_of_impact(u, time + from * time_step, time + time_step));
     return earliest > 1.0 ? 1.0 : from + options_.safety * earliest * (1.0 - from);
 }
 
@@ -476,10 +425,10 @@ Eigen::VectorXd ContactPotential::free_start(const dynamics::Body& body, const d
                                    obstacle.name(), ")");
                 }
             }
-            if (features_.relative_time_of_impact(state.u, state.time, state.u + time_step * v, obstacle_time) <= 1.0)
-                return "an obstacle's edge or corner meets the body's surface";
-            if (self_ && self_->time_of_impact(state.u, time_step * v) <= 1.0)
-                return "the body's surface meets itself";
+            const Eigen::VectorXd motion = time_step * v;
+            for (const auto& term : terms_)
+                if (term->time_of_impact(state.u, motion, state.time, obstacle_time) <= 1.0)
+                    return term->meeting();
             return {};
         }();
         if (reached.empty())

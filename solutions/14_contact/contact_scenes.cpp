@@ -56,7 +56,10 @@ BlockScene block_scene(const BlockSettings& settings)
     std::vector<std::shared_ptr<const Obstacle>> obstacles = settings.obstacles;
     if (obstacles.empty())
         obstacles.push_back(std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), settings.friction));
-    block.contact = std::make_unique<ContactPotential>(*block.body, obstacles, settings.contact);
+    std::vector<std::unique_ptr<ContactTerm>> terms;
+    if (settings.terms)
+        terms = settings.terms(*block.body, obstacles, settings.contact);
+    block.contact = std::make_unique<ContactPotential>(*block.body, obstacles, settings.contact, std::move(terms));
     block.integrator = std::make_unique<hyper::NewtonBackwardEuler>(settings.newton);
     block.integrator->set_potential(block.contact.get());
     block.stepper = std::make_unique<ContactStep>(*block.integrator, *block.contact, settings.friction_updates);
@@ -79,6 +82,11 @@ Eigen::Vector3d mean_velocity(const dynamics::Body& body, const Eigen::VectorXd&
 double lowest_height(const dynamics::Body& body, const Eigen::VectorXd& u)
 {
     return body.positions(u).col(2).minCoeff();
+}
+
+std::string time_step_label(double time_step)
+{
+    return str("1/", static_cast<int>(std::lround(1.0 / time_step)));
 }
 
 double slope_acceleration(double gravity, double slope, double friction)

@@ -1,6 +1,8 @@
 // The scenes capstone: a body's steps with obstacles. docs/scenes.md#obstacles
 #include "scenes/scene_contact.hpp"
 
+#include "15_body_contact/body_contact.hpp"
+
 #include "12_hyperelastic_newton/force_models.hpp"
 
 #include "common/error.hpp"
@@ -19,10 +21,10 @@ std::vector<std::shared_ptr<const contact::Obstacle>> scene_obstacles(const Scen
 
 namespace {
 
-contact::ContactOptions contact_options(const SceneSpec& scene, bool self_contact, std::vector<int> vertex_body,
-                                        std::vector<bool> self_contacts)
+contact::BodyContactOptions contact_options(const SceneSpec& scene, bool self_contact, std::vector<int> vertex_body,
+                                            std::vector<bool> self_contacts)
 {
-    contact::ContactOptions options;
+    contact::BodyContactOptions options;
     options.self_contact = self_contact;
     options.vertex_body = std::move(vertex_body);
     options.body_self_contact = std::move(self_contacts);
@@ -57,9 +59,9 @@ ContactIntegrator::ContactIntegrator(dynamics::Integrator& own, std::vector<Scen
     : own_(own),
       levels_(std::move(levels)),
       obstacles_(obstacles),
-      potential_(std::make_unique<contact::ContactPotential>(
+      potential_(std::make_unique<contact::ContactPotential>(contact::body_contact_potential(
           body, std::move(obstacles),
-          contact_options(scene, self_contact, std::move(vertex_body), std::move(self_contacts)))),
+          contact_options(scene, self_contact, std::move(vertex_body), std::move(self_contacts))))),
       newton_(contact_newton_options(scene, &solver_)),
       surface_(contact::surface_primitives(body.mesh())),
       rest_(body.mesh().V)
@@ -73,8 +75,8 @@ ContactPairs ContactIntegrator::pairs(const Eigen::VectorXd& u, double time) con
         throw Error(str("ContactIntegrator::pairs: u has ", u.size(), " entries, expected 3 x ", rest_.rows(),
                         " vertices"));
     ContactPairs counted;
-    if (const contact::SelfContactBarrier* self = potential_->self_barrier())
-        for (const contact::SurfacePair& pair : self->pairs(u, false))
+    if (const auto* bodies = potential_->term<contact::BodyContactTerm>())
+        for (const contact::SurfacePair& pair : bodies->barrier().pairs(u, false))
             ++(pair.kind == contact::PrimitivePair::point_triangle ? counted.point_triangle : counted.edge_edge);
     const double reach = potential_->options().activation_distance;
     for (int v : surface_.vertices) {

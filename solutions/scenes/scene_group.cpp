@@ -2,8 +2,8 @@
 // docs/scenes.md#bodies-against-bodies
 #include "scenes/scene_group.hpp"
 
-#include "14_contact/distances.hpp"
-#include "14_contact/intersections.hpp"
+#include "15_body_contact/distances.hpp"
+#include "15_body_contact/intersections.hpp"
 
 #include "13_skinning/skinning.hpp"
 

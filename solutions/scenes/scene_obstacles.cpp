@@ -3,7 +3,7 @@
 // start clear of them. docs/scenes.md#obstacles
 #include "scene_parts.hpp"
 
-#include "14_contact/mesh_obstacle.hpp"
+#include "15_body_contact/mesh_obstacle.hpp"
 
 #include "common/mesh_io.hpp"
 

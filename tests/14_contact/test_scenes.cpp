@@ -4,9 +4,9 @@
 // docs/14_contact.md#checks
 #include "14_contact/contact.hpp"
 #include "14_contact/contact_scenes.hpp"
-#include "14_contact/mesh_obstacle.hpp"
 #include "14_contact/obstacles.hpp"
-#include "contact_delegate.hpp"
+#include "fire_at.hpp"
+#include "one_thread.hpp"
 #include "rest_weight.hpp"
 #include "slope_creep.hpp"
 
@@ -30,24 +30,6 @@ using namespace fem;
 using namespace fem::contact;
 using fem::test::degree;
 
-namespace {
-
-/// A contact potential that records the smallest distance of every configuration the line search
-/// and the step start evaluate: none of them may be inside an obstacle.
-class WatchedContact final : public test::ContactDelegate {
-public:
-    using ContactDelegate::ContactDelegate;
-    double energy(const Eigen::VectorXd& u) const override
-    {
-        smallest = std::min(smallest, contact_.smallest_distance(u));
-        ++evaluations;
-        return contact_.energy(u);
-    }
-    mutable double smallest = std::numeric_limits<double>::infinity();
-    mutable int evaluations = 0;
-};
-
-}  // namespace
 
 TEST_CASE("a cube at rest on the floor: its contact forces sum to its weight at equilibrium, none below",
           "[ex14.2]")
@@ -174,69 +156,16 @@ TEST_CASE("a cube dropped from h lands at sqrt(2gh) within backward Euler's lag 
     CHECK(rebound <= h);
 }
 
-namespace {
-
-/// Fires the block at 100 m/s (100 × a drop's ~1 m/s: one step of 1/100 s would carry it 1 m) at
-/// the obstacle, 0.1 m below it, and watches every configuration Newton evaluates for 10 steps.
-/// Returns the lowest z of the block at the end.
-double fire_at(std::shared_ptr<const Obstacle> obstacle, double speed = 100.0)
-{
-    BlockSettings settings;
-    settings.height = 0.2;
-    settings.gravity = 0.0;
-    settings.newton.max_iterations = 500;
-    settings.obstacles = {std::move(obstacle)};
-    BlockScene block = block_scene(settings);
-    const ContactPotential& contact = *block.contact;
-    WatchedContact watched(*block.contact);
-    block.integrator->set_potential(&watched);
-    Eigen::VectorXd v = Eigen::VectorXd::Zero(block.state.u.size());
-    for (Eigen::Index i = 2; i < v.size(); i += 3)
-        v[i] = -speed;
-    block.state = dynamics::initial_state(*block.body, {}, v);
-    for (int step = 0; step < 10; ++step) {
-        block.step();
-        INFO("step " << step);
-        REQUIRE(contact.smallest_distance(block.state.u) > 0.0);
-    }
-    INFO(watched.evaluations << " evaluations");
-    CHECK(watched.smallest > 0.0);
-    CHECK(watched.smallest < settings.contact.activation_distance);  // it did reach the obstacle
-    return lowest_height(*block.body, block.state.u);
-}
-
-}  // namespace
 
 TEST_CASE("fired at the floor at 100 times a drop's speed, no vertex ever gets inside", "[ex14.2]")
 {
-    fire_at(std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ()));
+    test::fire_at(std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ()));
 }
 
 TEST_CASE("fired at a ball at 100 times a drop's speed, no vertex gets inside or jumps across", "[ex14.3]")
 {
     // Under the block's four lower corners; one unchecked step would carry them 1 m past it.
-    fire_at(std::make_shared<Sphere>(Eigen::Vector3d(0.05, 0.05, 0.0), 0.08));
-}
-
-TEST_CASE("fired at a triangle mesh at 100 times a drop's speed, no vertex gets through its sheet or onto it",
-          "[ex14.8]")
-{
-    // A tent: the square [-1, 1]² at z = 0 cut into four triangles at a raised apex (0.05, 0.05, 0.02)
-    // under the block's centre; the block's lower corners come down over two of its ridges (edge
-    // regions) and its faces (face regions). An open sheet: its distance is unsigned, nothing stops a
-    // vertex that jumps it but the conservative line search.
-    TriMesh tent;
-    tent.V.resize(5, 3);
-    tent.V << -1.0, -1.0, 0.0, 1.0, -1.0, 0.0, 1.0, 1.0, 0.0, -1.0, 1.0, 0.0, 0.05, 0.05, 0.02;
-    tent.F.resize(4, 3);
-    tent.F << 0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 4;
-    // Still above the sheet (z ≥ 0 everywhere under the block), on the side it came from: a vertex
-    // that had jumped it would be 80 cm below. The apex, held off the block's lower face by the
-    // obstacles' corner barrier, sits a few 10⁻⁷ m under it while the face slides over it: there
-    // the line search's time of impact rests on the coplanarity filter (coplanar_free_time), without
-    // which the inclusion test stops at its box cap and Newton's steps shrink to slivers (500
-    // iterations did not converge the impact step).
-    CHECK(fire_at(std::make_shared<MeshObstacle>(tent), 100.0) > 0.0);
+    test::fire_at(std::make_shared<Sphere>(Eigen::Vector3d(0.05, 0.05, 0.0), 0.08));
 }
 
 TEST_CASE("a conveyor floor (moving along x) drags a resting block up to its speed by friction", "[ex14.4]")

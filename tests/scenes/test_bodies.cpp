@@ -9,8 +9,8 @@
 #include "scenes/runner.hpp"
 #include "scenes/scene_group.hpp"
 
-#include "14_contact/broad_phase.hpp"
-#include "14_contact/intersections.hpp"
+#include "15_body_contact/broad_phase.hpp"
+#include "15_body_contact/intersections.hpp"
 
 #include "12_hyperelastic_newton/force_models.hpp"
 

@@ -7,8 +7,8 @@
 #include "scenes/runner.hpp"
 #include "scenes/scene_group.hpp"
 
-#include "14_contact/broad_phase.hpp"
-#include "14_contact/distances.hpp"
+#include "15_body_contact/broad_phase.hpp"
+#include "15_body_contact/distances.hpp"
 
 #include <catch2/catch.hpp>
 

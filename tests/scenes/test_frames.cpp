@@ -5,7 +5,7 @@
 #include "scenes/runner.hpp"
 #include "scenes/scene_text.hpp"
 
-#include "14_contact/mesh_obstacle.hpp"
+#include "15_body_contact/mesh_obstacle.hpp"
 
 #include "common/figures.hpp"
 #include "common/motion.hpp"
