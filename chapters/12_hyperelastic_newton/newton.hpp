@@ -54,6 +54,11 @@ struct NewtonOptions {
     /// test alone (the default). docs/14_contact.md#bodies-against-bodies-the-cost
     double step_tolerance = 0.0;
     bool line_search = true;           ///< false: plain Newton, α = 1 always (to show what it risks)
+    /// The volume filter of NewtonBackwardEuler's line search: its trials start at α ≤ the largest
+    /// step that keeps every tet's volume ≥ this fraction of its volume at the iterate
+    /// (largest_volume_keeping_step), so no accepted iterate turns a tet inside out, whatever the
+    /// material. In [0, 1); 0: off (and off without the line search). docs/12_hyperelastic_newton.md#the-volume-filter
+    double kept_volume = 0.1;
     HessianChoice hessian = HessianChoice::exact_then_definite;
     /// Inexact Newton: an iterative solver solves H d = −∇E only to the relative residual
     /// max(its own tolerance, min(forcing, ‖∇E‖/scale)) — loose far from the answer, tight near it,
@@ -228,7 +233,8 @@ Eigen::VectorXd solve_static(dynamics::Body& body, const NewtonOptions& options 
 class NewtonBackwardEuler final : public dynamics::Integrator {
 public:
     /// fem::Error for a tolerance outside (0, 1), a cap < 1, c outside (0, ½), shrink outside (0, 1),
-    /// a smallest step outside (0, 1), a step tolerance < 0 or not finite, or an unknown solver.
+    /// a smallest step outside (0, 1), a step tolerance < 0 or not finite, a kept volume outside
+    /// [0, 1), or an unknown solver.
     explicit NewtonBackwardEuler(NewtonOptions options = {});
 
     std::string name() const override { return "Newton backward Euler"; }
@@ -237,6 +243,11 @@ public:
     /// ‖∇E‖ ≤ tol · momentum_scale, the pinned dofs held at v = ṽ_p (Body::pin_velocity), so
     /// q⁺_p = qᵗ_p + Δt ṽ_p. With a potential: from the potential's start_velocity v₀, moved toward
     /// q̇ᵗ as far as its largest_safe_step allows, and the scale raised by Δt ‖∇P‖ at that start.
+    /// With options.kept_volume > 0 the start (moved from v = 0 or v₀ toward q̇ᵗ) and every line
+    /// search are also cut by the volume filter (largest_volume_keeping_step): a tet of positive
+    /// volume at qᵗ keeps a positive volume at every iterate, and a step the filter cuts at a tet
+    /// squeezed below collapsed_volume_ratio of its rest volume is refused (fem::Error naming the tet
+    /// and the material: one whose energy stays finite at det F = 0 cannot stop that impact).
     /// StepInfo::damping_work = Δt v⁺ᵀ D v⁺ (≥ 0) [J]; when the pins move,
     /// StepInfo::boundary_work = Δt ṽ_pᵀ r_p = ṽ_pᵀ ∇E(v⁺) (the reactions r_p = ∇E_p(v⁺)/Δt) [J]. fem::Error (state
     /// unchanged) when the cap is reached, the line search fails, or d is no descent direction (an

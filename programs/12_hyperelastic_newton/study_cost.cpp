@@ -4,6 +4,7 @@
 // (plain_routes.hpp) against ours on two bunnies, like for like, with HOBAK's figure beside it.
 // docs/12_hyperelastic_newton.md#cost
 #include "12_hyperelastic_newton/plain_routes.hpp"
+#include "12_hyperelastic_newton/volume_filter.hpp"
 #include "studies.hpp"
 
 #include "11_corotational/frozen_preconditioner.hpp"
@@ -19,6 +20,7 @@
 #include "common/parallel.hpp"
 #include "common/table.hpp"
 #include "common/timer.hpp"
+#include "common/vtk_io.hpp"
 
 #include <algorithm>
 #include <ctime>
@@ -196,7 +198,8 @@ void cost_study(const RunContext& run, const Settings& settings)
     Table parts("The parts of one Newton iteration at a sagging state",
                 {{"free dofs", Format::integer}, {"tets", Format::integer}, {"energy and forces [s]", Format::scientific, 2},
                  {"exact Hessian [s]", Format::scientific, 2}, {"projected Hessian [s]", Format::scientific, 2},
-                 {"step matrix [s]", Format::scientific, 2}, {"factor and solve [s]", Format::scientific, 2}});
+                 {"step matrix [s]", Format::scientific, 2}, {"factor and solve [s]", Format::scientific, 2},
+                 {"volume filter [s]", Format::scientific, 2}});
     for (int cells : settings.cost_cells) {
         dynamics::Scene scene = dynamics::cantilever_scene(dynamics::Material{1e6, 0.45, 1100.0}, cells, 1.0);
         dynamics::Body body(scene, make_force_model("neo-hookean", scene.mesh, scene.material));
@@ -221,7 +224,13 @@ void cost_study(const RunContext& run, const Settings& settings)
             solver->prepare(A);
             (void)solver->solve(b);
         }, settings.seconds);
-        parts.add_row({double(body.dofs().size()), double(scene.mesh.T.rows()), evaluate, exact, projected, matrix, solve});
+        // The line search's volume filter along the step's motion from qᵗ (Δt q̇ᵗ: a free step's, where it never binds).
+        const MatrixX3d x = body.positions(state.u), dx = io::vertex_rows(scene.time_step * state.v);
+        const double filter = best_time([&] {
+            (void)largest_volume_keeping_step(scene.mesh, x, dx, NewtonOptions{}.kept_volume);
+        }, settings.seconds);
+        parts.add_row({double(body.dofs().size()), double(scene.mesh.T.rows()), evaluate, exact, projected, matrix, solve,
+                       filter});
     }
     parts.print(std::cout);
     parts.write_csv(run.file("parts_table.csv"));

@@ -1,6 +1,11 @@
 #include "12_hyperelastic_newton/newton.hpp"
 
+#include "12_hyperelastic_newton/volume_filter.hpp"
+
+#include "04_tet_jacobians/tet_jacobians.hpp"
+
 #include "common/error.hpp"
+#include "common/vtk_io.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -126,28 +131,78 @@ NewtonBackwardEuler::NewtonBackwardEuler(NewtonOptions options)
         throw Error(str("Newton: the forcing term must lie in [0, 1), got ", options_.forcing));
     if (options_.max_iterations < 1)
         throw Error(str("Newton: the iteration cap must be >= 1, got ", options_.max_iterations));
+    if (!(options_.kept_volume >= 0.0 && options_.kept_volume < 1.0))
+        throw Error(str("Newton: the kept volume (the fraction of each tet's volume the line search keeps) must lie ",
+                        "in [0, 1) (0: no volume filter), got ", options_.kept_volume));
     if (!(options_.step_tolerance >= 0.0 && std::isfinite(options_.step_tolerance)))
         throw Error(str("Newton: the step tolerance must be a finite number >= 0 (0: off), got ", options_.step_tolerance));
 }
 
 namespace {
 
+/// The relative shifts τ newton_direction tries, in turn, when a definite Hessian H does not factor:
+/// H + τ diag(H), from above the direct solvers' pivot test (n ε |h_jj|) up to 1 %.
+constexpr double first_shift = 1e-12, last_shift = 1e-2;
+
 /// d with H d = −gradient for the exact or definite Hessian at x; slope = gradientᵀd. False if the
-/// exact Hessian is not positive definite or gives no descent direction.
+/// exact Hessian is not positive definite or gives no descent direction. A definite Hessian is
+/// positive semi-definite by construction (M + Δt² K_PSD + Δt² ∇²P_PSD, M positive definite), but a
+/// sum whose diagonal spans more than a double resolves (a barrier's κ b''(d) at d ≪ d̂ beside a
+/// vertex's mass) can fail a factorization's pivot test by round-off: it is then solved shifted,
+/// (H + τ diag(H)) d = −gradient for the first τ = first_shift, 100 first_shift, … that factors (a
+/// descent direction still: H + τ diag(H) is positive definite). fem::Error in the course's words,
+/// naming problem.what and the diagonal's span, when none up to last_shift does.
 bool newton_direction(const NewtonProblem& problem, cg::LinearSolver& solver, const Eigen::VectorXd& x, bool definite,
                       const Eigen::VectorXd& gradient, Eigen::VectorXd& direction, double& slope, int& iterations)
 {
+    const dynamics::SparseMatrix& hessian = problem.hessian(x, definite);
     try {
-        solver.prepare(problem.hessian(x, definite));
+        solver.prepare(hessian);
         direction = solver.solve(-gradient);
     } catch (const Error&) {
-        if (definite)
-            throw;  // a definite Hessian that fails to factor is a real error, not a choice
-        return false;
+        if (!definite)
+            return false;  // the exact Hessian is indefinite: the caller falls back to the definite one
+        const Eigen::VectorXd diagonal = hessian.diagonal();
+        bool solved = false;
+        for (double shift = first_shift; shift <= last_shift && !solved; shift *= 100.0) {
+            dynamics::SparseMatrix shifted = hessian;
+            for (Eigen::Index i = 0; i < diagonal.size(); ++i)
+                shifted.coeffRef(i, i) += shift * std::abs(diagonal[i]);
+            try {
+                solver.prepare(shifted);
+                direction = solver.solve(-gradient);
+                solved = true;
+            } catch (const Error&) {
+            }
+        }
+        if (!solved)
+            throw Error(str("Newton: ", problem.what, ": the system of the Newton step (mass, stiffness and the ",
+                            "extra potential's Hessian, each made positive semi-definite) could not be solved, even with ",
+                            "its diagonal raised by ", 100.0 * last_shift, " %: its diagonal runs from ",
+                            diagonal.cwiseAbs().minCoeff(), " to ", diagonal.cwiseAbs().maxCoeff(),
+                            ", or holds a value that is not finite; the scene's stiffness (Young's modulus, the ",
+                            "contact's kappa) is beyond what its masses resolve in one step: use a smaller dt"));
     }
     iterations += solver.stats().iterations;
     slope = gradient.dot(direction);
     return slope < 0.0;
+}
+
+/// fem::Error when tet, the one the volume filter cuts a step at, is squeezed at positions x (#V×3)
+/// below collapsed_volume_ratio of its rest volume: its material cannot stop the step (what: the step).
+void refuse_collapsing_tet(const dynamics::Body& body, const MatrixX3d& x, int tet, const std::string& what)
+{
+    const TetMesh& mesh = body.mesh();
+    const double ratio = tet::signed_volume(tet::tet_vertices(mesh, x, tet)) /
+                         tet::signed_volume(tet::tet_vertices(mesh, mesh.V, tet));
+    if (ratio >= collapsed_volume_ratio)
+        return;
+    throw Error(str("Newton: ", what, ": tet ", tet, " is squeezed to ", ratio, " of its rest volume and the step ",
+                    "pushes it further, toward inside out (the line search's volume filter keeps every tet's volume ",
+                    "positive, so the step is refused here): the material ", body.model().name(),
+                    (body.model().name() == "neo-hookean" ? "" : ", whose energy stays finite as a tet flattens,"),
+                    " cannot stop this impact or squeeze; use the material neo-hookean, whose energy grows without ",
+                    "bound as det F -> 0, or slower bodies"));
 }
 
 }  // namespace
@@ -314,9 +369,22 @@ dynamics::StepInfo NewtonBackwardEuler::step(dynamics::Body& body, double time_s
             gradient += time_step * potential_->gradient(state.u + time_step * v);
         return Eigen::VectorXd(dofs.gather(gradient));
     };
-    if (potential_ != nullptr)
+    // The first trial along d: the volume filter's largest step (every tet keeps kept_volume of its
+    // volume; a part of the line search, so plain Newton goes without), cut by the potential's
+    // continuous collision check.
+    const bool volume_filter = options_.line_search && options_.kept_volume > 0.0;
+    if (potential_ != nullptr || volume_filter)
         problem.largest_step = [&](const Eigen::VectorXd& x, const Eigen::VectorXd& d) {
-            return potential_->largest_safe_step(state.u + time_step * full(x), full_change(d));
+            const Eigen::VectorXd u = state.u + time_step * full(x), du = full_change(d);
+            double alpha = 1.0;
+            if (volume_filter) {
+                int tet = -1;
+                const MatrixX3d x_tets = body.positions(u);
+                alpha = largest_volume_keeping_step(body.mesh(), x_tets, io::vertex_rows(du), options_.kept_volume, &tet);
+                if (tet >= 0)
+                    refuse_collapsing_tet(body, x_tets, tet, problem.what);
+            }
+            return potential_ != nullptr ? std::min(alpha, potential_->largest_safe_step(u, du)) : alpha;
         };
     // H = M + Δt D + Δt² K = (1 + Δt α) M + Δt² (K + (β/Δt) K_t), in the fixed pattern.
     const dynamics::Damping& coefficients = damping.coefficients();
@@ -346,7 +414,8 @@ dynamics::StepInfo NewtonBackwardEuler::step(dynamics::Body& body, double time_s
     // tet inverted by qᵗ + Δt q̇ᵗ); then v = 0, which keeps qᵗ, where E is finite.
     // With a potential the start is the potential's start velocity (v = 0 unless a moving obstacle
     // needs another), moved toward that last velocity as far as the potential allows (its continuous
-    // collision check: no vertex passes through an obstacle on the way there).
+    // collision check: no vertex passes through an obstacle on the way there); with the volume
+    // filter, moved from there only as far as every tet keeps kept_volume of its volume.
     Eigen::VectorXd start = dofs.gather(state.v);
     Eigen::VectorXd fallback = Eigen::VectorXd::Zero(start.size());
     if (potential_ != nullptr) {
@@ -354,8 +423,9 @@ dynamics::StepInfo NewtonBackwardEuler::step(dynamics::Body& body, double time_s
         if (!std::isfinite(problem.objective(fallback, nullptr)))
             throw Error(str("Newton: ", problem.what, ": the energy is infinite at the start velocity the potential ",
                             "gives (the body's elastic energy there, or the potential's)"));
-        start = fallback + std::min(1.0, problem.largest_step(fallback, start - fallback)) * (start - fallback);
     }
+    if (problem.largest_step)
+        start = fallback + std::min(1.0, problem.largest_step(fallback, start - fallback)) * (start - fallback);
     if (!std::isfinite(problem.objective(start, nullptr)))
         start = fallback;
     // A potential's force is one more load of the step (an obstacle pushing a body at rest).

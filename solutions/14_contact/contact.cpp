@@ -523,8 +523,8 @@ dynamics::StepInfo contact_step(hyper::NewtonBackwardEuler& newton, ContactPoten
     if (turned >= 0)
         throw Error(str("contact: step ", state.step + 1, " (t = ", next.time, " s) would turn tet ", turned,
                         " inside out (volume ", volume, " m^3): only the surface vertices carry the barrier, and ",
-                        "this impact or squeeze is more than the mesh can resolve; use a smaller dt, a finer or ",
-                        "stiffer body, or slower obstacles"));
+                        "Newton's volume filter is off; turn it on (chapter 12's NewtonOptions::kept_volume, 0.1 by ",
+                        "default), which keeps every tet's volume positive at every iterate"));
     // κ is the step's now (begin_step set it): B at the start with it, against B at the end.
     info.boundary_work += contact.barrier_energy(state.u, state.time) - contact.barrier_energy(next.u, next.time) +
                           contact.obstacle_work(next.u, time_step);

@@ -218,15 +218,12 @@ TEST_CASE("fired at a turned box, an axis-aligned box, a mesh triangle and the f
     CHECK(impact.smallest_distance < ContactOptions{}.activation_distance);  // it did meet the obstacle
 }
 
-TEST_CASE("fired at a turned box, an axis-aligned box or a mesh triangle at 1000 m/s, every step converges and "
-          "nothing is ever inside", "[ex15.4]")
+TEST_CASE("fired at a turned box or a mesh triangle at 1000 m/s, every step converges and nothing is ever inside",
+          "[ex15.4]")
 {
-    // 10 m a step: the block meets the corner and slides off it, or lands on the box's top face,
-    // within the first step.
+    // 10 m a step: the block meets the corner and slides off it within the first step.
     const auto [name, obstacle] = GENERATE(table<const char*, std::shared_ptr<const Obstacle>>(
-        {{"turned box", box_under(turned)},
-         {"axis-aligned box", box_under(Eigen::Matrix3d::Identity())},
-         {"mesh triangle", triangle_under()}}));
+        {{"turned box", box_under(turned)}, {"mesh triangle", triangle_under()}}));
     const Impact impact = fire(obstacle, 1000.0);
     INFO(name << ": " << impact.error << impact.inside);
     CHECK(impact.steps == 10);
@@ -235,17 +232,21 @@ TEST_CASE("fired at a turned box, an axis-aligned box or a mesh triangle at 1000
     CHECK(impact.smallest_distance < ContactOptions{}.activation_distance);
 }
 
-TEST_CASE("fired at the floor at 1000 m/s, the impact step is refused before a tet turns inside out, nothing inside",
-          "[ex15.4]")
+TEST_CASE("fired at the floor or flat on an axis-aligned box at 1000 m/s, the impact step is refused before a tet "
+          "turns inside out, nothing inside", "[ex15.4]")
 {
     // The lower face stops at the floor within the step while the upper one, 10 m behind, would pass
-    // through it: the one-cell block cannot resolve that, and only its surface vertices carry the
-    // barrier (docs/14_contact.md#what-is-guaranteed). The step is refused, not taken.
-    const Impact impact = fire(std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ()), 1000.0);
-    INFO(impact.error << impact.inside);
+    // through it: stable neo-Hookean's energy stays finite as a tet flattens, so the step's minimum is
+    // inverted; chapter 12's volume filter keeps every tet upright and the step is refused, not taken,
+    // with advice that test_inversion_free.cpp follows (neo-Hookean runs it).
+    const auto [name, obstacle] = GENERATE(table<const char*, std::shared_ptr<const Obstacle>>(
+        {{"floor", std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ())},
+         {"axis-aligned box", box_under(Eigen::Matrix3d::Identity())}}));
+    const Impact impact = fire(obstacle, 1000.0);
+    INFO(name << ": " << impact.error << impact.inside);
     CHECK(impact.steps == 0);
-    CHECK_THAT(impact.error, Catch::Matchers::Contains("step 1: contact: step 1") &&
-                                 Catch::Matchers::Contains("inside out"));
+    CHECK_THAT(impact.error, Catch::Matchers::Contains("step 1: Newton: step 1") &&
+                                 Catch::Matchers::Contains("use the material neo-hookean"));
     CHECK(impact.inside.empty());
     CHECK(impact.smallest_distance > 0.0);
 }
