@@ -51,7 +51,7 @@ struct NewtonOptions {
     /// Also converged when the Newton direction d is this small: ‖d‖∞ ≤ step_tolerance (x's units;
     /// for a step, a velocity: a fraction of d̂ / Δt bounds every vertex's last move), after taking
     /// its step, beside the gradient's test (IPC's test on the step's length). 0: the gradient's
-    /// test alone (the default). docs/14_contact.md#bodies-against-bodies-the-cost
+    /// test alone (the default). docs/15_body_contact.md#the-cost-of-contact
     double step_tolerance = 0.0;
     bool line_search = true;           ///< false: plain Newton, α = 1 always (to show what it risks)
     /// The volume filter of NewtonBackwardEuler's line search: its trials start at α ≤ the largest
