@@ -22,8 +22,6 @@
 
 #include "studies.hpp"
 
-#include "09_conjugate_gradient/linear_solver.hpp"
-
 #include "common/cli.hpp"
 #include "common/error.hpp"
 #include "common/parallel.hpp"

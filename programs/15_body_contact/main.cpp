@@ -33,10 +33,9 @@
 #include "studies.hpp"
 #include "study_ccd.hpp"
 
-#include "09_conjugate_gradient/linear_solver.hpp"
-
 #include "common/cli.hpp"
 #include "common/error.hpp"
+#include "common/parallel.hpp"
 
 using namespace fem;
 using namespace fem::contact;
@@ -70,7 +69,7 @@ int main(int argc, char** argv)
             settings.mesh_queries = 2000;
             settings.grid_spacings = {0.01};
         }
-        cg::set_blas_threads(1);
+        set_blas_threads(1);
         study::mesh_study(run, settings);
         study::ccd_study(run, study::ccd_benchmark_files());
         study::self_contact_study(run);
