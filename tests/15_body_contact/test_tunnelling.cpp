@@ -173,14 +173,13 @@ TEST_CASE("two cubes thrown head-on at 20 and 50 m/s with steps of 1/10000 s mee
     }
 }
 
-// Hidden: it fails today, and shows why. At Δt = 1/400 s (a relative travel of 10 and 25 cm a step
-// against cubes 10 cm wide) the cubes end on each other's far side, with no crossing on any segment
-// of the path and no intersection at any iterate, so the CCD, its candidates and the referee are
-// right. Two causes:
-// - stable neo-Hookean (finite energy at J ≤ 0): the iterates turn up to 46 of the 96 tets inside
-//   out, and the cubes pass through each other's turned tets without their surfaces crossing (also at
-//   Δt = 1/10000 s: 24 tets turned, no bounce). A line-search filter on every tet's volume (issue 48,
-//   item 2) removes it.
+// Hidden, and no exercise's (the grading runs every tagged test): it fails today, and shows a limit
+// docs/15_body_contact.md#what-is-guaranteed states. At Δt = 1/400 s (a relative travel of 10 and
+// 25 cm a step against cubes 10 cm wide) no segment of the path crosses and no iterate intersects,
+// so the CCD, its candidates and the referee are right, yet the step does not bounce the cubes:
+// - stable neo-Hookean (finite energy at J ≤ 0): before chapter 12's volume filter its iterates
+//   turned up to 46 of the 96 tets inside out and the cubes passed through each other's turned tets;
+//   with the filter the step is refused, advising neo-Hookean (an exception here).
 // - neo-Hookean (no tet ever turned): the step's minimum is the free flight xᵗ + Δt vᵗ, already clear
 //   of the other cube at 50 m/s, and Newton reaches it along an intersection-free path that flattens
 //   the cubes and slides them past each other (their centres 7.7 cm apart across, at 20 m/s in 2
@@ -188,7 +187,7 @@ TEST_CASE("two cubes thrown head-on at 20 and 50 m/s with steps of 1/10000 s mee
 //   path of the iterates is not the motion. At Δt = 1/10000 s (the test above) they bounce.
 TEST_CASE("two cubes thrown head-on at 20 and 50 m/s with steps of 1/400 s meet and bounce, with either "
           "neo-Hookean model",
-          "[.][self][ex15.5]")
+          "[.][self]")
 {
     for (const char* material : {"neo-hookean", "stable-neo-hookean"})
         for (double speed : {20.0, 50.0}) {
