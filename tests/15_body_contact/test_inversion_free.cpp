@@ -216,7 +216,7 @@ ThrownBodies block_over_plate(double speed)
 }  // namespace
 
 TEST_CASE("a block meeting a free plate one tet thick at 2 m/s runs: Newton's system never fails in the "
-          "factorization's words", "[ex15.5]")
+          "factorization's words", "[ex15.5][slow]")
 {
     // At Δt = 1/1000 s the block's free flight ends exactly on the plate: the barrier's Hessian at a
     // distance far below d̂ beside the plate's vertex masses made the definite system fail chapter 08's

@@ -163,7 +163,7 @@ Thrown throw_cubes(const std::string& material, double speed, double time_step, 
 
 TEST_CASE("two cubes thrown head-on at 20 and 50 m/s with steps of 1/10000 s meet and bounce: no crossing on "
           "any iterate's segment, no tet turned, momentum kept",
-          "[self][ex15.5]")
+          "[self][ex15.5][slow]")
 {
     for (double speed : {20.0, 50.0}) {
         const Thrown thrown = throw_cubes("neo-hookean", speed, 1e-4, 100);
