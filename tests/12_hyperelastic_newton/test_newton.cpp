@@ -14,6 +14,7 @@
 #include "common/vtk_io.hpp"
 
 #include "../common/test_support.hpp"
+#include "pinned_cube.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -36,23 +37,11 @@ using fem::test::EntriesNear;
 using fem::test::entries_of;
 using Catch::Matchers::Contains;
 
-namespace {
-
-dynamics::Scene cube_scene(double youngs, double poisson)
-{
-    dynamics::Scene scene;
-    scene.mesh = box_mesh(2, 2, 2, Eigen::Vector3d(0.1, 0.1, 0.1));
-    scene.material = {youngs, poisson, 1000.0};
-    scene.pinned = assembly::vertices_on_plane(scene.mesh, 2, 0.0);
-    scene.time_step = 1.0 / 30.0;
-    return scene;
-}
-
-}  // namespace
+using fem::test::pinned_cube;
 
 TEST_CASE("the backward Euler objective: its terms, and its minimum at chapter 10's step for a linear body", "[ex12.7]")
 {
-    dynamics::Scene scene = cube_scene(1e5, 0.3);
+    dynamics::Scene scene = pinned_cube(1e5, 0.3);
     dynamics::Body body(scene);
     dynamics::State state = dynamics::initial_state(body);
     state.v = 0.1 * fem::random_vector(state.v.size(), 21).cwiseProduct(body.dofs().free_mask());
@@ -77,7 +66,7 @@ TEST_CASE("the backward Euler objective: its terms, and its minimum at chapter 1
 
 TEST_CASE("the backward Euler gradient: the objective's by finite differences, zero at chapter 10's step", "[ex12.8]")
 {
-    dynamics::Scene scene = cube_scene(1e5, 0.3);
+    dynamics::Scene scene = pinned_cube(1e5, 0.3);
     dynamics::Body body(scene);
     dynamics::State state = dynamics::initial_state(body);
     const double dt = scene.time_step;
@@ -97,7 +86,7 @@ TEST_CASE("the backward Euler gradient: the objective's by finite differences, z
 
 TEST_CASE("Newton backward Euler: one iteration and chapter 10's step for a linear body", "[ex12.9]")
 {
-    dynamics::Scene scene = cube_scene(1e5, 0.3);
+    dynamics::Scene scene = pinned_cube(1e5, 0.3);
     dynamics::Body newton_body(scene), theta_body(scene);
     NewtonBackwardEuler newton;
     dynamics::ThetaMethod theta(1.0);
@@ -286,7 +275,7 @@ TEST_CASE("the line search where E's differences are round-off: the slopes decid
 TEST_CASE("Newton backward Euler: the gradient and Hessian of E by finite differences, quadratic convergence",
           "[ex12.9]")
 {
-    dynamics::Scene scene = cube_scene(1e5, 0.4);
+    dynamics::Scene scene = pinned_cube(1e5, 0.4);
     scene.gravity = Eigen::Vector3d(0.0, 0.0, -200.0);  // a large sag: a nonlinear step
     dynamics::Body body(scene, std::make_unique<HyperelasticElasticity>(scene.mesh, make_material("neo-hookean", 1e5, 0.4)));
     const dynamics::State state = dynamics::initial_state(body);
@@ -332,7 +321,7 @@ TEST_CASE("Newton backward Euler: the line search keeps neo-Hookean tets uninver
 {
     // A soft cube pinned at its base, its top slammed down at 40 m/s: one step of 1/24 s would move
     // the top by sixteen times the cube's height.
-    dynamics::Scene scene = cube_scene(1e5, 0.4);
+    dynamics::Scene scene = pinned_cube(1e5, 0.4);
     scene.gravity.setZero();
     scene.time_step = 1.0 / 24.0;
     Eigen::VectorXd v0 = Eigen::VectorXd::Zero(3 * scene.mesh.V.rows());
@@ -390,7 +379,7 @@ TEST_CASE("a vibration that dies out without gravity: Newton converges every ste
     // A stretched cube released without gravity: backward Euler's damping shrinks the motion by a
     // constant factor a step, so u and v pass 1e-154 (where norms' squares underflow) after some
     // 900 steps. The relative test cannot hold there; smallest_measurable_norm ends the iteration.
-    dynamics::Scene scene = cube_scene(1e5, 0.45);
+    dynamics::Scene scene = pinned_cube(1e5, 0.45);
     scene.gravity.setZero();
     scene.time_step = 1.0 / 60.0;
     Eigen::VectorXd u0 = Eigen::VectorXd::Zero(3 * scene.mesh.V.rows());

@@ -15,6 +15,8 @@
 #include "common/mesh.hpp"
 #include "common/random.hpp"
 
+#include "pinned_cube.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <Eigen/SparseCore>
@@ -137,12 +139,8 @@ TEST_CASE("Newton backward Euler with the volume filter: stable neo-Hookean keep
     // A soft cube of 2³ cells pinned at its base, its top slammed down at 40 m/s: one step of 1/24 s
     // would move the top by sixteen times the cube's height. Stable neo-Hookean is finite at J ≤ 0,
     // so without the filter nothing stops Newton's iterates from turning tets inside out.
-    dynamics::Scene scene;
-    scene.mesh = box_mesh(2, 2, 2, Eigen::Vector3d(0.1, 0.1, 0.1));
-    scene.material = {1e5, 0.4, 1000.0};
+    dynamics::Scene scene = test::pinned_cube(1e5, 0.4, 1.0 / 24.0);
     scene.gravity.setZero();
-    scene.pinned = assembly::vertices_on_plane(scene.mesh, 2, 0.0);
-    scene.time_step = 1.0 / 24.0;
     Eigen::VectorXd v0 = Eigen::VectorXd::Zero(3 * scene.mesh.V.rows());
     for (Eigen::Index v = 0; v < scene.mesh.V.rows(); ++v)
         v0[3 * v + 2] = -400.0 * scene.mesh.V(v, 2);
