@@ -129,7 +129,7 @@ private:
     /// Whether triangle f's piece at p, of closest point q, is left out: q lies on (within same_point_,
     /// or, where flat triangles meet at a small angle, 2 flat_mesh_edge_sine |p − q|) an edge of f
     /// shared with a flat neighbour g, or at a corner of f whose flat fan holds g, and g's closest
-    /// point to p is nearer (|p − q_g| < |p − q|), or the same point or as near and g < f. known: the
+    /// point to p is nearer (|p − q_g| < |p − q|), or as near and g < f. known: the
     /// closest points to p already computed (triangle, point); g's is taken from there when it is.
     bool shadowed(int f, const Eigen::Vector3d& closest, const Eigen::Vector3d& p,
                   const std::vector<std::pair<int, TrianglePoint>>& known) const;
@@ -143,7 +143,7 @@ private:
     /// Per triangle f and corner k, at 3f + k: the other triangles of the corner's flat fan, those
     /// reached from f by turning about the corner across flat edges.
     std::vector<std::vector<int>> flat_fan_;
-    double same_point_ = 0.0;  // two closest points this near are one [m]: 10⁻⁷ of the mesh's box diagonal
+    double same_point_ = 0.0;  // a closest point this near an edge or corner is on it [m]: 10⁻⁷ of the mesh's box diagonal
 };
 
 /// The unsigned distance of a mesh obstacle sampled at the nodes of a regular grid (spacing h at
