@@ -121,7 +121,9 @@ double conservative_time_of_impact(const Obstacle& obstacle, const Eigen::Vector
 /// slope): d = n·(x − p), ∇d = n, ∇²d = 0; time of impact d/(−n·dx) when n·dx < 0.
 class HalfSpace final : public Obstacle {
 public:
-    /// fem::Error for a zero or non-finite normal (it is normalised) or a non-finite point.
+    /// fem::Error for a zero or non-finite normal (it is normalised, of any finite size) or a
+    /// non-finite point. The plane is kept by its point nearest the origin, (n·p) n, so that a point
+    /// given far along the plane costs no digits of d.
     HalfSpace(const Eigen::Vector3d& point, const Eigen::Vector3d& normal, double friction = 0.0,
               const Eigen::Vector3d& velocity = Eigen::Vector3d::Zero());
     std::string name() const override { return "half-space"; }

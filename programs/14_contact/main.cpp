@@ -31,19 +31,25 @@
 using namespace fem;
 using namespace fem::contact;
 
+/// A fixed κ must be at least this many W/d̂ (W: the block's weight).
+constexpr double smallest_barrier_hold = 1e-4;
+
 int main(int argc, char** argv)
 {
     ChapterCli cli("ch14_contact", "14_contact",
                    "Chapter 14: contact with obstacles: the IPC barrier, the collision-free line search, friction");
     study::Settings settings;
-    cli.app.add_option("--dhat", settings.activation_distances, "Activation distances d̂ [m] swept")
-        ->check(check::real(0.0, 0.1, check::Ends::open_closed))->capture_default_str();
-    cli.app.add_option("--kappa", settings.stiffnesses, "Barrier stiffnesses kappa [N/m] swept (0: adaptive)")
+    cli.app.add_option("--dhat", settings.activation_distances,
+                       "Activation distances d̂ [m] swept (from 1e-5: below, Newton stalls at the drop's 1e-7 tolerance)")
+        ->check(check::real(1e-5, 0.1, check::Ends::closed))->capture_default_str();
+    cli.app.add_option("--kappa", settings.stiffnesses,
+                       "Barrier stiffnesses kappa [N/m] swept (0: adaptive; else at least 1e-4 W / d̂, W = the block's weight)")
         ->check(check::real(0.0, 1e9, check::Ends::closed))->capture_default_str();
     cli.app.add_option("--dt", settings.time_steps, "Time steps [s] swept")
         ->check(check::real(0.0, 0.05, check::Ends::open_closed))->capture_default_str();
-    cli.app.add_option("--tolerance", settings.tolerances, "Newton's relative tolerances swept")
-        ->check(check::real(0.0, 0.1, check::Ends::open_closed))->capture_default_str();
+    cli.app.add_option("--tolerance", settings.tolerances,
+                       "Newton's relative tolerances swept (from 1e-7: below, round-off of the barrier's gradient)")
+        ->check(check::real(1e-7, 0.1, check::Ends::closed))->capture_default_str();
     cli.app.add_option("--friction-updates", settings.friction_updates,
                        "Lagged friction updates per step swept on the slope (1: IPC's one lag; 0: until converged)")
         ->check(check::integer(0, 20))->capture_default_str();
@@ -58,6 +64,16 @@ int main(int argc, char** argv)
                 if (cli.app.count(swept) > 0)
                     throw Error(str(swept, ": --quick runs its one fixed configuration and would ignore it; ",
                                     "leave out --quick or ", swept));
+        // A fixed κ must hold the block up at a resolvable distance: a vertex carrying its share of
+        // the weight W sinks to about κ d̂² / W, and where κ d̂ < 1e-4 W (κ = 1e-3 N/m at d̂ = 1e-3 m,
+        // 20 N/m at 1e-5 m) Newton stalled in the sweep of --dt.
+        const double weight = study::block_weight();
+        const double smallest_dhat = *std::min_element(settings.activation_distances.begin(), settings.activation_distances.end());
+        for (double kappa : settings.stiffnesses)
+            if (kappa > 0.0 && kappa * smallest_dhat < smallest_barrier_hold * weight)
+                throw Error(str("--kappa: ", kappa, " N/m with --dhat ", smallest_dhat, " m holds the block's weight W = ",
+                                weight, " N too weakly: a fixed kappa must be 0 (adaptive) or at least ",
+                                smallest_barrier_hold, " W / d̂ = ", smallest_barrier_hold * weight / smallest_dhat, " N/m"));
         // The sweep's work, before any of it is done: a tiny --dt would otherwise run for days.
         if (cli.app.count("--quick") == 0 && study::swept_steps(settings) > study::most_swept_steps)
             throw Error(str("--dt: the drop and slope studies would take ", study::swept_steps(settings),

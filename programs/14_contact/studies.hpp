@@ -36,6 +36,8 @@ double swept_steps(const Settings& settings);
 inline constexpr double most_swept_steps = 1e6;
 /// The block settings of one case.
 BlockSettings block_settings(const Case& c);
+/// The studies' block's weight ρ a³ g [N] (BlockSettings' cube).
+double block_weight();
 
 void drop_study(const RunContext& run, const Settings& settings);
 void slope_study(const RunContext& run, const Settings& settings);

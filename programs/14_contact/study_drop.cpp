@@ -78,6 +78,12 @@ BlockSettings block_settings(const Case& c)
     return block;
 }
 
+double block_weight()
+{
+    const BlockSettings block;
+    return block.material.density * std::pow(block.edge, 3) * block.gravity;
+}
+
 void drop_study(const RunContext& run, const Settings& settings)
 {
     std::cout << "\n== 1. The drop: a 0.1 m cube falls " << settings.drop_height << " m onto the floor\n\n";

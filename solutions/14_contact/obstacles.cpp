@@ -55,13 +55,18 @@ void Obstacle::local_pieces(const Eigen::Vector3d& p, double reach, std::vector<
 
 HalfSpace::HalfSpace(const Eigen::Vector3d& point, const Eigen::Vector3d& normal, double friction,
                      const Eigen::Vector3d& velocity)
-    : Obstacle(velocity, friction), point_(point)
+    : Obstacle(velocity, friction)
 {
     require_finite_point(point, "point of the plane");
     require_finite_point(normal, "normal of the plane");
-    if (!(normal.norm() > 0.0))
+    const double largest = normal.cwiseAbs().maxCoeff();  // scaled first: |n|² of [1e308, 1e308, 0] overflows
+    if (!(largest > 0.0))
         throw Error("half-space: the normal of the plane must not be zero");
-    normal_ = normal.normalized();
+    normal_ = (normal / largest).normalized();
+    // The plane's point nearest the origin, (n·p) n: d = n·(x − p) with a point far along the plane
+    // (p = (0, 10⁹, −10⁹) for the plane y + z = 0) lost x's digits in x − p, and Newton stalled on
+    // a distance that moved in steps of 10⁻⁷ m; from this point only the plane's offset is rounded.
+    point_ = normal_.dot(point) * normal_;
 }
 
 double HalfSpace::local_distance(const Eigen::Vector3d& p) const

@@ -288,6 +288,7 @@ void read_obstacles(const Fields& top, SceneSpec& scene)
         const std::string name = str("obstacle[", i, "]");
         scene.obstacles.push_back(
             read_obstacle(table_in_array(top, *list.get(i), "obstacle"), name, top.source(), scene.file));
+        check_obstacle_scale(top, *list.get(i), name, scene);
         check_bodies_clear(top, *list.get(i), name, scene);
     }
     if (scene.integrator != "backward-euler") {

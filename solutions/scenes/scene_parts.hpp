@@ -27,11 +27,34 @@ Motion read_motion(const Fields& fields, double duration);
 ObstacleSpec read_obstacle(const toml::table& table, const std::string& name, const Source& source,
                            const std::filesystem::path& scene_file);
 
+/// An obstacle may reach this many d̂ from the origin, its motion over the run included: a double
+/// resolves a position there to 2·10⁻⁸ d̂, about the barrier's own round-off; a sphere of radius
+/// 10⁶ m against a 10 cm block (d̂ = 10⁻³ m) stalled Newton at step 8, one of 10⁵ m ran.
+inline constexpr double obstacle_reach_limit = 1e8;
+
+/// A body's vertex may start this many d̂ from a solid obstacle at the least: closer, the barrier's
+/// curvature ~ κ d̂²/d² leaves a double's range (a block 10⁻¹⁰⁰ m above the floor: its Newton step
+/// could not be solved; 10⁻²⁰ m ran).
+inline constexpr double closest_start = 1e-8;
+
+/// Refuses an obstacle (scene.obstacles.back(), read from node, called name) that moves farther
+/// than obstacle_reach_limit d̂ in the run (at its velocity field) or reaches farther than that from
+/// the origin (at its field of the largest magnitude). docs/scenes.md#obstacles
+void check_obstacle_scale(const Fields& top, const toml::node& node, const std::string& name, const SceneSpec& scene);
+
 /// Refuses a scene whose bodies start inside its last obstacle (scene.obstacles.back(), read from
 /// node, called name): no vertex may start inside, where its barrier energy would be infinite. A
 /// mesh's distance is unsigned (no inside): a body must start beyond d̂ of it, and no edge of its
 /// tets may pass through a triangle (a body through a sheet may have every vertex far from it).
+/// A solid must start at least closest_start d̂ from every vertex, no surface edge of a body may
+/// pass through it, no edge of a box or a mesh through a body's surface triangle, and no obstacle
+/// may lie inside a body; and a body meeting obstacles may not be of model linear (at its
+/// material.model field). Each refusal names the body, its vertex, edge, triangle or tet.
 void check_bodies_clear(const Fields& top, const toml::node& node, const std::string& name, const SceneSpec& scene);
+
+/// Refuses a mesh obstacle of this many triangles when its memory (bytes_per_obstacle_triangle each,
+/// scene_memory.cpp) with the bodies' and obstacles' before it passes the scene's budget: at field key.
+void check_obstacle_memory(const Fields& fields, const toml::node& node, const std::string& key, long long triangles);
 
 /// Refuses a body whose run would need more memory than the scene may use (see memory_estimate),
 /// the bodies read before it included: the error is at field, the field to change.

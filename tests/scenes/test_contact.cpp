@@ -194,10 +194,18 @@ TEST_CASE("an obstacle no vertex comes near adds nothing: the run is the free ru
         CHECK((with.frames[0][k].array() == without.frames[0][k].array()).all());
 }
 
-TEST_CASE("a linear body cannot meet obstacles: the run refuses it before any step", "[scenes][contact]")
+TEST_CASE("a linear body cannot meet obstacles: the reader refuses it at its model field, the run (--model linear) "
+          "before any step", "[scenes][contact]")
 {
-    const SceneSpec scene = read_scene(drop_scene("drop_linear"), {"body.material.model=\"linear\""});
-    CHECK_THROWS_WITH(run_positions(scene), Catch::Contains("model linear cannot meet obstacles"));
+    CHECK_THROWS_WITH(read_scene(drop_scene("drop_linear"), {"body.material.model=\"linear\""}),
+                      Catch::Contains("drop_linear.toml: --set body.material.model=\"linear\": body[0].material.model: "
+                                      "model linear cannot meet obstacles"));
+    std::ofstream(output / "drop_linear_in_file.toml")
+        << "[[body]]\nmesh = { generator = \"box\", cells = [1, 1, 1], translate = [0.0, 0.0, 0.02] }\n"
+           "material = { model = \"linear\", youngs_modulus = 1e5, poisson_ratio = 0.3, density = 1000.0 }\n"
+           "[[obstacle]]\ntype = \"half-space\"\n[time]\nstep = 0.01\nduration = 0.1\n";
+    CHECK_THROWS_WITH(read_scene(output / "drop_linear_in_file.toml"),
+                      Catch::Contains("drop_linear_in_file.toml:3:22:") && Catch::Contains("body[0].material.model: model linear"));
     CHECK_THROWS_WITH(run_positions(read_scene(drop_scene("drop_linear_option")), "linear"),
                       Catch::Contains("model linear cannot meet obstacles"));
 }
