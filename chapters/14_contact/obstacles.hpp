@@ -33,6 +33,9 @@ struct DistancePiece {
 struct ObstacleFeatures {
     Eigen::MatrixX3d corners;
     Eigen::MatrixX2i edges;
+    /// The rounding: the obstacle is the points within radius of its corners and edges [m] (a
+    /// sphere's core is its centre, a capsule's its segment: Obstacle::local_core); 0 for sharp ones.
+    double radius = 0.0;
 };
 
 /// A rigid obstacle. The body's vertices are kept at d > 0 by chapter 14's barrier.
@@ -66,6 +69,11 @@ public:
 
     /// Its corners and edges at the rest placement (ObstacleFeatures; default: none, a smooth shape).
     virtual ObstacleFeatures local_features() const { return {}; }
+    /// A rounded obstacle's core at the rest placement: the points and segments it is the points
+    /// within ObstacleFeatures::radius of (a sphere: its centre; a capsule: its segment), so that
+    /// chapter 15's FeatureBarrier holds it off the body's triangles and edges, not only its
+    /// vertices (docs/15_body_contact.md#edges-and-corners-of-obstacles); default: none.
+    virtual ObstacleFeatures local_core() const { return {}; }
 
     /// The triangles it is drawn as at the rest placement (V #V×3 [m], F #F×3): a solid's surface, a
     /// mesh's own triangles. A half-space has no edge: it is drawn as the square of its plane under
@@ -153,6 +161,8 @@ public:
     double local_time_of_impact(const Eigen::Vector3d& p, const Eigen::Vector3d& dp) const override;
     /// A triangulated ball (swept_ball_surface(c, c, r)).
     TriMesh local_surface(const std::array<double, 6>& around) const override;
+    /// Its centre, radius r.
+    ObstacleFeatures local_core() const override;
 
 private:
     Eigen::Vector3d centre_;
@@ -207,6 +217,9 @@ public:
     double local_time_of_impact(const Eigen::Vector3d& p, const Eigen::Vector3d& dp) const override;
     /// A triangulated tube with a half ball at each end (swept_ball_surface(a, b, r)).
     TriMesh local_surface(const std::array<double, 6>& around) const override;
+
+    /// Its segment (two corners, one edge), radius r.
+    ObstacleFeatures local_core() const override;
 
 private:
     /// The closest point of the segment to p.

@@ -14,7 +14,11 @@
 // being smooth: a body edge lying along a box edge is then held by its vertices' barrier). The
 // obstacle is kinematic: only the body's coordinates of a pair are unknowns, so a pair's gradient
 // is the body's part of the 12 (6 for an edge, 9 for a triangle) and its Hessian that block,
-// projected to PSD per pair. Obstacles with no sharp feature (a half-space, a sphere) add nothing.
+// projected to PSD per pair. A rounded obstacle — a sphere, a point with a radius r, or a capsule, a
+// segment with one (Obstacle::local_core) — is its core's corners and edges with every pair's
+// distance d − r (its barrier b(d − r), the chain rule through √: rounded() in the .cpp, and the
+// time of impact by additive conservative advancement on d − r), so that it is held off the body's
+// faces and edges, not only its vertices. A half-space adds nothing.
 
 #include "14_contact/obstacles.hpp"
 
@@ -75,6 +79,7 @@ public:
 private:
     struct Features {
         std::shared_ptr<const Obstacle> obstacle;
+        double radius = 0.0;        // a rounded core's (Obstacle::local_core): pairs measure d − radius
         Eigen::MatrixX3d vertices;  // rest placement
         Eigen::MatrixX2i edges;
         skin::BoxHierarchy vertex_tree, edge_tree;

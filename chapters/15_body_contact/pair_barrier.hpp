@@ -39,8 +39,10 @@ PrimitiveFunction unit_mollifier();
 /// step is below 10⁻³ of s (at most 100 times), with g = d(0)/10, it answers an s at which the
 /// distance is still ≥ g > 0: a lower bound of the time of impact of motion, one that a step can be
 /// cut to without coming nearer than a tenth of the distance it started at; +∞ when s passes 1 or
-/// nothing moves relative to the other. docs/15_body_contact.md#edges-and-corners-of-obstacles
-double additive_time_of_impact(PrimitivePair pair, const PrimitiveMotion& motion);
+/// nothing moves relative to the other. With radius r > 0 the same for d − r, the gap of a rounded
+/// pair (a sphere's centre or a capsule's segment against the body), 0 when d(0) ≤ r.
+/// docs/15_body_contact.md#edges-and-corners-of-obstacles
+double additive_time_of_impact(PrimitivePair pair, const PrimitiveMotion& motion, double radius = 0.0);
 
 /// The most boxes inclusion_ccd evaluates for one pair inside a line search (line_search_time_of_impact).
 inline constexpr long long line_search_ccd_boxes = 4000;

@@ -57,13 +57,18 @@ void Obstacle::local_pieces(const Eigen::Vector3d& p, double reach, std::vector<
 
 HalfSpace::HalfSpace(const Eigen::Vector3d& point, const Eigen::Vector3d& normal, double friction,
                      const Eigen::Vector3d& velocity)
-    : Obstacle(velocity, friction), point_(point)
+    : Obstacle(velocity, friction)
 {
     require_finite_point(point, "point of the plane");
     require_finite_point(normal, "normal of the plane");
-    if (!(normal.norm() > 0.0))
+    const double largest = normal.cwiseAbs().maxCoeff();  // scaled first: |n|² of [1e308, 1e308, 0] overflows
+    if (!(largest > 0.0))
         throw Error("half-space: the normal of the plane must not be zero");
-    normal_ = normal.normalized();
+    normal_ = (normal / largest).normalized();
+    // The plane's point nearest the origin, (n·p) n: d = n·(x − p) with a point far along the plane
+    // (p = (0, 10⁹, −10⁹) for the plane y + z = 0) lost x's digits in x − p, and Newton stalled on
+    // a distance that moved in steps of 10⁻⁷ m; from this point only the plane's offset is rounded.
+    point_ = normal_.dot(point) * normal_;
 }
 
 double HalfSpace::local_distance(const Eigen::Vector3d& p) const
@@ -395,6 +400,25 @@ TriMesh swept_ball_surface(const Eigen::Vector3d& a, const Eigen::Vector3d& b, d
             surface.F.row(row++) << p, q + segments, q;
         }
     return surface;
+}
+
+ObstacleFeatures Sphere::local_core() const
+{
+    ObstacleFeatures core;
+    core.corners = centre_.transpose();
+    core.radius = radius_;
+    return core;
+}
+
+ObstacleFeatures Capsule::local_core() const
+{
+    ObstacleFeatures core;
+    core.corners.resize(2, 3);
+    core.corners << start_.transpose(), end_.transpose();
+    core.edges.resize(1, 2);
+    core.edges << 0, 1;
+    core.radius = radius_;
+    return core;
 }
 
 }  // namespace fem::contact

@@ -288,12 +288,15 @@ bool MeshObstacle::shadowed(int f, const Eigen::Vector3d& closest, const Eigen::
                 return point.point;
         return closest_on(other, p).point;
     };
-    const auto beats = [&](int other) {  // a nearer point of other, or as near (the same point) and a lower number
-        const Eigen::Vector3d point = point_of(other);
-        const double other_distance = (p - point).norm();
-        if ((point - closest).norm() <= same_point_ || other_distance == distance)
-            return other < f;
-        return other_distance < distance;
+    // A nearer point of other, or as near and a lower number: a strict order by (distance, number),
+    // so that the piece kept is the nearest of its flat neighbourhood and the sum is its minimum's
+    // barrier, continuous. (Two points that nearly coincide are still ranked by distance: over a
+    // shared edge, the face piece of the triangle p stands over is nearer than the neighbour's edge
+    // piece by δ²/2d at a lateral offset δ, and preferring the edge piece there by number put a
+    // step of that size in the energy at δ = same_point_, where Newton's line search stalled.)
+    const auto beats = [&](int other) {
+        const double other_distance = (p - point_of(other)).norm();
+        return other_distance < distance || (other_distance == distance && other < f);
     };
     // The neighbours compared: across the flat edges q lies on and in the flat fans of the corners q
     // is at. An edge or vertex piece's q lies there exactly; a face piece's q is matched in a plane

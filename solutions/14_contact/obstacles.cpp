@@ -408,4 +408,23 @@ TriMesh swept_ball_surface(const Eigen::Vector3d& a, const Eigen::Vector3d& b, d
     return surface;
 }
 
+ObstacleFeatures Sphere::local_core() const
+{
+    ObstacleFeatures core;
+    core.corners = centre_.transpose();
+    core.radius = radius_;
+    return core;
+}
+
+ObstacleFeatures Capsule::local_core() const
+{
+    ObstacleFeatures core;
+    core.corners.resize(2, 3);
+    core.corners << start_.transpose(), end_.transpose();
+    core.edges.resize(1, 2);
+    core.edges << 0, 1;
+    core.radius = radius_;
+    return core;
+}
+
 }  // namespace fem::contact

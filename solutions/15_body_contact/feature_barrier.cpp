@@ -44,6 +44,19 @@ std::vector<BoundingBox> boxes_of(const Eigen::MatrixX3d& points, const Eigen::M
     return boxes;
 }
 
+/// A rounded pair's squared gap (√s − r)² from its squared distance s (r > 0, √s > r), with its
+/// derivatives by the chain rule: with q = √s, ∇ = (1 − r/q) ∇s, ∇² = (1 − r/q) ∇²s + r/(2q³) ∇s ∇sᵀ.
+PrimitiveFunction rounded(const PrimitiveFunction& squared, double radius)
+{
+    const double q = std::sqrt(squared.value);
+    PrimitiveFunction gap;
+    gap.value = (q - radius) * (q - radius);
+    gap.gradient = (1.0 - radius / q) * squared.gradient;
+    gap.hessian = (1.0 - radius / q) * squared.hessian +
+                  (radius / (2.0 * q * q * q)) * squared.gradient * squared.gradient.transpose();
+    return gap;
+}
+
 }  // namespace
 
 FeatureBarrier::FeatureBarrier(const TetMesh& mesh, const std::vector<std::shared_ptr<const Obstacle>>& obstacles,
@@ -53,9 +66,12 @@ FeatureBarrier::FeatureBarrier(const TetMesh& mesh, const std::vector<std::share
     for (const auto& obstacle : obstacles) {
         ObstacleFeatures features = obstacle->local_features();
         if (features.corners.rows() == 0)
+            features = obstacle->local_core();  // a sphere's centre, a capsule's segment, with their radius
+        if (features.corners.rows() == 0)
             continue;
         Features entry;
         entry.obstacle = obstacle;
+        entry.radius = features.radius;
         entry.vertices = std::move(features.corners);
         entry.edges = std::move(features.edges);
         entry.vertex_boxes = boxes_of(entry.vertices, Eigen::MatrixX2i());
@@ -78,9 +94,21 @@ bool FeatureBarrier::for_each_pair(const Eigen::VectorXd& u, double time, double
                                    Visit visit) const
 {
     const auto x = [&](int v) -> Eigen::Vector3d { return rest_.row(v).transpose() + u.segment<3>(3 * v); };
-    const Eigen::Vector3d grow = Eigen::Vector3d::Constant(reach);
     for (int o = 0; o < static_cast<int>(obstacles_.size()); ++o) {
         const Features& features = obstacles_[static_cast<std::size_t>(o)];
+        const double radius = features.radius;
+        const Eigen::Vector3d grow = Eigen::Vector3d::Constant(reach + radius);
+        // A pair's squared gap (d − r)² [m²] and its derivatives; false when it touches (d ≤ r).
+        const auto gap_of = [&](const PrimitiveFunction& squared, PrimitiveFunction& gap) {
+            if (radius == 0.0) {
+                gap = squared;
+                return squared.value > 0.0;
+            }
+            if (!(squared.value > radius * radius))
+                return false;
+            gap = rounded(squared, radius);
+            return true;
+        };
         const Eigen::Vector3d shift = time * features.obstacle->velocity();
         const auto corner = [&](int c) -> Eigen::Vector3d { return features.vertices.row(c).transpose() + shift; };
         // The body's surface edges against the obstacle's edges.
@@ -95,11 +123,14 @@ bool FeatureBarrier::for_each_pair(const Eigen::VectorXd& u, double time, double
                     const int c0 = features.edges(k, 0), c1 = features.edges(k, 1);
                     const Eigen::Vector3d b0 = corner(c0), b1 = corner(c1);
                     const EdgeEdgeType type = edge_edge_type(a0, a1, b0, b1);
-                    const PrimitiveFunction squared = edge_edge_squared_distance(a0, a1, b0, b1, type);
+                    const PrimitiveFunction distance = edge_edge_squared_distance(a0, a1, b0, b1, type);
+                    if (!(distance.value < (reach + radius) * (reach + radius)))
+                        continue;
+                    PrimitiveFunction squared;
+                    if (!gap_of(distance, squared))
+                        return false;
                     if (!(squared.value < reach * reach))
                         continue;
-                    if (!(squared.value > 0.0))
-                        return false;
                     const double threshold = edge_edge_mollifier_threshold(
                         rest_.row(i).transpose(), rest_.row(j).transpose(), features.vertices.row(c0).transpose(),
                         features.vertices.row(c1).transpose());
@@ -128,12 +159,15 @@ bool FeatureBarrier::for_each_pair(const Eigen::VectorXd& u, double time, double
             for (int k : skin::boxes_meeting(features.vertex_tree, features.vertex_boxes, low - shift - grow,
                                              high - shift + grow)) {
                 const Eigen::Vector3d p = corner(k);
-                const PrimitiveFunction squared =
+                const PrimitiveFunction distance =
                     point_triangle_squared_distance(p, a, b, c, point_triangle_type(p, a, b, c));
+                if (!(distance.value < (reach + radius) * (reach + radius)))
+                    continue;
+                PrimitiveFunction squared;
+                if (!gap_of(distance, squared))
+                    return false;
                 if (!(squared.value < reach * reach))
                     continue;
-                if (!(squared.value > 0.0))
-                    return false;
                 const PrimitiveFunction f =
                     mollified_barrier(squared, unit_mollifier(), activation_distance_, with_derivatives);
                 Pair pair;
@@ -229,17 +263,20 @@ double FeatureBarrier::earliest_impact(const MatrixX3d& x0, const MatrixX3d& x1,
         const auto start = [&](int v) -> Eigen::Vector3d { return x0.row(v).transpose(); };
         const auto end = [&](int v) -> Eigen::Vector3d { return x1.row(v).transpose() - back; };
         const auto corner = [&](int c) -> Eigen::Vector3d { return features.vertices.row(c).transpose() + at; };
+        const Eigen::Vector3d round = Eigen::Vector3d::Constant(features.radius);  // a rounded core's reach
         PrimitiveMotion motion;
         if (features.edges.rows() > 0)
             for (Eigen::Index e = 0; e < edges_.rows(); ++e) {
                 const int i = edges_(e, 0), j = edges_(e, 1);
                 const Eigen::Vector3d low = start(i).cwiseMin(start(j)).cwiseMin(end(i)).cwiseMin(end(j));
                 const Eigen::Vector3d high = start(i).cwiseMax(start(j)).cwiseMax(end(i)).cwiseMax(end(j));
-                for (int k : skin::boxes_meeting(features.edge_tree, features.edge_boxes, low - at, high - at)) {
+                for (int k : skin::boxes_meeting(features.edge_tree, features.edge_boxes, low - at - round, high - at + round)) {
                     const Eigen::Vector3d b0 = corner(features.edges(k, 0)), b1 = corner(features.edges(k, 1));
                     motion.start << start(i), start(j), b0, b1;
                     motion.end << end(i), end(j), b0, b1;
-                    earliest = std::min(earliest, line_search_time_of_impact(PrimitivePair::edge_edge, motion));
+                    earliest = std::min(earliest, features.radius > 0.0
+                                                      ? additive_time_of_impact(PrimitivePair::edge_edge, motion, features.radius)
+                                                      : line_search_time_of_impact(PrimitivePair::edge_edge, motion));
                 }
             }
         for (Eigen::Index t = 0; t < triangles_.rows(); ++t) {
@@ -248,11 +285,13 @@ double FeatureBarrier::earliest_impact(const MatrixX3d& x0, const MatrixX3d& x1,
                 start(a).cwiseMin(start(b)).cwiseMin(start(c)).cwiseMin(end(a)).cwiseMin(end(b)).cwiseMin(end(c));
             const Eigen::Vector3d high =
                 start(a).cwiseMax(start(b)).cwiseMax(start(c)).cwiseMax(end(a)).cwiseMax(end(b)).cwiseMax(end(c));
-            for (int k : skin::boxes_meeting(features.vertex_tree, features.vertex_boxes, low - at, high - at)) {
+            for (int k : skin::boxes_meeting(features.vertex_tree, features.vertex_boxes, low - at - round, high - at + round)) {
                 const Eigen::Vector3d p = corner(k);
                 motion.start << p, start(a), start(b), start(c);
                 motion.end << p, end(a), end(b), end(c);
-                earliest = std::min(earliest, line_search_time_of_impact(PrimitivePair::point_triangle, motion));
+                earliest = std::min(earliest, features.radius > 0.0
+                                                  ? additive_time_of_impact(PrimitivePair::point_triangle, motion, features.radius)
+                                                  : line_search_time_of_impact(PrimitivePair::point_triangle, motion));
             }
         }
     }

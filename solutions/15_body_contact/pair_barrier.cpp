@@ -71,7 +71,7 @@ PrimitiveFunction unit_mollifier()
     return one;
 }
 
-double additive_time_of_impact(PrimitivePair kind, const PrimitiveMotion& motion)
+double additive_time_of_impact(PrimitivePair kind, const PrimitiveMotion& motion, double radius)
 {
     Eigen::Matrix<double, 3, 4> change = motion.end - motion.start;
     change.colwise() -= change.rowwise().mean();
@@ -82,12 +82,15 @@ double additive_time_of_impact(PrimitivePair kind, const PrimitiveMotion& motion
         move = std::max(move, change.col(i).norm());
     }
     const double bound = first_move + second_move;
-    const double gap = 0.1 * std::sqrt(squared_distance_at(kind, motion, 0.0));
+    const double start = std::sqrt(squared_distance_at(kind, motion, 0.0)) - radius;
+    if (!(start > 0.0))
+        return 0.0;  // a rounded pair already touching (radius 0: d(0) > 0 is the caller's)
+    const double gap = 0.1 * start;
     if (bound == 0.0)
         return infinity;
     double s = 0.0;
     for (int advance = 0; advance < 100; ++advance) {
-        const double step = (std::sqrt(squared_distance_at(kind, motion, s)) - gap) / bound;
+        const double step = (std::sqrt(squared_distance_at(kind, motion, s)) - radius - gap) / bound;
         if (step <= 0.0)
             return s;
         s += step;
