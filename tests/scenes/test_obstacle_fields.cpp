@@ -3,7 +3,10 @@
 // and chapter 14's own refusals are each refused by the reader at the scene's line and column,
 // naming the field, the body and its primitives and what is allowed; directions and angles of any
 // magnitude are read as the directions they are. docs/scenes.md#obstacles
+#include "scenes/runner.hpp"
 #include "scenes/scene_text.hpp"
+
+#include "14_contact/surface.hpp"
 
 #include "common/error.hpp"
 
@@ -11,6 +14,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -164,5 +168,33 @@ TEST_CASE("obstacle fields: a mesh obstacle whose triangles need more memory tha
     ReadLimits enough;
     enough.memory = 30'000'000;
     CHECK_NOTHROW(read_scene(output / "red_memory.toml", {}, false, enough));
+}
+
+TEST_CASE("obstacle fields: a 2 x 2 x 2 block fired at 6 m/s at a 5 cm sphere keeps every point of its surface "
+          "outside it, every frame", "[scenes][contact]")
+{
+    const SceneSpec scene = scene_from(
+        "red_sphere_hit",
+        "gravity = [0.0, 0.0, 0.0]\n[[body]]\nname = \"block\"\n"
+        "mesh = { generator = \"box\", size = [0.2, 0.2, 0.2], cells = [2, 2, 2], translate = [-0.05, -0.05, 0.01] }\n"
+        "material = { model = \"auto\", youngs_modulus = 1e5, poisson_ratio = 0.4, density = 1000.0 }\n"
+        "initial_velocity = [0.0, 0.0, -6.0]\n"
+        "[[obstacle]]\ntype = \"sphere\"\ncenter = [0.0, 0.0, -0.05]\nradius = 0.05\n"
+        "[time]\nstep = 0.01\nduration = 0.1\n[output]\nframe_rate = 100\n");
+    const RunResult run = run_positions(scene);
+    const contact::SurfacePrimitives surface = contact::surface_primitives(scene.bodies[0].mesh);
+    const contact::Obstacle& sphere = *scene.obstacles[0].obstacle;
+    double smallest = INFINITY;
+    for (const MatrixX3d& x : run.frames[0])
+        for (Eigen::Index t = 0; t < surface.triangles.rows(); ++t) {
+            const Eigen::Vector3d a = x.row(surface.triangles(t, 0)), b = x.row(surface.triangles(t, 1)),
+                                  c = x.row(surface.triangles(t, 2));
+            for (int i = 0; i <= 20; ++i)
+                for (int j = 0; i + j <= 20; ++j)
+                    smallest = std::min(smallest, sphere.distance(a + (b - a) * i / 20.0 + (c - a) * j / 20.0, 0.0));
+        }
+    INFO("the smallest gap of a sampled surface point over " << run.frames[0].size() << " frames: " << smallest << " m");
+    CHECK(run.frames[0].size() == 11);
+    CHECK(smallest > 0.0);  // by the vertices alone the sphere was 2.4 cm inside the face
 }
 
