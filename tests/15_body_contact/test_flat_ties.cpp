@@ -58,7 +58,8 @@ std::pair<double, int> tie_barrier(const Obstacle& obstacle, const Eigen::Vector
 }
 
 /// The floors every tie is tried on: the plate and the grid, each as made, inverted, and written
-/// to and read back from an .obj and an .stl (STL's corners merged again by the reader).
+/// to and read back from an .obj and an .stl (STL's corners merged again by the reader); the plate
+/// as one quad of an .obj.
 std::vector<std::pair<std::string, TriMesh>> floors()
 {
     std::vector<std::pair<std::string, TriMesh>> all;
@@ -74,6 +75,9 @@ std::vector<std::pair<std::string, TriMesh>> floors()
             all.emplace_back(name + extension, io::read_tri_mesh(file));
         }
     }
+    // The plate as one quad, which the reader splits into two triangles.
+    std::ofstream(folder / "plate_quad.obj") << "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3 4\n";
+    all.emplace_back("plate as a quad", io::read_tri_mesh(folder / "plate_quad.obj"));
     return all;
 }
 
