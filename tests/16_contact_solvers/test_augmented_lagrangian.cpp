@@ -57,7 +57,7 @@ Eigen::Vector3d momentum_change(const dynamics::Body& body, const dynamics::Stat
 }  // namespace
 
 TEST_CASE("augmented Lagrangian potential: gradient and Hessian against central differences, every kind of pair",
-          "[ch16]")
+          "[ex16.2]")
 {
     // Two cubes, the upper one turned about z and shifted (point–triangle and edge–edge pairs between
     // them), the lower one 0.5 δ above the floor (vertex–obstacle pairs) or above the turned box's
@@ -122,7 +122,7 @@ TEST_CASE("augmented Lagrangian potential: gradient and Hessian against central 
 }
 
 TEST_CASE("a block at rest on the floor: the multipliers carry its weight to 1e-3, every step's momentum balance "
-          "holds, nothing crosses", "[ex16.1]")
+          "holds, nothing crosses", "[ex16.3]")
 {
     // Placed 0.5 δ above the floor (inside δ: the constraints act from the first step), at rest.
     SolverScene resting = drop_scene(0.5e-3, 100);
@@ -148,7 +148,7 @@ TEST_CASE("a block at rest on the floor: the multipliers carry its weight to 1e-
     CHECK(run.largest_violation <= AugmentedLagrangianOptions{}.violation_tolerance * 1e-3);
 }
 
-TEST_CASE("the stack of three: the force through each interface against the weight above to 1e-3", "[ex16.2]")
+TEST_CASE("the stack of three: the force through each interface against the weight above to 1e-3", "[ex16.3]")
 {
     const SolverScene stack = stack_scene(1e-3, 100);
     double errors[2] = {0.0, 0.0};
@@ -171,7 +171,7 @@ TEST_CASE("the stack of three: the force through each interface against the weig
     CHECK(run.smallest_distance > 0.0);
 }
 
-TEST_CASE("two blocks thrown at each other, spinning: momentum kept to round-off, never an intersection", "[ex16.2]")
+TEST_CASE("two blocks thrown at each other, spinning: momentum kept to round-off, never an intersection", "[ex16.3]")
 {
     const SolverScene two = two_bodies_scene(box_mesh(2, 2, 2, Eigen::Vector3d::Constant(0.1)), 0.1, 5e-3, 0.5, 5.0, 12);
     const SolverRun run = run_scene(two, ContactSolver::augmented_lagrangian, {}, true);
