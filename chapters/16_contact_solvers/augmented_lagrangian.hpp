@@ -16,11 +16,13 @@
 // then updates λ_k ← max(0, λ_k − μ g_k) (augmented_multiplier). ψ is C¹ in g, convex, and its
 // slope −max(0, λ − μg) is the pair's contact force along ∇g: at a fixed point of the update
 // either λ = 0 and g ≥ 0 or g = 0 and λ > 0 — the KKT conditions of the constrained step.
-// The pairs k (the active set): every surface vertex against every obstacle, every point–triangle
-// and edge–edge pair of the body's surface (chapter 15), that the step's CCD finds — along the
-// step's predicted motion xᵗ → xᵗ + Δt vᵗ + Δt² g at its start, along each Newton direction the CCD
-// cuts, and within 2δ of each outer iterate — added at once with λ = 0; a filter drops a pair with
-// λ = 0 and g above filter_gap · δ, and a pair idle (λ = 0) for stale_steps steps decays away.
+// The pairs k (the active set): a surface vertex against an obstacle, an obstacle's corner against
+// a surface triangle and its edge against a surface edge, and, with self-contact, the point–triangle
+// and edge–edge pairs of the body's surface (chapter 15's distances) — those the step's CCD finds
+// along the step's predicted motion xᵗ → xᵗ + Δt vᵗ + Δt² g at its start (added at once, λ = 0),
+// along each Newton direction the CCD cuts, and within 2δ of each inner solution; a filter drops a
+// pair with λ = 0 and g above filter_gap · δ, and a pair idle (λ = 0) for stale_steps steps in a row
+// decays away. docs/16_contact_solvers.md#the-active-set
 
 #include "15_body_contact/body_contact.hpp"
 
@@ -87,12 +89,13 @@ std::string describe(const ContactConstraint& constraint);
 struct AugmentedLagrangianOptions {
     double gap = 1e-3;            ///< δ [m]: the constraint d ≥ δ (IPC's d̂, so that both keep bodies as far apart)
     /// μ's scale: at a step's start μ = max(penalty_scale × m̄ / Δt², 8 T / δ²) (m̄ the mean vertex
-    /// mass, T = ½ vᵗᵀ M vᵗ the kinetic energy): the penalty's Hessian Δt² μ ∇g∇gᵀ at least
-    /// penalty_scale × a vertex's mass block, and its energy at a violation of δ/2, (μ/2)(δ/2)², at
-    /// least T, so that an impact is held within δ by the first solve.
+    /// mass, T = Σ ½ m_v |v_vᵗ|² over the vertices of the active pairs once the predicted motion's
+    /// pairs have joined): the penalty's Hessian Δt² μ ∇g∇gᵀ at least penalty_scale × a vertex's
+    /// mass block, and its energy at a violation of δ/2, (μ/2)(δ/2)², at least T, so that an impact
+    /// is held within δ by the first solve.
     double penalty_scale = 100.0;
-    /// Whether μ takes the kinetic energy's bound 8 T / δ² (else penalty_scale's alone: the
-    /// alternative the study measures, docs/16_contact_solvers.md#the-penalty).
+    /// Whether μ takes the kinetic bound 8 T / δ² (else penalty_scale's alone: the alternative the
+    /// study measures, docs/16_contact_solvers.md#the-penalty).
     bool kinetic_penalty = true;
     /// μ ← penalty_growth × μ after an outer iteration whose largest violation did not fall below
     /// a quarter of the last one's (standard AL practice), ≥ 1.

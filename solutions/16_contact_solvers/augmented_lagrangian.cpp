@@ -184,15 +184,6 @@ void AugmentedLagrangianContact::begin_step(dynamics::Body& body, const dynamics
     resolving_ = false;
     ccd_.begin_step(body, state, time_step);
     time_ = state.time + time_step;
-    const Eigen::VectorXd& masses = body.dof_masses();
-    // μ: at least penalty_scale × a vertex's mass block, and stiff enough that the penalty's energy at
-    // a violation of δ/2, (μ/2)(δ/2)², holds the kinetic energy of the step's start: an impact is then
-    // stopped within δ of contact in the first solve, before the CCD would have to (TOI locking).
-    const double kinetic = 0.5 * state.v.dot(masses.cwiseProduct(state.v));
-    penalty_ = options_.penalty_scale * masses.mean() / (time_step * time_step);
-    if (options_.kinetic_penalty)
-        penalty_ = std::max(penalty_, 8.0 * kinetic / (options_.gap * options_.gap));
-    last_violation_ = infinity;
     // Decay: a pair idle for stale_steps steps in a row leaves.
     std::erase_if(constraints_, [&](const ContactConstraint& c) { return c.idle_steps >= options_.stale_steps; });
     // The pairs the predicted motion's CCD finds (xᵗ → xᵗ + Δt vᵗ + Δt² g), or within 2δ, join at once.
@@ -200,6 +191,24 @@ void AugmentedLagrangianContact::begin_step(dynamics::Body& body, const dynamics
     for (Eigen::Index i = 0; i < motion.size(); i += 3)
         motion.segment<3>(i) += time_step * time_step * body.scene().gravity;
     add_pairs(state.u, motion, 2.0 * options_.gap, -infinity);
+    // μ: at least penalty_scale × a vertex's mass block, and stiff enough that the penalty's energy at
+    // a violation of δ/2, (μ/2)(δ/2)², holds the kinetic energy T of the active pairs' vertices at the
+    // step's start: an impact is then stopped within δ of contact in the first solve, before the CCD
+    // would have to (TOI locking).
+    const Eigen::VectorXd& masses = body.dof_masses();
+    std::vector<bool> in_pair(static_cast<std::size_t>(rest_.rows()), false);
+    for (const ContactConstraint& c : constraints_)
+        for (int i = 0; i < (c.kind == ConstraintKind::vertex_obstacle ? 1 : 4); ++i)
+            if (c.vertices[i] >= 0)
+                in_pair[static_cast<std::size_t>(c.vertices[i])] = true;
+    double kinetic = 0.0;
+    for (Eigen::Index v = 0; v < rest_.rows(); ++v)
+        if (in_pair[static_cast<std::size_t>(v)])
+            kinetic += 0.5 * masses[3 * v] * state.v.segment<3>(3 * v).squaredNorm();
+    penalty_ = options_.penalty_scale * masses.mean() / (time_step * time_step);
+    if (options_.kinetic_penalty)
+        penalty_ = std::max(penalty_, 8.0 * kinetic / (options_.gap * options_.gap));
+    last_violation_ = infinity;
 }
 
 int AugmentedLagrangianContact::add_pairs(const Eigen::VectorXd& u, const Eigen::VectorXd& du, double reach,
