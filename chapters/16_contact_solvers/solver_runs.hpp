@@ -63,6 +63,9 @@ struct SolverStep {
 struct SolverRun {
     std::vector<SolverStep> steps;
     int newton_iterations = 0, factorizations = 0, contact_steps = 0, contact_iterations = 0;
+    /// The factorizations with a new sparsity pattern (a new fill-reducing ordering and symbolic
+    /// analysis, chapter 15's TimedSolver::new_patterns).
+    int new_patterns = 0;
     double seconds = 0.0;
     double smallest_distance = 0.0;  ///< over every step's end [m] (+∞: never within d̂)
     /// max over the steps' ends of max(0, δ − d) over the pairs within δ [m]: how far inside δ

@@ -90,7 +90,8 @@ void side_by_side_study(const RunContext& run, const std::vector<SolverScene>& s
                  {"steps in contact", Format::integer, 0}, {"Newton iterations", Format::integer, 0},
                  {"Newton iterations in contact", Format::integer, 0},
                  {"Newton iterations per step in contact", Format::fixed, 2},
-                 {"linear solves", Format::integer, 0}, {"time per step [ms]", Format::fixed, 3},
+                 {"linear solves", Format::integer, 0}, {"new matrix patterns", Format::integer, 0},
+                 {"time per step [ms]", Format::fixed, 3},
                  {"time per step / free step [measured]", Format::fixed, 1},
                  {"smallest distance [m]", Format::scientific, 2}, {"largest violation below delta [m]", Format::scientific, 2},
                  {"momentum drift [round-off]", Format::scientific, 1}, {"error", Format::text, 0}});
@@ -111,7 +112,8 @@ void side_by_side_study(const RunContext& run, const std::vector<SolverScene>& s
             table.add_row({scene.name, solver_name(solver), double(result.steps.size()), double(result.contact_steps),
                            double(result.newton_iterations), double(result.contact_iterations),
                            result.contact_steps > 0 ? double(result.contact_iterations) / result.contact_steps : 0.0,
-                           double(result.factorizations), 1e3 * per_step, per_step / free_step,
+                           double(result.factorizations), double(result.new_patterns), 1e3 * per_step,
+                           per_step / free_step,
                            distance_cell(result.smallest_distance), result.largest_violation,
                            moving ? Cell(result.momentum_drift) : Cell(std::string("-")),
                            failure(result)});

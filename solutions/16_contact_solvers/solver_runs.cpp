@@ -123,6 +123,7 @@ SolverRun run_scene(const SolverScene& scene, ContactSolver solver, AugmentedLag
         }
     }
     run.end = state;
+    run.new_patterns = timed != nullptr ? timed->new_patterns : 0;
     return run;
 }
 
