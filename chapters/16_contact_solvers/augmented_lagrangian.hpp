@@ -27,6 +27,7 @@
 #include "15_body_contact/body_contact.hpp"
 
 #include "14_contact/contact.hpp"
+#include "14_contact/friction.hpp"
 #include "14_contact/obstacles.hpp"
 #include "14_contact/surface.hpp"
 
@@ -110,6 +111,13 @@ struct AugmentedLagrangianOptions {
     std::vector<int> vertex_body;       ///< as BodyContactOptions: the body of each vertex (empty: one)
     std::vector<bool> body_self_contact;  ///< as BodyContactOptions
     bool check_intersections = false;   ///< chapter 15's referee at every configuration E is asked of
+    /// ε_v [m/s]: chapter 14's friction smoothing (ε = ε_v Δt), for the obstacles with μ > 0.
+    double friction_velocity = 1e-3;
+    /// Friction on the vertex–obstacle pairs (chapter 14's lagged_friction with normal force λ_k):
+    /// false, lagged — λ_k and the tangent basis from the step's start (IPC's lag); true, converged —
+    /// both updated after every outer iteration, and the step ends only when no pair's normal force
+    /// changed by more than 10⁻⁶ of the largest. docs/16_contact_solvers.md#friction
+    bool converged_friction = false;
 };
 
 /// The filter of the active set: a pair stays when λ > 0 or g ≤ filter_gap · δ (a pair that pushes,
@@ -139,7 +147,7 @@ class AugmentedLagrangianContact final : public hyper::StepPotential {
 public:
     /// fem::Error for no obstacle without self_contact, δ ≤ 0, penalty_scale ≤ 0, penalty_growth < 1,
     /// a tolerance ≤ 0, filter_gap < 0, stale_steps < 1, max_outer_iterations < 1, safety outside
-    /// (0, 1), an obstacle with friction (not in this solver), and what chapter 15's potential refuses.
+    /// (0, 1), ε_v ≤ 0, and what chapter 15's potential refuses.
     AugmentedLagrangianContact(const dynamics::Body& body, std::vector<std::shared_ptr<const Obstacle>> obstacles,
                                AugmentedLagrangianOptions options = {});
 
@@ -171,6 +179,10 @@ public:
     OuterResiduals update_multipliers(const Eigen::VectorXd& u, const Eigen::VectorXd& v);
     /// Ends the step: idle counts of the pairs with λ = 0.
     void end_step();
+    /// With converged_friction: the friction pairs' normal forces and bases from the multipliers and
+    /// u (3n) after an update; returns the largest change of a normal force relative to the largest
+    /// normal force (0 without friction or with lagged friction).
+    double relag_friction(const Eigen::VectorXd& u);
 
     /// g_k(u) = d_k(u) − δ [m] of a pair.
     double constraint_gap(const ContactConstraint& constraint, const Eigen::VectorXd& u) const;
@@ -196,6 +208,11 @@ private:
     /// Adds the pairs found along u → u + du (CCD) or within reach of u, not yet in the set and with
     /// g(u) ≥ min_gap, with λ = 0. Returns how many joined.
     int add_pairs(const Eigen::VectorXd& u, const Eigen::VectorXd& du, double reach, double min_gap) const;
+    /// Sets friction_ from the vertex–obstacle pairs with λ > 0 against obstacles with μ > 0 at u
+    /// (3n): normal force λ, basis ⟂ ∇d(x_v), sticking to start (3n) + Δt w_o.
+    void lag_friction(const Eigen::VectorXd& u, const Eigen::VectorXd& start);
+    /// A friction pair's lagged friction at u (3n).
+    LaggedFriction friction_of(const FrictionPair& pair, const Eigen::VectorXd& u) const;
     /// The position of obstacle corner −1 − index at the step's end time (index < 0) [m].
     Eigen::Vector3d corner(int index) const;
     struct ObstacleCorner {
@@ -212,7 +229,9 @@ private:
     std::vector<ObstacleCorner> corners_;             // every obstacle's corners, in the obstacles' order
     std::vector<std::array<int, 2>> obstacle_edges_;  // their edges, in indices of corners_
     mutable std::vector<ContactConstraint> constraints_;
-    double time_ = 0.0, penalty_ = 0.0, last_violation_ = 0.0;
+    std::vector<FrictionPair> friction_;  // the friction pairs of the step
+    Eigen::VectorXd step_start_;          // uᵗ (3n)
+    double time_ = 0.0, time_step_ = 0.0, penalty_ = 0.0, last_violation_ = 0.0;
     bool first_solve_ = true, resolving_ = false;
     mutable bool skip_start_move_ = false, last_cut_ = false;
     Eigen::VectorXd warm_v_;

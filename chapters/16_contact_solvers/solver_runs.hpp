@@ -101,6 +101,10 @@ SolverRun run_scene(const SolverScene& scene, ContactSolver solver, AugmentedLag
 /// g = 9.81 m/s², Δt = 1/100 s.
 SolverScene drop_scene(double height = 0.05, int steps = 40, int cells = 1);
 
+/// A 10 cm cube (one cell) resting 0.5 mm above a floor of friction μ = friction, gravity tilted by
+/// slope [rad] along +x (g = 9.81 (sin θ, 0, −cos θ) m/s²: a slope of angle θ), Δt = 1/100 s.
+SolverScene slope_scene(double slope, double friction, int steps);
+
 /// A box of half extent 3 cm turned by the rotation of 0.6 rad about (1, 2, 3)/√14, its highest
 /// point at z = 0 under the centre of a 10 cm cube whose lowest face is 0.2 m up: its corners and
 /// edges meet the cube's lower face between its vertices.

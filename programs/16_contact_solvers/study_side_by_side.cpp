@@ -53,6 +53,62 @@ std::string failure(const SolverRun& run)
     return run.error.empty() ? std::string("-") : str("failed at ", run.error.substr(0, run.error.find(':')));
 }
 
+/// The block on slopes around tan θ = μ = 0.5 with IPC (chapter 14's lagged friction), the augmented
+/// Lagrangian with lagged friction and with converged friction: below the threshold the creep speed
+/// of the last 10 steps against the mollifier's bound ε_v and its closed form ε_v (1 − √(1 − tan θ/μ));
+/// above it the acceleration of the last 10 steps against g (sin θ − μ cos θ); friction_table.csv.
+void friction_table(const RunContext& run)
+{
+    const double mu = 0.5, g = 9.81, dt = 0.01, eps_v = AugmentedLagrangianOptions{}.friction_velocity;
+    Table table("A block on a slope of friction mu = 0.5 near tan(theta) = mu, 60 steps of 1/100 s: below it the creep "
+                "speed (the last 10 steps' largest) against eps_v = 1 mm/s and the closed form eps_v (1 - sqrt(1 - tan/mu)); "
+                "above it the acceleration's error (the last 10 steps' largest) / g",
+                {{"tan theta / mu", Format::fixed, 2}, {"solver", Format::text, 0}, {"friction", Format::text, 0},
+                 {"creep speed / eps_v", Format::scientific, 2}, {"closed-form creep speed / eps_v", Format::scientific, 2},
+                 {"acceleration error / g", Format::scientific, 1}, {"Newton iterations", Format::integer, 0}});
+    struct Model {
+        ContactSolver solver;
+        bool converged;
+        const char* name;
+    };
+    const Model models[] = {{ContactSolver::ipc, false, "lagged (IPC's one update)"},
+                            {ContactSolver::augmented_lagrangian, false, "lagged"},
+                            {ContactSolver::augmented_lagrangian, true, "converged"}};
+    const std::vector<double> ratios = run.quick ? std::vector<double>{0.9, 1.2} : std::vector<double>{0.5, 0.9, 0.99, 1.2};
+    for (double ratio : ratios) {
+        const double slope = std::atan(ratio * mu);
+        for (const Model& model : models) {
+            AugmentedLagrangianOptions options;
+            options.converged_friction = model.converged;
+            std::vector<double> velocities;
+            const SolverRun result = run_scene(slope_scene(slope, mu, 60), model.solver, options, false,
+                                               [&](const dynamics::Body& body, const dynamics::State&,
+                                                   const dynamics::State& after, const Eigen::VectorXd&) {
+                                                   const Eigen::VectorXd& m = body.dof_masses();
+                                                   double momentum = 0.0;
+                                                   for (Eigen::Index i = 0; i < m.size(); i += 3)
+                                                       momentum += m[i] * after.v[i];
+                                                   velocities.push_back(momentum / (m.sum() / 3.0));
+                                               });
+            double creep = 0.0, error = 0.0;
+            for (std::size_t s = velocities.size() - 10; s < velocities.size(); ++s) {
+                creep = std::max(creep, std::abs(velocities[s]));
+                error = std::max(error, std::abs((velocities[s] - velocities[s - 1]) / dt -
+                                                 g * (std::sin(slope) - mu * std::cos(slope))));
+            }
+            const bool sticks = ratio < 1.0;
+            table.add_row({ratio, solver_name(model.solver), std::string(model.name),
+                           sticks ? Cell(creep / eps_v) : Cell(std::string("-")),
+                           sticks ? Cell(1.0 - std::sqrt(1.0 - ratio)) : Cell(std::string("-")),
+                           sticks ? Cell(std::string("-")) : Cell(error / g), double(result.newton_iterations)});
+            if (!result.error.empty())
+                std::cout << "slope " << ratio << ", " << model.name << ": " << result.error << "\n";
+        }
+    }
+    table.print(std::cout);
+    table.write_csv(run.file("friction_table.csv"));
+}
+
 }  // namespace
 
 std::vector<SolverScene> comparison_scenes(const RunContext& run, bool bunnies)
@@ -150,6 +206,9 @@ void side_by_side_study(const RunContext& run, const std::vector<SolverScene>& s
             forms.add_row({scene->name, solver_name(solver), weight_error(*scene, solver)});
     forms.print(std::cout);
     forms.write_csv(run.file("closed_forms_table.csv"));
+
+    std::cout << "\n   Friction near the stick-slip threshold: lagged against converged\n\n";
+    friction_table(run);
 
     std::cout << "\n   The augmented Lagrangian's open choices against their alternatives\n\n";
     Table choices("The augmented Lagrangian's choices (docs: the penalty, the active set) against their alternatives "

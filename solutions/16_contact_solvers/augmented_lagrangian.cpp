@@ -36,8 +36,7 @@ BodyContactOptions collision_options(const AugmentedLagrangianOptions& options)
     return ccd;
 }
 
-const AugmentedLagrangianOptions& checked(const AugmentedLagrangianOptions& options,
-                                          const std::vector<std::shared_ptr<const Obstacle>>& obstacles)
+const AugmentedLagrangianOptions& checked(const AugmentedLagrangianOptions& options)
 {
     require_positive(options.gap, "augmented Lagrangian: gap delta [m]");
     require_positive(options.penalty_scale, "augmented Lagrangian: penalty_scale");
@@ -53,10 +52,7 @@ const AugmentedLagrangianOptions& checked(const AugmentedLagrangianOptions& opti
         throw Error(str("augmented Lagrangian: max_outer_iterations must be >= 1, got ", options.max_outer_iterations));
     if (!(options.safety > 0.0 && options.safety < 1.0))
         throw Error(str("augmented Lagrangian: safety must lie in (0, 1), got ", options.safety));
-    for (std::size_t o = 0; o < obstacles.size(); ++o)
-        if (obstacles[o] != nullptr && obstacles[o]->friction() != 0.0)
-            throw Error(str("augmented Lagrangian: obstacle ", o, " (", obstacles[o]->name(), ") has friction mu = ",
-                            obstacles[o]->friction(), ": this solver has no friction yet (use chapter 14's contact_step)"));
+    require_positive(options.friction_velocity, "augmented Lagrangian: friction_velocity eps_v [m/s]");
     return options;
 }
 
@@ -111,7 +107,7 @@ struct AugmentedLagrangianContact::PairGeometry {
 AugmentedLagrangianContact::AugmentedLagrangianContact(const dynamics::Body& body,
                                                        std::vector<std::shared_ptr<const Obstacle>> obstacles,
                                                        AugmentedLagrangianOptions options)
-    : obstacles_(obstacles), options_(checked(options, obstacles)),
+    : obstacles_(obstacles), options_(checked(options)),
       ccd_(body_contact_potential(body, std::move(obstacles), collision_options(options_))),
       rest_(body.mesh().V), surface_(surface_primitives(body.mesh())), vertex_body_(options_.vertex_body)
 {
@@ -125,6 +121,13 @@ AugmentedLagrangianContact::AugmentedLagrangianContact(const dynamics::Body& bod
         for (Eigen::Index e = 0; e < features.edges.rows(); ++e)
             obstacle_edges_.push_back({first + features.edges(e, 0), first + features.edges(e, 1)});
     }
+}
+
+LaggedFriction AugmentedLagrangianContact::friction_of(const FrictionPair& pair, const Eigen::VectorXd& u) const
+{
+    const Eigen::Vector3d x = rest_.row(pair.vertex).transpose() + u.segment<3>(3 * pair.vertex);
+    return lagged_friction(pair.tangent, x - pair.start, pair.coefficient * pair.normal_force,
+                           options_.friction_velocity * time_step_);
 }
 
 Eigen::Vector3d AugmentedLagrangianContact::corner(int index) const
@@ -209,6 +212,56 @@ void AugmentedLagrangianContact::begin_step(dynamics::Body& body, const dynamics
     if (options_.kinetic_penalty)
         penalty_ = std::max(penalty_, 8.0 * kinetic / (options_.gap * options_.gap));
     last_violation_ = infinity;
+    time_step_ = time_step;
+    step_start_ = state.u;
+    lag_friction(state.u, state.u);  // the multipliers the last step left: its contact forces
+}
+
+void AugmentedLagrangianContact::lag_friction(const Eigen::VectorXd& u, const Eigen::VectorXd& start)
+{
+    friction_.clear();
+    for (const ContactConstraint& c : constraints_) {
+        if (c.kind != ConstraintKind::vertex_obstacle || c.multiplier == 0.0)
+            continue;
+        const Obstacle& obstacle = *obstacles_[static_cast<std::size_t>(c.obstacle)];
+        if (obstacle.friction() == 0.0)
+            continue;
+        const int v = c.vertices[0];
+        FrictionPair pair;
+        pair.vertex = v;
+        pair.obstacle = c.obstacle;
+        pair.normal_force = c.multiplier;
+        pair.coefficient = obstacle.friction();
+        pair.tangent = tangent_basis(obstacle.gradient(rest_.row(v).transpose() + u.segment<3>(3 * v), time_));
+        pair.start = rest_.row(v).transpose() + start.segment<3>(3 * v) + time_step_ * obstacle.velocity();
+        friction_.push_back(pair);
+    }
+}
+
+double AugmentedLagrangianContact::relag_friction(const Eigen::VectorXd& u)
+{
+    if (!options_.converged_friction)
+        return 0.0;
+    const std::vector<FrictionPair> before = friction_;
+    lag_friction(u, step_start_);
+    double largest = 0.0, change = 0.0;
+    for (const FrictionPair& pair : friction_)
+        largest = std::max(largest, pair.normal_force);
+    for (const FrictionPair& pair : friction_) {
+        double old = 0.0;
+        for (const FrictionPair& b : before)
+            if (b.vertex == pair.vertex && b.obstacle == pair.obstacle)
+                old = b.normal_force;
+        change = std::max(change, std::abs(pair.normal_force - old));
+    }
+    for (const FrictionPair& b : before) {  // a pair that left
+        bool kept = false;
+        for (const FrictionPair& pair : friction_)
+            kept = kept || (b.vertex == pair.vertex && b.obstacle == pair.obstacle);
+        if (!kept)
+            change = std::max(change, b.normal_force);
+    }
+    return largest > 0.0 ? change / largest : change;
 }
 
 int AugmentedLagrangianContact::add_pairs(const Eigen::VectorXd& u, const Eigen::VectorXd& du, double reach,
@@ -349,6 +402,8 @@ double AugmentedLagrangianContact::energy(const Eigen::VectorXd& u) const
             return infinity;
         total += augmented_term(gap, c.multiplier, penalty_).value;
     }
+    for (const FrictionPair& pair : friction_)
+        total += friction_of(pair, u).value;
     return total;
 }
 
@@ -364,6 +419,8 @@ Eigen::VectorXd AugmentedLagrangianContact::gradient(const Eigen::VectorXd& u) c
             if (pair.vertices[i] >= 0)
                 gradient.segment<3>(3 * pair.vertices[i]) += term.slope * pair.gradient.segment<3>(3 * i);
     }
+    for (const FrictionPair& pair : friction_)
+        gradient.segment<3>(3 * pair.vertex) += friction_of(pair, u).gradient;
     return gradient;
 }
 
@@ -390,6 +447,12 @@ dynamics::SparseMatrix AugmentedLagrangianContact::hessian(const Eigen::VectorXd
                     for (int s = 0; s < 3; ++s)
                         triplets.emplace_back(3 * pair.vertices[i] + r, 3 * pair.vertices[j] + s,
                                               block(3 * i + r, 3 * j + s));
+    }
+    for (const FrictionPair& pair : friction_) {
+        const Eigen::Matrix3d block = friction_of(pair, u).hessian;
+        for (int r = 0; r < 3; ++r)
+            for (int q = 0; q < 3; ++q)
+                triplets.emplace_back(3 * pair.vertex + r, 3 * pair.vertex + q, block(r, q));
     }
     dynamics::SparseMatrix H(u.size(), u.size());
     H.setFromTriplets(triplets.begin(), triplets.end());
@@ -488,7 +551,9 @@ dynamics::StepInfo augmented_lagrangian_step(hyper::NewtonBackwardEuler& newton,
         r.newton_iterations = total.newton_iterations;
         r.residuals = al.update_multipliers(solution.u, solution.v);
         r.active_pairs = static_cast<int>(al.constraints().size());
-        if (outer_converged(r.residuals, options.gap, options.violation_tolerance, options.dual_tolerance)) {
+        const bool friction_settled = al.relag_friction(solution.u) <= 1e-6;
+        if (outer_converged(r.residuals, options.gap, options.violation_tolerance, options.dual_tolerance) &&
+            friction_settled) {
             al.end_step();
             state = std::move(solution);
             return total;

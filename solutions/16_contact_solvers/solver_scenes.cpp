@@ -41,6 +41,18 @@ SolverScene drop_scene(double height, int steps, int cells)
     return drop;
 }
 
+SolverScene slope_scene(double slope, double friction, int steps)
+{
+    SolverScene block;
+    block.name = str("block on a slope of ", slope, " rad, mu = ", friction);
+    block.scene = rubber_scene(cube_at(0.1, 1, Eigen::Vector3d(0.0, 0.0, 0.5e-3)), 9.81, 1.0 / 100.0);
+    block.scene.gravity = 9.81 * Eigen::Vector3d(std::sin(slope), 0.0, -std::cos(slope));
+    block.obstacles = {std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), friction)};
+    block.steps = steps;
+    block.newton_tolerance = 1e-9;
+    return block;
+}
+
 std::shared_ptr<const Obstacle> turned_box()
 {
     const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.6, Eigen::Vector3d(1.0, 2.0, 3.0).normalized()).toRotationMatrix();

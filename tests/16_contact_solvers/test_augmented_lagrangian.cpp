@@ -24,6 +24,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <vector>
 
 using namespace fem;
 using namespace fem::contact;
@@ -195,7 +196,7 @@ TEST_CASE("the block fired at the turned box at 10 and 100 m/s: every step conve
     CHECK(run.smallest_distance > 0.0);
 }
 
-TEST_CASE("augmented Lagrangian contact: options out of range, friction, no room and a start inside are refused",
+TEST_CASE("augmented Lagrangian contact: options out of range, no obstacle, no room and a start inside are refused",
           "[ch16]")
 {
     const SolverScene drop = drop_scene();
@@ -218,9 +219,9 @@ TEST_CASE("augmented Lagrangian contact: options out of range, friction, no room
     bad = {};
     bad.filter_gap = -1.0;
     refused(bad, "filter_gap");
-    CHECK_THROWS_WITH(AugmentedLagrangianContact(
-                          body, {std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.5)}),
-                      Catch::Contains("friction"));
+    bad = {};
+    bad.friction_velocity = 0.0;
+    refused(bad, "friction_velocity");
     CHECK_THROWS_WITH(AugmentedLagrangianContact(body, {}), Catch::Contains("obstacle"));
 
     // A ceiling coming down at 10 m/s onto the block on the floor: squeezed into less than its
@@ -234,4 +235,55 @@ TEST_CASE("augmented Lagrangian contact: options out of range, friction, no room
     SolverScene inside = drop_scene(-0.01, 3);
     const SolverRun started_inside = run_scene(inside, ContactSolver::augmented_lagrangian);
     CHECK_THAT(started_inside.error, Catch::Contains("step 1"));
+}
+
+namespace {
+
+/// The mass-weighted mean velocity along x (the slope's direction) of each step's end [m/s].
+std::vector<double> slope_velocities(const SolverScene& slope, bool converged, SolverRun& run)
+{
+    AugmentedLagrangianOptions options;
+    options.converged_friction = converged;
+    std::vector<double> velocities;
+    run = run_scene(slope, ContactSolver::augmented_lagrangian, options, false,
+                    [&](const dynamics::Body& body, const dynamics::State&, const dynamics::State& after,
+                        const Eigen::VectorXd&) {
+                        const Eigen::VectorXd& m = body.dof_masses();
+                        double momentum = 0.0;
+                        for (Eigen::Index i = 0; i < m.size(); i += 3)
+                            momentum += m[i] * after.v[i];
+                        velocities.push_back(momentum / (m.sum() / 3.0));
+                    });
+    return velocities;
+}
+
+}  // namespace
+
+TEST_CASE("friction: a block sliding down a slope accelerates at g (sin t - mu cos t) to 1e-6 g, lagged or converged",
+          "[ex16.3]")
+{
+    const double slope = 0.5, mu = 0.3;  // tan θ = 0.55 > μ: it slides
+    const bool converged = GENERATE(false, true);
+    SolverRun run;
+    const std::vector<double> v = slope_velocities(slope_scene(slope, mu, 40), converged, run);
+    INFO((converged ? "converged" : "lagged") << ": " << run.error);
+    REQUIRE(run.error.empty());
+    const double expected = 9.81 * (std::sin(slope) - mu * std::cos(slope)), dt = 0.01;
+    double worst = 0.0;
+    for (std::size_t s = 20; s < v.size(); ++s)  // settled: the lagged normal force is the weight's share
+        worst = std::max(worst, std::abs((v[s] - v[s - 1]) / dt - expected));
+    CHECK(worst < 1e-6 * 9.81);
+}
+
+TEST_CASE("friction: a block on a slope below tan t = mu creeps no faster than eps_v, lagged or converged",
+          "[ex16.3]")
+{
+    const double slope = 0.15, mu = 0.5;  // tan θ = 0.15 < μ: it sticks
+    const bool converged = GENERATE(false, true);
+    SolverRun run;
+    const std::vector<double> v = slope_velocities(slope_scene(slope, mu, 40), converged, run);
+    INFO((converged ? "converged" : "lagged") << ": " << run.error);
+    REQUIRE(run.error.empty());
+    for (std::size_t s = 5; s < v.size(); ++s)
+        CHECK(std::abs(v[s]) <= AugmentedLagrangianOptions{}.friction_velocity);
 }
