@@ -140,7 +140,8 @@ bool outer_converged(const OuterResiduals& residuals, double separation, double 
                      double dual_tolerance);
 
 /// The augmented Lagrangian of the header as a chapter 12 StepPotential: P(u) = Σ_k ψ(g_k(u), λ_k, μ)
-/// over the active set, its line search cut by the CCD of a chapter 15 ContactPotential of the same
+/// over the active set plus chapter 14's lagged friction of its vertex–obstacle pairs with λ_k > 0
+/// against obstacles with μ > 0 (normal force λ_k), its line search cut by the CCD of a chapter 15 ContactPotential of the same
 /// body and obstacles (its barrier never used: only largest_safe_step, start_velocity,
 /// smallest_distance). Driven by augmented_lagrangian_step.
 class AugmentedLagrangianContact final : public hyper::StepPotential {
@@ -151,15 +152,18 @@ public:
     AugmentedLagrangianContact(const dynamics::Body& body, std::vector<std::shared_ptr<const Obstacle>> obstacles,
                                AugmentedLagrangianOptions options = {});
 
-    /// The first solve of a step (prepare_step): the CCD's potential begins the step, μ from the
-    /// mean vertex mass, stale pairs decay, and the pairs the predicted motion's CCD finds join.
+    /// The first solve of a step (prepare_step): the CCD's potential begins the step, stale pairs
+    /// decay, the pairs the predicted motion's CCD finds join, μ (AugmentedLagrangianOptions::
+    /// penalty_scale), and the friction pairs lagged from the multipliers the last step left.
     /// A re-solve of the same step: nothing.
     void begin_step(dynamics::Body& body, const dynamics::State& state, double time_step) override;
-    /// Σ_k ψ(g_k(u), λ_k, μ) [J]; +∞ where some pair has d ≤ 0.
+    /// Σ_k ψ(g_k(u), λ_k, μ) + the friction pairs' μ_o λ_k f₀ [J]; +∞ where some pair has d ≤ 0.
     double energy(const Eigen::VectorXd& u) const override;
-    /// Σ_k ∂ψ/∂g ∇g_k (3n) [N].
+    /// Σ_k ∂ψ/∂g ∇g_k + the friction pairs' gradients (3n) [N].
     Eigen::VectorXd gradient(const Eigen::VectorXd& u) const override;
-    /// Σ_k [∂²ψ/∂g² ∇g ∇gᵀ + ∂ψ/∂g ∇²g] per pair block (3×3 or 12×12), each projected to PSD (clamp).
+    /// Σ_k [∂²ψ/∂g² ∇g ∇gᵀ + ∂ψ/∂g ∇²g] per pair block (3×3 or 12×12), each projected to PSD (clamp;
+    /// zeros where the pair exerts nothing, so the pattern follows the active set), plus the friction
+    /// pairs' PSD blocks.
     dynamics::SparseMatrix hessian(const Eigen::VectorXd& u) const override;
     /// The CCD potential's safe step (safety × the time of impact over every pair, the obstacles'
     /// edges too); when it cuts (< 1), the pairs whose CCD along u → u + du hits, at g ≥ 0 at u, join
@@ -247,7 +251,9 @@ struct AugmentedLagrangianReport {
 
 /// One backward Euler step with the augmented Lagrangian contact: inner solves (newton.step from
 /// the step's start with al as potential, warm-started from the last solution) and multiplier
-/// updates until outer_converged; StepInfo's Newton and solver iterations summed over the solves.
+/// updates (then, with converged_friction, relag_friction) until outer_converged and no friction
+/// normal force moved by more than 10⁻⁶ of the largest; StepInfo's Newton and solver iterations
+/// summed over the solves.
 /// fem::Error (the state left at the step's start) when max_outer_iterations pass, naming the pair
 /// with the largest violation. newton must have al set as its potential.
 /// docs/16_contact_solvers.md#the-algorithm
