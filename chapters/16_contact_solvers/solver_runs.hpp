@@ -105,6 +105,11 @@ SolverScene drop_scene(double height = 0.05, int steps = 40, int cells = 1);
 /// slope [rad] along +x (g = 9.81 (sin θ, 0, −cos θ) m/s²: a slope of angle θ), Δt = 1/100 s.
 SolverScene slope_scene(double slope, double friction, int steps);
 
+/// Chapter 15's block in the bowl (the mesh obstacle of data/bowl.obj, μ = 0.3): a 4 cm cube of cells³
+/// cells of soft rubber (Y = 10⁵ Pa, ν = 0.4), its lowest corner at (0.05, −0.02, 0.045) m, dropped
+/// onto the bowl's wall, g = 9.81 m/s², Δt = 1/100 s.
+SolverScene bowl_scene(int cells, int steps);
+
 /// A box of half extent 3 cm turned by the rotation of 0.6 rad about (1, 2, 3)/√14, its highest
 /// point at z = 0 under the centre of a 10 cm cube whose lowest face is 0.2 m up: its corners and
 /// edges meet the cube's lower face between its vertices.

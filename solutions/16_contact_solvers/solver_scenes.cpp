@@ -1,6 +1,10 @@
 #include "16_contact_solvers/solver_runs.hpp"
 
+#include "15_body_contact/mesh_obstacle.hpp"
+
+#include "common/files.hpp"
 #include "common/mesh.hpp"
+#include "common/mesh_io.hpp"
 
 #include <Eigen/Geometry>
 
@@ -51,6 +55,18 @@ SolverScene slope_scene(double slope, double friction, int steps)
     block.steps = steps;
     block.newton_tolerance = 1e-9;
     return block;
+}
+
+SolverScene bowl_scene(int cells, int steps)
+{
+    SolverScene bowl;
+    bowl.name = "block dropped into the bowl";
+    bowl.scene = rubber_scene(cube_at(0.04, cells, Eigen::Vector3d(0.05, -0.02, 0.045)), 9.81, 1.0 / 100.0);
+    bowl.scene.material = {1e5, 0.4, 1000.0};
+    bowl.obstacles = {std::make_shared<MeshObstacle>(io::read_tri_mesh(data_path("bowl.obj")), 0.3,
+                                                     Eigen::Vector3d::Zero(), "bowl.obj")};
+    bowl.steps = steps;
+    return bowl;
 }
 
 std::shared_ptr<const Obstacle> turned_box()
