@@ -53,16 +53,17 @@ std::string failure(const SolverRun& run)
     return run.error.empty() ? std::string("-") : str("failed at ", run.error.substr(0, run.error.find(':')));
 }
 
-/// The block on slopes around tan θ = μ = 0.5 with IPC (chapter 14's lagged friction), the augmented
+/// The block on slopes around tan θ = μ = 0.5 (60 steps, 30 with --quick) with IPC (chapter 14's lagged friction), the augmented
 /// Lagrangian with lagged friction and with converged friction: below the threshold the creep speed
 /// of the last 10 steps against the mollifier's bound ε_v and its closed form ε_v (1 − √(1 − tan θ/μ));
 /// above it the acceleration of the last 10 steps against g (sin θ − μ cos θ); friction_table.csv.
 void friction_table(const RunContext& run)
 {
     const double mu = 0.5, g = 9.81, dt = 0.01, eps_v = AugmentedLagrangianOptions{}.friction_velocity;
-    Table table("A block on a slope of friction mu = 0.5 near tan(theta) = mu, 60 steps of 1/100 s: below it the creep "
+    const int steps = run.quick ? 30 : 60;
+    Table table(str("A block on a slope of friction mu = 0.5 near tan(theta) = mu, ", steps, " steps of 1/100 s: below it the creep "
                 "speed (the last 10 steps' largest) against eps_v = 1 mm/s and the closed form eps_v (1 - sqrt(1 - tan/mu)); "
-                "above it the acceleration's error (the last 10 steps' largest) / g",
+                "above it the acceleration's error (the last 10 steps' largest) / g"),
                 {{"tan theta / mu", Format::fixed, 2}, {"solver", Format::text, 0}, {"friction", Format::text, 0},
                  {"creep speed / eps_v", Format::scientific, 2}, {"closed-form creep speed / eps_v", Format::scientific, 2},
                  {"acceleration error / g", Format::scientific, 1}, {"Newton iterations", Format::integer, 0}});
@@ -81,7 +82,7 @@ void friction_table(const RunContext& run)
             AugmentedLagrangianOptions options;
             options.converged_friction = model.converged;
             std::vector<double> velocities;
-            const SolverRun result = run_scene(slope_scene(slope, mu, 60), model.solver, options, false,
+            const SolverRun result = run_scene(slope_scene(slope, mu, steps), model.solver, options, false,
                                                [&](const dynamics::Body& body, const dynamics::State&,
                                                    const dynamics::State& after, const Eigen::VectorXd&) {
                                                    const Eigen::VectorXd& m = body.dof_masses();
