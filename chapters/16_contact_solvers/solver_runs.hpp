@@ -67,6 +67,10 @@ struct SolverRun {
     /// analysis, chapter 15's TimedSolver::new_patterns).
     int new_patterns = 0;
     double seconds = 0.0;
+    /// The continuous collision check's share of it: ContactClocks::collision_seconds of the run's
+    /// chapter 15 potential (IPC's own; the augmented Lagrangian's collision_check) [s]. The
+    /// augmented Lagrangian's own search for the pairs that join is not in it.
+    double collision_seconds = 0.0;
     double smallest_distance = 0.0;  ///< over every step's end [m] (+∞: never within d̂)
     /// max over the steps' ends of max(0, δ − d) over the pairs within δ [m]: how far inside δ
     /// (the augmented Lagrangian's constraint; IPC's barrier keeps d < d̂ = δ by design).

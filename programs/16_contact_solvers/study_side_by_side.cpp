@@ -152,6 +152,7 @@ void side_by_side_study(const RunContext& run, const std::vector<SolverScene>& s
                  {"linear solves", Format::integer, 0}, {"new matrix patterns", Format::integer, 0},
                  {"time per step [ms]", Format::fixed, 3},
                  {"time per step / free step [measured]", Format::fixed, 1},
+                 {"collision check share [measured]", Format::fixed, 2},
                  {"smallest distance [m]", Format::scientific, 2}, {"largest violation below delta [m]", Format::scientific, 2},
                  {"momentum drift [round-off]", Format::scientific, 1}, {"error", Format::text, 0}});
     for (const SolverScene& scene : scenes) {
@@ -172,7 +173,7 @@ void side_by_side_study(const RunContext& run, const std::vector<SolverScene>& s
                            double(result.newton_iterations), double(result.contact_iterations),
                            result.contact_steps > 0 ? double(result.contact_iterations) / result.contact_steps : 0.0,
                            double(result.factorizations), double(result.new_patterns), 1e3 * per_step,
-                           per_step / free_step,
+                           per_step / free_step, result.seconds > 0.0 ? result.collision_seconds / result.seconds : 0.0,
                            distance_cell(result.smallest_distance), result.largest_violation,
                            moving ? Cell(result.momentum_drift) : Cell(std::string("-")),
                            failure(result)});

@@ -124,6 +124,7 @@ SolverRun run_scene(const SolverScene& scene, ContactSolver solver, AugmentedLag
     }
     run.end = state;
     run.new_patterns = timed != nullptr ? timed->new_patterns : 0;
+    run.collision_seconds = distances != nullptr ? distances->clocks().collision_seconds : 0.0;
     return run;
 }
 
