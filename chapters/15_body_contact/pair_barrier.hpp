@@ -32,6 +32,10 @@ void add_pair_block(const int (&vertices)[4], const Matrix12d& block, std::vecto
 /// The mollifier of a point–triangle pair: m = 1, ∇m = 0, ∇²m = 0 (12).
 PrimitiveFunction unit_mollifier();
 
+/// The squared distance of the primitives of motion at s ∈ [0, 1] (their closest-feature type first:
+/// point_triangle_type, edge_edge_type) [m²].
+double squared_distance_at(PrimitivePair pair, const PrimitiveMotion& motion, double s);
+
 /// Additive conservative advancement (after Li et al. 2021): with the common part of the four
 /// vertices' moves taken out (it moves neither primitive relative to the other), M = the largest move
 /// of the first primitive's vertices plus the largest of the second's bounds how fast their distance

@@ -18,7 +18,8 @@ namespace {
 
 constexpr double infinity = std::numeric_limits<double>::infinity();
 
-/// The squared distance of the primitives of motion at s ∈ [0, 1].
+}  // namespace
+
 double squared_distance_at(PrimitivePair kind, const PrimitiveMotion& motion, double s)
 {
     const Eigen::Matrix<double, 3, 4> x = (1.0 - s) * motion.start + s * motion.end;
@@ -30,8 +31,6 @@ double squared_distance_at(PrimitivePair kind, const PrimitiveMotion& motion, do
                                       edge_edge_type(x.col(0), x.col(1), x.col(2), x.col(3)))
         .value;
 }
-
-}  // namespace
 
 PrimitiveFunction mollified_barrier(const PrimitiveFunction& squared_distance, const PrimitiveFunction& mollifier,
                                     double activation_distance, bool with_derivatives)
