@@ -65,7 +65,7 @@ std::string land_block(double speed, double time_step, double thickness, double 
 }  // namespace
 
 TEST_CASE("the line search's collision check keeps a minimum separation: a motion that ends a hair from "
-          "touching is cut where the distance is still a tenth of min(its start, d-hat)", "[ex15.3]")
+          "touching is cut where the distance is still a tenth of min(its start, d-hat)", "[ex15.5]")
 {
     // Ending 10⁻¹⁷ m apart: no contact on [0, 1], so the check of touching alone lets the whole step.
     const PrimitiveMotion hair = landing_edges(1e-17);

@@ -69,7 +69,7 @@ std::string fire_at_plate(double speed, double time_step, int steps, bool blind,
 }  // namespace
 
 TEST_CASE("first_crossing_on_segment: a vertex through a triangle, an edge through an edge, and the same "
-          "motions passing beside", "[ex15.3]")
+          "motions passing beside", "[ex15.5]")
 {
     // Two triangles of one surface: one flat at z = 0, the other's vertex 3 above it.
     SurfacePrimitives surface;
