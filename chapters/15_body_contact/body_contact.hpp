@@ -55,6 +55,13 @@ struct BodyContactOptions : ContactOptions {
     /// (IntersectionCheck, intersections.hpp); fem::Error naming them otherwise. It costs a box tree a
     /// call: for tests and for finding a bug, not for runs. docs/15_body_contact.md#never-an-intersection
     bool check_intersections = false;
+    /// A debug check (PathCheckTerm), with self_contact: every segment of every Newton solve's path
+    /// (uᵗ, each accepted iterate, its end) checked for a crossing of the pairs the barrier holds
+    /// apart by a second CCD (first_crossing_on_segment); fem::Error naming the step, the segment, the
+    /// bodies and the primitives otherwise. docs/15_body_contact.md#the-path-check
+    bool check_path = false;
+    /// The name of each body of vertex_body, for the path check's messages (empty: "body 0", "body 1", …).
+    std::vector<std::string> body_names;
 };
 
 /// The obstacles' edges and corners against the body's surface (FeatureBarrier) as a contact term.
@@ -143,10 +150,57 @@ private:
     MatrixX3d rest_;
 };
 
+/// The path check of BodyContactOptions::check_path as a contact term that adds nothing: it records
+/// each Newton solve's path — the start uᵗ (begin_step), every accepted iterate (the line search's
+/// collision check is asked there: time_of_impact), the solve's end (the last configuration the
+/// energy was asked of: the accepted trial) — and checks each new segment at once with
+/// first_crossing_on_segment over the candidates of its swept boxes (tree_candidates, no inflation)
+/// that the barrier holds apart (SelfContactBarrier::kept). fem::Error on a crossing: "path check:
+/// step 12 (t = 0.06 s), segment 3 of its path (iterate 2 to iterate 3): body 'a' vertex 5 and body
+/// 'b' triangle (0, 1, 2) may meet …", each body's own vertex numbers.
+/// docs/15_body_contact.md#the-path-check
+class PathCheckTerm final : public ContactTerm {
+public:
+    /// The surface of mesh with options' activation_distance, vertex_body, body_self_contact and
+    /// body_names. fem::Error as SelfContactBarrier, or for body_names neither empty nor one per body.
+    PathCheckTerm(const TetMesh& mesh, const BodyContactOptions& options);
+    /// Closes the last solve's path (its end: the last configuration check saw) and opens one at uᵗ.
+    void begin_step(const ContactStepStart& start) override;
+    /// Remembers u: the last before the next solve or end_step is the solve's end.
+    void check(const Eigen::VectorXd& u, double time) const override;
+    /// u is an accepted iterate: the segment from the path's last point to u is checked; +∞.
+    double time_of_impact(const Eigen::VectorXd& u, const Eigen::VectorXd& du, double time,
+                          double end_time) const override;
+    /// After a step: its last segment, to u_end (3n), checked, and the path closed.
+    void end_step(const Eigen::VectorXd& u_end) const;
+    /// A step taken without contact (a chord from u to u_end, 3n each) of step `step` ending at time.
+    void check_chord(const Eigen::VectorXd& u, const Eigen::VectorXd& u_end, int step, double time) const;
+    /// The segments checked so far, and the pair tests they took.
+    long long segments() const { return segments_; }
+    long long pair_tests() const { return pair_tests_; }
+
+private:
+    void check_segment(const Eigen::VectorXd& from, const Eigen::VectorXd& to, const std::string& which) const;
+    /// "body 'a'" (or "body 0") for a vertex of the mesh, and its number in its own body.
+    std::string body_name(int vertex) const;
+    int own_number(int vertex) const;
+
+    SelfContactBarrier pairs_;  // the surface and the pairs held apart
+    MatrixX3d rest_;
+    std::vector<int> vertex_body_, first_vertex_;
+    std::vector<std::string> names_;
+    mutable std::vector<Eigen::VectorXd> path_;
+    mutable Eigen::VectorXd last_checked_;
+    mutable int step_ = 0;
+    mutable double time_ = 0.0;
+    mutable long long segments_ = 0, pair_tests_ = 0;
+};
+
 /// The contact terms of body against obstacles: a FeatureTerm when some obstacle has edges or
 /// corners, a BodyContactTerm with options.self_contact, an IntersectionTerm with
-/// options.check_intersections, in that order. fem::Error for a body_friction < 0 or > 0 without
-/// self_contact, a pattern_reach not a finite number ≥ 0, and what the terms refuse.
+/// options.check_intersections, a PathCheckTerm with options.check_path, in that order. fem::Error for
+/// a body_friction < 0 or > 0 without self_contact, a pattern_reach not a finite number ≥ 0, check_path
+/// without self_contact, and what the terms refuse.
 std::vector<std::unique_ptr<ContactTerm>> body_contact_terms(const dynamics::Body& body,
                                                              const std::vector<std::shared_ptr<const Obstacle>>& obstacles,
                                                              const BodyContactOptions& options);

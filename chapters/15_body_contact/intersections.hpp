@@ -23,6 +23,7 @@
 // produces).
 
 #include "15_body_contact/broad_phase.hpp"
+#include "15_body_contact/ccd.hpp"
 #include "14_contact/obstacles.hpp"
 
 #include "common/mesh.hpp"
@@ -45,6 +46,36 @@ int certified_orientation(const Eigen::Vector3d& a, const Eigen::Vector3d& b, co
 /// apart by certified orientations (header); touching, coplanar and undecidable count as meeting.
 bool segment_meets_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eigen::Vector3d& a,
                             const Eigen::Vector3d& b, const Eigen::Vector3d& c);
+
+/// A pair of surface primitives that may meet on a straight motion (first_crossing_on_segment).
+struct SegmentCrossing {
+    PrimitivePair kind = PrimitivePair::point_triangle;
+    int vertices[4] = {-1, -1, -1, -1};  ///< the point and the triangle's 3, or the two edges' (mesh numbering)
+    double time = 0.0;                   ///< a lower bound of their first contact in [0, 1]
+    bool proven = true;                  ///< false: the inclusion CCD stopped at its box limit (not proven free)
+    bool found() const { return vertices[0] >= 0; }
+};
+
+/// The inclusion CCD's tolerance δ and box limit in the path check (first_crossing_on_segment):
+/// tighter than the line search's 10⁻⁶ and 4000 boxes.
+inline constexpr double path_check_tolerance = 1e-9;
+inline constexpr long long path_check_boxes = 10'000'000;
+/// The most pieces the path check's distance bound bisects a segment into before it hands the pair
+/// to the CCDs (first_crossing_on_segment).
+inline constexpr int path_check_pieces = 1 << 20;
+
+/// The first pair of candidates (surface's point–triangle pairs, then its edge–edge pairs, in their
+/// order) whose primitives may meet while the mesh moves linearly from start to end (#V×3 each). A
+/// pair is cleared by a distance bound (no point moves farther than its primitive's farthest vertex,
+/// so on a piece [a, b] of the motion the distance stays ≥ (d(a) + d(b) − M (b − a))/2, M the two
+/// primitives' farthest moves summed; [0, 1] bisected into up to path_check_pieces pieces until each
+/// is positive), else by two CCDs that are not the line search's (line_search_time_of_impact:
+/// coplanar filter, inclusion at 10⁻⁶, additive advancement): inclusion_ccd at δ = path_check_tolerance
+/// (never misses a contact; a pair it cannot clear within path_check_boxes counts, proven = false)
+/// and cubic_ccd (the roots of the coplanarity cubic): either one's hit is a crossing. tested (if
+/// given) is increased by the pairs tested. None: found() false. docs/15_body_contact.md#the-path-check
+SegmentCrossing first_crossing_on_segment(const SurfacePrimitives& surface, const CandidatePairs& candidates,
+                                          const MatrixX3d& start, const MatrixX3d& end, long long* tested = nullptr);
 
 /// An edge through a triangle: rows of the edges and triangles given.
 struct EdgeThroughTriangle {

@@ -32,6 +32,10 @@ void add_pair_block(const int (&vertices)[4], const Matrix12d& block, std::vecto
 /// The mollifier of a point–triangle pair: m = 1, ∇m = 0, ∇²m = 0 (12).
 PrimitiveFunction unit_mollifier();
 
+/// The squared distance of the primitives of motion at s ∈ [0, 1] (their closest-feature type first:
+/// point_triangle_type, edge_edge_type) [m²].
+double squared_distance_at(PrimitivePair pair, const PrimitiveMotion& motion, double s);
+
 /// Additive conservative advancement (after Li et al. 2021): with the common part of the four
 /// vertices' moves taken out (it moves neither primitive relative to the other), M = the largest move
 /// of the first primitive's vertices plus the largest of the second's bounds how fast their distance
@@ -43,6 +47,11 @@ PrimitiveFunction unit_mollifier();
 /// pair (a sphere's centre or a capsule's segment against the body), 0 when d(0) ≤ r.
 /// docs/15_body_contact.md#edges-and-corners-of-obstacles
 double additive_time_of_impact(PrimitivePair pair, const PrimitiveMotion& motion, double radius = 0.0);
+
+/// The same advancement to a given gap g > 0 [m] (additive_time_of_impact's is (d(0) − r)/10): an s at
+/// which d − r is still ≥ g (0 when it starts below g), +∞ when s passes 1 or nothing moves; r = radius
+/// as there.
+double additive_time_to_gap(PrimitivePair pair, const PrimitiveMotion& motion, double gap, double radius = 0.0);
 
 /// The most boxes inclusion_ccd evaluates for one pair inside a line search (line_search_time_of_impact).
 inline constexpr long long line_search_ccd_boxes = 4000;
@@ -68,8 +77,12 @@ double coplanar_free_time(PrimitivePair pair, const PrimitiveMotion& motion);
 /// the larger of inclusion_ccd's time of impact (tolerance 10⁻⁶, stopped at line_search_ccd_boxes, so
 /// that edges moving in one plane cost no more than that) and additive_time_of_impact's, which keeps
 /// the answer above s₀ while they are apart, where the first may answer 0 within its tolerance of a
-/// contact or at its box limit. fem::Error as inclusion_ccd.
+/// contact or at its box limit. When they do not touch on [0, 1] but end nearer than the gap
+/// g = min(d(0), separation)/10 (separation > 0 [m], e.g. d̂), additive_time_to_gap(g): so no step
+/// ends a pair a hair apart, where the barrier's Hessian (~κ d̂²/d²) would swamp the masses in double
+/// precision and make Newton's system singular (docs/15_body_contact.md#the-minimum-separation);
+/// separation = 0: no such gap. fem::Error as inclusion_ccd.
 /// docs/15_body_contact.md#edges-and-corners-of-obstacles
-double line_search_time_of_impact(PrimitivePair pair, const PrimitiveMotion& motion);
+double line_search_time_of_impact(PrimitivePair pair, const PrimitiveMotion& motion, double separation = 0.0);
 
 }  // namespace fem::contact

@@ -111,6 +111,8 @@ public:
     /// Hessian, pairs or smallest_distance whose x lies outside the last motion's boxes, and each
     /// time_of_impact): what the motion's candidates save.
     long long broad_phases() const { return broad_phases_; }
+    /// candidates without the pairs inside one body that does not hold itself off: the pairs it holds apart.
+    CandidatePairs kept(CandidatePairs candidates) const;
 
 private:
     /// Calls visit(pair) for every pair within reach at u; with_derivatives: with the barrier's
@@ -120,8 +122,6 @@ private:
     /// x (#V×3) moved by u (3n, vertex-major); fem::Error naming what when u's size is not 3n.
     MatrixX3d moved(const MatrixX3d& x, const Eigen::VectorXd& u, const char* what) const;
 
-    /// candidates without the pairs inside one body that does not hold itself off.
-    CandidatePairs kept(CandidatePairs candidates) const;
     /// The candidates within reach at x (#V×3): the last motion's when reach ≤ d̂ and every surface
     /// vertex of x lies within δ of its swept box, else tree_candidates at x, kept in fresh.
     const CandidatePairs& candidates_at(const MatrixX3d& x, double reach, CandidatePairs& fresh) const;

@@ -62,6 +62,9 @@ struct RunResult {
     /// time split and pairs (contact_cost.hpp; contact_steps.csv and contact_cost.csv)
     std::vector<ContactStepRecord> contact_records;
     int frame_count = 0;
+    /// With [contact] check_path: the path segments proven free of crossings (every contact step's
+    /// Newton path, every chord of a step without contact) and the primitive pairs the CCDs tested.
+    long long path_segments = 0, path_pair_tests = 0;
 };
 
 /// How to run a scene.

@@ -55,11 +55,12 @@ public:
     /// with the scene's d̂ and ε_v (κ adaptive), with self_contact its surface against itself too (the
     /// bodies of a group against each other, and each member whose self_contacts entry is true — one
     /// a member, in order — against itself; vertex_body: the member of each vertex), with the scene's
-    /// friction between bodies, Newton with the scene's solver and tolerance. fem::Error as
-    /// ContactPotential.
+    /// friction between bodies, Newton with the scene's solver and tolerance; body_names: each
+    /// member's name (the path check's messages, [contact] check_path). fem::Error as ContactPotential.
     ContactIntegrator(dynamics::Integrator& own, std::vector<SceneForces*> levels, const dynamics::Body& body,
                       std::vector<std::shared_ptr<const contact::Obstacle>> obstacles, const SceneSpec& scene,
-                      bool self_contact = false, std::vector<int> vertex_body = {}, std::vector<bool> self_contacts = {});
+                      bool self_contact = false, std::vector<int> vertex_body = {}, std::vector<bool> self_contacts = {},
+                      std::vector<std::string> body_names = {});
 
     std::string name() const override { return last_contact_ ? newton_.name() + " with contact" : own_.name(); }
     int order() const override { return 1; }

@@ -173,6 +173,10 @@ struct ContactSpec {
     /// surface pairs, BodyContactOptions::body_friction): with bodies or a body's self_contact; 0: none.
     /// docs/scenes.md#bodies-against-bodies
     double friction = 0.0;
+    /// The path check (chapter 15's BodyContactOptions::check_path, fem_scene --check-path): every
+    /// segment of every contact step's path between bodies, and every step's chord without contact,
+    /// proven free of crossings by a second CCD; a debug mode. docs/scenes.md#bodies-against-bodies
+    bool check_path = false;
 };
 
 /// A whole scene, as read from its file.
@@ -251,6 +255,10 @@ std::vector<std::filesystem::path> input_files(const SceneSpec& scene);
 /// Chapter 10's Scene of one body of a scene: its mesh, material, pinned vertices, damping and mass,
 /// the scene's gravity, Δt and duration.
 dynamics::Scene dynamics_scene(const SceneSpec& scene, const BodySpec& body);
+
+/// Whether the scene has bodies that meet: [contact] bodies with two or more bodies, or a body with
+/// self_contact (what friction between bodies and the path check need). docs/scenes.md#bodies-against-bodies
+bool bodies_meet(const SceneSpec& scene);
 
 /// Whether any step of the scene may need contact: it has obstacles, [contact] bodies with two or
 /// more bodies, or a body with self_contact. docs/scenes.md#bodies-against-bodies

@@ -69,6 +69,10 @@ int main(int argc, char** argv)
     cli.app.add_flag("--html", html,
                      "Also write <scene>.html: one self-contained web page that plays the run (as output.html = true)");
     cli.app.add_flag("--no-progress", no_progress, "No progress bar on stderr (it shows only on a terminal anyway)");
+    bool check_path = false;
+    cli.app.add_flag("--check-path", check_path,
+                     "Debug: prove every segment of every step's path between bodies free of crossings with a second "
+                     "CCD (as [contact] check_path = true); stops at the first crossing, naming it");
     bool view = false;
     std::vector<int> screenshots;
     cli.app.add_flag("--view", view,
@@ -114,6 +118,11 @@ int main(int argc, char** argv)
         for (const std::string& file : files) {
             scenes.push_back(read_scene(file, settings, quick));
             scenes.back().output.html = scenes.back().output.html || html;
+            scenes.back().contact.check_path = scenes.back().contact.check_path || check_path;
+            if (scenes.back().contact.check_path && !bodies_meet(scenes.back()))
+                throw Error(str(file, ": --check-path (or [contact] check_path) checks the pairs between bodies and of a ",
+                                "body against itself, and this scene has none: set [contact] bodies = true with two or ",
+                                "more bodies, or a body's self_contact = true"));
             if (scenes.back().output.html && !compare) {
                 check_web_page_library();
                 cli.writes_entry(scenes.back().file.stem().string() + ".html");
@@ -178,6 +187,9 @@ int main(int argc, char** argv)
         std::cout << result.steps << " steps in " << result.seconds << " s ("
                   << (result.steps > 0 ? 1e3 * result.seconds / result.steps : 0.0) << " ms per step), "
                   << result.frame_count << " frames, " << result.newton_iterations << " Newton iterations\n";
+        if (scenes.front().contact.check_path)
+            std::cout << "path check: " << result.path_segments << " segments of the steps' paths proven free of "
+                      << "crossings (" << result.path_pair_tests << " primitive pair tests)\n";
         stopped = result.interrupted;
     });
     // Stopped: the files so far were published (a valid .pvd); the exit code says by what (128 +

@@ -140,18 +140,13 @@ NewtonBackwardEuler::NewtonBackwardEuler(NewtonOptions options)
 
 namespace {
 
-/// The relative shifts τ newton_direction tries, in turn, when a definite Hessian H does not factor:
-/// H + τ diag(H), from above the direct solvers' pivot test (n ε |h_jj|) up to 1 %.
-constexpr double first_shift = 1e-12, last_shift = 1e-2;
-
 /// d with H d = −gradient for the exact or definite Hessian at x; slope = gradientᵀd. False if the
 /// exact Hessian is not positive definite or gives no descent direction. A definite Hessian is
-/// positive semi-definite by construction (M + Δt² K_PSD + Δt² ∇²P_PSD, M positive definite), but a
-/// sum whose diagonal spans more than a double resolves (a barrier's κ b''(d) at d ≪ d̂ beside a
-/// vertex's mass) can fail a factorization's pivot test by round-off: it is then solved shifted,
-/// (H + τ diag(H)) d = −gradient for the first τ = first_shift, 100 first_shift, … that factors (a
-/// descent direction still: H + τ diag(H) is positive definite). fem::Error in the course's words,
-/// naming problem.what and the diagonal's span, when none up to last_shift does.
+/// positive definite by construction (M + Δt² K_PSD + Δt² ∇²P_PSD, M positive definite); where its
+/// factorization fails all the same, its diagonal spans more than a double resolves (a contact pair
+/// a hair apart, κ b''(d) beside a vertex's mass, which chapter 15's minimum separation prevents) or
+/// a potential's "definite" Hessian is not: fem::Error in the course's words, naming problem.what,
+/// the diagonal's span and what to change, never the factorization's.
 bool newton_direction(const NewtonProblem& problem, cg::LinearSolver& solver, const Eigen::VectorXd& x, bool definite,
                       const Eigen::VectorXd& gradient, Eigen::VectorXd& direction, double& slope, int& iterations)
 {
@@ -162,26 +157,13 @@ bool newton_direction(const NewtonProblem& problem, cg::LinearSolver& solver, co
     } catch (const Error&) {
         if (!definite)
             return false;  // the exact Hessian is indefinite: the caller falls back to the definite one
-        const Eigen::VectorXd diagonal = hessian.diagonal();
-        bool solved = false;
-        for (double shift = first_shift; shift <= last_shift && !solved; shift *= 100.0) {
-            dynamics::SparseMatrix shifted = hessian;
-            for (Eigen::Index i = 0; i < diagonal.size(); ++i)
-                shifted.coeffRef(i, i) += shift * std::abs(diagonal[i]);
-            try {
-                solver.prepare(shifted);
-                direction = solver.solve(-gradient);
-                solved = true;
-            } catch (const Error&) {
-            }
-        }
-        if (!solved)
-            throw Error(str("Newton: ", problem.what, ": the system of the Newton step (mass, stiffness and the ",
-                            "extra potential's Hessian, each made positive semi-definite) could not be solved, even with ",
-                            "its diagonal raised by ", 100.0 * last_shift, " %: its diagonal runs from ",
-                            diagonal.cwiseAbs().minCoeff(), " to ", diagonal.cwiseAbs().maxCoeff(),
-                            ", or holds a value that is not finite; the scene's stiffness (Young's modulus, the ",
-                            "contact's kappa) is beyond what its masses resolve in one step: use a smaller dt"));
+        const Eigen::VectorXd diagonal = hessian.diagonal().cwiseAbs();
+        throw Error(str("Newton: ", problem.what, ": the system of the Newton step (mass, stiffness and the extra ",
+                        "potential's Hessian, each made positive semi-definite) is not positive definite to working ",
+                        "precision: its diagonal runs from ", diagonal.minCoeff(), " to ", diagonal.maxCoeff(),
+                        diagonal.allFinite() ? "" : " and holds a value that is not finite",
+                        "; a stiffness (Young's modulus, the contact's kappa or a pair of surfaces nearly touching) ",
+                        "beyond what the masses resolve in one step: use a smaller dt"));
     }
     iterations += solver.stats().iterations;
     slope = gradient.dot(direction);

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 namespace fem::contact {
@@ -149,6 +150,99 @@ void IntersectionTerm::check(const Eigen::VectorXd& u, double time) const
     check_.require_none(rest_ + u.reshaped<Eigen::RowMajor>(rest_.rows(), 3), time);
 }
 
+PathCheckTerm::PathCheckTerm(const TetMesh& mesh, const BodyContactOptions& options)
+    : pairs_(mesh, options.activation_distance, options.vertex_body, options.body_self_contact),
+      rest_(mesh.V),
+      vertex_body_(options.vertex_body),
+      names_(options.body_names)
+{
+    if (vertex_body_.empty())
+        vertex_body_.assign(static_cast<std::size_t>(mesh.V.rows()), 0);
+    for (int v = 0; v < static_cast<int>(vertex_body_.size()); ++v) {
+        const int body = vertex_body_[std::size_t(v)];
+        if (body >= static_cast<int>(first_vertex_.size()))
+            first_vertex_.resize(std::size_t(body) + 1, -1);
+        if (first_vertex_[std::size_t(body)] < 0)
+            first_vertex_[std::size_t(body)] = v;
+    }
+    if (!names_.empty() && names_.size() != first_vertex_.size())
+        throw Error(str("path check: ", names_.size(), " body names for ", first_vertex_.size(), " bodies"));
+}
+
+std::string PathCheckTerm::body_name(int vertex) const
+{
+    const int body = vertex_body_[std::size_t(vertex)];
+    return names_.empty() ? str("body ", body) : str("body '", names_[std::size_t(body)], "'");
+}
+
+int PathCheckTerm::own_number(int vertex) const
+{
+    return vertex - first_vertex_[std::size_t(vertex_body_[std::size_t(vertex)])];
+}
+
+void PathCheckTerm::check_segment(const Eigen::VectorXd& from, const Eigen::VectorXd& to, const std::string& which) const
+{
+    const MatrixX3d start = rest_ + from.reshaped<Eigen::RowMajor>(rest_.rows(), 3);
+    const MatrixX3d end = rest_ + to.reshaped<Eigen::RowMajor>(rest_.rows(), 3);
+    const CandidatePairs candidates = pairs_.kept(tree_candidates(pairs_.surface(), start, end, 0.0));
+    const SegmentCrossing crossing = first_crossing_on_segment(pairs_.surface(), candidates, start, end, &pair_tests_);
+    ++segments_;
+    if (!crossing.found())
+        return;
+    const int* v = crossing.vertices;
+    const std::string pair =
+        crossing.kind == PrimitivePair::point_triangle
+            ? str(body_name(v[0]), " vertex ", own_number(v[0]), " and ", body_name(v[1]), " triangle (",
+                  own_number(v[1]), ", ", own_number(v[2]), ", ", own_number(v[3]), ")")
+            : str(body_name(v[0]), " edge (", own_number(v[0]), ", ", own_number(v[1]), ") and ", body_name(v[2]),
+                  " edge (", own_number(v[2]), ", ", own_number(v[3]), ")");
+    throw Error(str("path check: step ", step_, " (t = ", time_, " s), ", which, ": ", pair,
+                    crossing.proven ? str(" meet at ", crossing.time, " of it")
+                                    : str(" could not be proven apart on it (the inclusion CCD stopped at ",
+                                          path_check_boxes, " boxes)"),
+                    " (each body's own vertex numbers): the line search's collision check let the step cross them; ",
+                    "a bug of the contact code to report with the scene"));
+}
+
+void PathCheckTerm::begin_step(const ContactStepStart& start)
+{
+    if (!path_.empty() && last_checked_.size() == path_.back().size() && last_checked_ != path_.back())
+        check_segment(path_.back(), last_checked_, str("segment ", path_.size(), " of a solve's path (to its end)"));
+    path_ = {start.state.u};
+    step_ = start.state.step + 1;
+    time_ = start.state.time + start.time_step;
+}
+
+void PathCheckTerm::check(const Eigen::VectorXd& u, double /*time*/) const { last_checked_ = u; }
+
+double PathCheckTerm::time_of_impact(const Eigen::VectorXd& u, const Eigen::VectorXd& /*du*/, double /*time*/,
+                                     double /*end_time*/) const
+{
+    if (!path_.empty() && u != path_.back()) {
+        check_segment(path_.back(), u,
+                      str("segment ", path_.size(), " of its path (", path_.size() == 1 ? str("the step's start") : str("iterate ", path_.size() - 1),
+                          " to iterate ", path_.size(), ")"));
+        path_.push_back(u);
+    }
+    return std::numeric_limits<double>::infinity();
+}
+
+void PathCheckTerm::end_step(const Eigen::VectorXd& u_end) const
+{
+    if (!path_.empty() && u_end != path_.back())
+        check_segment(path_.back(), u_end,
+                      str("segment ", path_.size(), " of its path (",
+                          path_.size() == 1 ? str("the step's start") : str("iterate ", path_.size() - 1), " to its end)"));
+    path_.clear();
+}
+
+void PathCheckTerm::check_chord(const Eigen::VectorXd& u, const Eigen::VectorXd& u_end, int step, double time) const
+{
+    step_ = step;
+    time_ = time;
+    check_segment(u, u_end, "its step without contact (one straight segment)");
+}
+
 std::vector<std::unique_ptr<ContactTerm>> body_contact_terms(const dynamics::Body& body,
                                                              const std::vector<std::shared_ptr<const Obstacle>>& obstacles,
                                                              const BodyContactOptions& options)
@@ -170,6 +264,12 @@ std::vector<std::unique_ptr<ContactTerm>> body_contact_terms(const dynamics::Bod
         terms.push_back(std::make_unique<BodyContactTerm>(body.mesh(), options));
     if (options.check_intersections)
         terms.push_back(std::make_unique<IntersectionTerm>(body.mesh(), obstacles, options.self_contact));
+    if (options.check_path) {
+        if (!options.self_contact)
+            throw Error("contact: the path check (check_path) checks the pairs between bodies and of a body against "
+                        "itself: it needs self-contact on");
+        terms.push_back(std::make_unique<PathCheckTerm>(body.mesh(), options));
+    }
     return terms;
 }
 

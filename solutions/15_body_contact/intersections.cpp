@@ -1,6 +1,8 @@
 // Chapter 15: the intersection check (intersections.hpp). docs/15_body_contact.md#never-an-intersection
 #include "15_body_contact/intersections.hpp"
 
+#include "15_body_contact/pair_barrier.hpp"
+
 #include "13_skinning/skinning.hpp"
 
 #include "common/error.hpp"
@@ -132,6 +134,84 @@ EdgeThroughTriangle first_edge_through_triangle(const MatrixX3d& x, const Eigen:
                 return {static_cast<int>(e), t};
         }
     }
+    return crossing;
+}
+
+namespace {
+
+/// Whether the distance bound of first_crossing_on_segment proves the primitives of motion apart on
+/// the whole of [0, 1] (header).
+bool apart_by_distance_bound(PrimitivePair kind, const PrimitiveMotion& motion)
+{
+    double first_move = 0.0, second_move = 0.0;
+    const int split = kind == PrimitivePair::point_triangle ? 1 : 2;
+    for (int k = 0; k < 4; ++k) {
+        double& side = k < split ? first_move : second_move;
+        side = std::max(side, (motion.end.col(k) - motion.start.col(k)).norm());
+    }
+    const double speed = first_move + second_move;
+    const auto distance = [&](double s) { return std::sqrt(squared_distance_at(kind, motion, s)); };
+    struct Piece {
+        double a, b, d_a, d_b;
+    };
+    std::vector<Piece> pieces = {{0.0, 1.0, distance(0.0), distance(1.0)}};
+    for (int evaluated = 0; !pieces.empty();) {
+        const Piece piece = pieces.back();
+        pieces.pop_back();
+        const double change = speed * (piece.b - piece.a);
+        // Round-off of the distances: 10⁻¹² of the sizes compared.
+        if (piece.d_a + piece.d_b - change > 1e-12 * (piece.d_a + piece.d_b + change))
+            continue;
+        if (++evaluated > path_check_pieces || !(piece.d_a > 0.0 && piece.d_b > 0.0))
+            return false;
+        const double middle = 0.5 * (piece.a + piece.b), d_middle = distance(middle);
+        pieces.push_back({middle, piece.b, d_middle, piece.d_b});
+        pieces.push_back({piece.a, middle, piece.d_a, d_middle});
+    }
+    return true;
+}
+
+}  // namespace
+
+SegmentCrossing first_crossing_on_segment(const SurfacePrimitives& surface, const CandidatePairs& candidates,
+                                          const MatrixX3d& start, const MatrixX3d& end, long long* tested)
+{
+    if (start.rows() != end.rows())
+        throw Error(str("path check: the segment's start has ", start.rows(), " vertices, its end ", end.rows()));
+    SegmentCrossing crossing;
+    PrimitiveMotion motion;
+    const auto meets = [&](PrimitivePair kind, const int (&v)[4]) {
+        for (int k = 0; k < 4; ++k) {
+            motion.start.col(k) = start.row(v[k]).transpose();
+            motion.end.col(k) = end.row(v[k]).transpose();
+        }
+        if (tested != nullptr)
+            ++*tested;
+        // Cleared first where it is cheap: every point of a primitive moves at most as far as its
+        // farthest vertex, so on [a, b] the distance changes at most M (b − a), M = the first's
+        // farthest move + the second's, and stays ≥ (d(a) + d(b) − M (b − a))/2 > 0 when that is
+        // positive; [0, 1] is bisected (at most path_check_pieces pieces) until every piece is.
+        if (apart_by_distance_bound(kind, motion))
+            return false;
+        const CcdResult inclusion =
+            inclusion_ccd(kind, motion, {.tolerance = path_check_tolerance, .max_boxes = path_check_boxes});
+        const CcdResult cubic = cubic_ccd(kind, motion);
+        if (!inclusion.collides && !cubic.collides)
+            return false;
+        crossing.kind = kind;
+        std::copy(v, v + 4, crossing.vertices);
+        crossing.time = std::min(inclusion.time_of_impact, cubic.time_of_impact);
+        crossing.proven = !inclusion.stopped_at_limit || cubic.collides;
+        return true;
+    };
+    for (const auto& [vertex, triangle] : candidates.point_triangle)
+        if (meets(PrimitivePair::point_triangle, {vertex, surface.triangles(triangle, 0), surface.triangles(triangle, 1),
+                                                  surface.triangles(triangle, 2)}))
+            return crossing;
+    for (const auto& [first, second] : candidates.edge_edge)
+        if (meets(PrimitivePair::edge_edge, {surface.edges(first, 0), surface.edges(first, 1), surface.edges(second, 0),
+                                             surface.edges(second, 1)}))
+            return crossing;
     return crossing;
 }
 

@@ -236,13 +236,16 @@ double SelfContactBarrier::time_of_impact(const Eigen::VectorXd& u, const Eigen:
             side_low = side_low.cwiseMin(low.row(v[k]));
             side_high = side_high.cwiseMax(high.row(v[k]));
         }
-        if ((first_low.array() > second_high.array()).any() || (second_low.array() > first_high.array()).any())
-            return;  // swept boxes apart: no impact
+        // Swept boxes more than the smallest gap apart (line_search_time_of_impact): no impact, and
+        // no end nearer than the gap.
+        const double gap = 0.1 * activation_distance_;
+        if ((first_low.array() > second_high.array() + gap).any() || (second_low.array() > first_high.array() + gap).any())
+            return;
         for (int k = 0; k < 4; ++k) {
             motion.start.col(k) = x0.row(v[k]).transpose();
             motion.end.col(k) = x1.row(v[k]).transpose();
         }
-        earliest = std::min(earliest, line_search_time_of_impact(kind, motion));
+        earliest = std::min(earliest, line_search_time_of_impact(kind, motion, activation_distance_));
     };
     for (const auto& [vertex, triangle] : candidates.point_triangle) {
         const auto corners = surface_.triangles.row(triangle);

@@ -10,6 +10,8 @@
 #include "scenes/scene_conditions.hpp"
 #include "scenes/scene_group.hpp"
 
+#include "15_body_contact/body_contact.hpp"
+
 #include "12_hyperelastic_newton/force_models.hpp"
 
 #include "common/error.hpp"
@@ -237,6 +239,9 @@ std::unique_ptr<GroupRun> start_group(std::vector<BodyRun>& bodies, const std::v
         // In a group: the member of each vertex, and which members hold themselves off.
         std::vector<int> vertex_body;
         std::vector<bool> self_contacts;
+        std::vector<std::string> names;
+        for (const BodyRun* m : g->members)
+            names.push_back(m->spec->name);
         if (joined)
             for (std::size_t m = 0; m < g->members.size(); ++m) {
                 vertex_body.insert(vertex_body.end(), static_cast<std::size_t>(g->members[m]->spec->mesh.V.rows()),
@@ -244,7 +249,7 @@ std::unique_ptr<GroupRun> start_group(std::vector<BodyRun>& bodies, const std::v
                 self_contacts.push_back(g->members[m]->spec->self_contact);
             }
         g->contact = std::make_unique<ContactIntegrator>(*g->integrator, levels, *g->body, obstacles, scene, self_contact,
-                                                         std::move(vertex_body), std::move(self_contacts));
+                                                         std::move(vertex_body), std::move(self_contacts), std::move(names));
     }
     std::vector<SceneConditions> conditions;
     for (BodyRun* b : g->members) {
@@ -302,8 +307,19 @@ void record_members(GroupRun& g)
 /// One step of a group, with each member's record and the segment of the model it used.
 void step_group(GroupRun& g)
 {
+    // The path check ([contact] check_path): a contact step's path closed at its end, a step without
+    // contact checked as its one straight segment.
+    const contact::PathCheckTerm* path = g.contact ? g.contact->potential().term<contact::PathCheckTerm>() : nullptr;
+    const Eigen::VectorXd start = path != nullptr ? g.simulation->state().u : Eigen::VectorXd();
     try {
         g.simulation->run(1);
+        if (path != nullptr) {
+            const dynamics::State& end = g.simulation->state();
+            if (g.contact->last_contact())
+                path->end_step(end.u);
+            else
+                path->check_chord(start, end.u, end.step, end.time);
+        }
     } catch (const Error& e) {
         throw Error(str(g.names(), ": ", e.what()));
     }
@@ -519,6 +535,11 @@ RunResult run_scene(const SceneSpec& scene, const RunOptions& options)
     for (BodyRun& b : running.bodies) {
         result.segments.push_back(b.segments);
         result.contact_steps.push_back(b.group->contact ? b.group->contact->contact_steps() : 0);
+        if (const auto* path = b.group->contact ? b.group->contact->potential().term<contact::PathCheckTerm>() : nullptr;
+            path != nullptr && b.group->members.front() == &b) {
+            result.path_segments += path->segments();
+            result.path_pair_tests += path->pair_tests();
+        }
         result.records.push_back(std::move(b.records));
     }
     if (options.print_models)

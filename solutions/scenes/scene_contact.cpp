@@ -22,7 +22,7 @@ std::vector<std::shared_ptr<const contact::Obstacle>> scene_obstacles(const Scen
 namespace {
 
 contact::BodyContactOptions contact_options(const SceneSpec& scene, bool self_contact, std::vector<int> vertex_body,
-                                            std::vector<bool> self_contacts)
+                                            std::vector<bool> self_contacts, std::vector<std::string> body_names)
 {
     contact::BodyContactOptions options;
     options.self_contact = self_contact;
@@ -31,6 +31,8 @@ contact::BodyContactOptions contact_options(const SceneSpec& scene, bool self_co
     options.body_friction = self_contact ? scene.contact.friction : 0.0;
     options.activation_distance = scene.contact.activation_distance;
     options.friction_velocity = scene.contact.friction_velocity;
+    options.check_path = self_contact && scene.contact.check_path;
+    options.body_names = std::move(body_names);
     return options;
 }
 
@@ -55,13 +57,13 @@ ContactIntegrator::ContactIntegrator(dynamics::Integrator& own, std::vector<Scen
                                      const dynamics::Body& body,
                                      std::vector<std::shared_ptr<const contact::Obstacle>> obstacles,
                                      const SceneSpec& scene, bool self_contact, std::vector<int> vertex_body,
-                                     std::vector<bool> self_contacts)
+                                     std::vector<bool> self_contacts, std::vector<std::string> body_names)
     : own_(own),
       levels_(std::move(levels)),
       obstacles_(obstacles),
       potential_(std::make_unique<contact::ContactPotential>(contact::body_contact_potential(
           body, std::move(obstacles),
-          contact_options(scene, self_contact, std::move(vertex_body), std::move(self_contacts))))),
+          contact_options(scene, self_contact, std::move(vertex_body), std::move(self_contacts), std::move(body_names))))),
       newton_(contact_newton_options(scene, &solver_)),
       surface_(contact::surface_primitives(body.mesh())),
       rest_(body.mesh().V)

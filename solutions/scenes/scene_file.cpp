@@ -208,10 +208,11 @@ void read_contact(const Fields& top, SceneSpec& scene)
     if (contact_table == nullptr)
         return;
     const Fields c(*contact_table, "contact", top.source(),
-                   {"activation_distance", "friction_velocity", "bodies", "friction"});
+                   {"activation_distance", "friction_velocity", "bodies", "friction", "check_path"});
     scene.contact.activation_distance = c.positive("activation_distance", scene.contact.activation_distance);
     scene.contact.friction_velocity = c.positive("friction_velocity", scene.contact.friction_velocity);
     scene.contact.bodies = c.flag("bodies", scene.contact.bodies);
+    scene.contact.check_path = c.flag("check_path", scene.contact.check_path);
     scene.contact.friction =
         c.number("friction", scene.contact.friction, [](double mu) { return mu >= 0.0 && mu <= 10.0; }, "a number in [0, 10]");
 }
@@ -226,15 +227,16 @@ void read_contact(const Fields& top, SceneSpec& scene)
 /// bodies only where bodies meet. docs/scenes.md#obstacles
 void check_contact_scales(const Fields& top, const SceneSpec& scene)
 {
-    const bool between_bodies = (scene.contact.bodies && scene.bodies.size() >= 2) ||
-                                std::any_of(scene.bodies.begin(), scene.bodies.end(), [](const BodySpec& b) { return b.self_contact; });
-    if (scene.contact.friction > 0.0 && !between_bodies) {  // a setting never silently ignored
-        const toml::table* given = top.subtable("contact");
-        Fields(*given, "contact", top.source(), {})
-            .fail(*given->get("friction"), "friction",
-                  "friction between bodies needs bodies that meet: [contact] bodies = true with two or more bodies, "
-                  "or a body's self_contact = true");
-    }
+    for (const char* key : {"friction", "check_path"})  // a setting never silently ignored
+        if ((std::string(key) == "friction" ? scene.contact.friction > 0.0 : scene.contact.check_path) &&
+            !bodies_meet(scene)) {
+            const toml::table* given = top.subtable("contact");
+            Fields(*given, "contact", top.source(), {})
+                .fail(*given->get(key), key,
+                      str(key == std::string("friction") ? "friction between bodies" : "the path check",
+                          " needs bodies that meet: [contact] bodies = true with two or more bodies, or a body's "
+                          "self_contact = true"));
+        }
     if (!has_contact(scene))
         return;
     double size = std::numeric_limits<double>::infinity();
@@ -386,10 +388,15 @@ std::vector<std::filesystem::path> input_files(const SceneSpec& scene)
     return files;
 }
 
+bool bodies_meet(const SceneSpec& scene)
+{
+    return (scene.contact.bodies && scene.bodies.size() >= 2) ||
+           std::any_of(scene.bodies.begin(), scene.bodies.end(), [](const BodySpec& b) { return b.self_contact; });
+}
+
 bool has_contact(const SceneSpec& scene)
 {
-    return !scene.obstacles.empty() || (scene.contact.bodies && scene.bodies.size() >= 2) ||
-           std::any_of(scene.bodies.begin(), scene.bodies.end(), [](const BodySpec& b) { return b.self_contact; });
+    return !scene.obstacles.empty() || bodies_meet(scene);
 }
 
 dynamics::Scene dynamics_scene(const SceneSpec& scene, const BodySpec& body)

@@ -162,11 +162,41 @@ void check_start_gaps(const SceneSpec& scene)
         return out + ")";
     };
     const auto at = [&](int v) -> Eigen::Vector3d { return mesh.V.row(v).transpose(); };
+    // Bodies closer than d̂ would feel the barrier at rest: the gap must grow by d̂ − d. A smaller d̂
+    // helps only when they do not touch (d > 0).
     const auto refuse = [&](const std::string& what, double distance) {
         throw Error(str(scene.file.string(), ": ", what, " is ", distance, " m away, closer than d̂ = ", d_hat,
-                        " m ([contact] activation_distance): bodies must start at least d̂ apart (move them apart or "
-                        "set a smaller d̂)"));
+                        " m ([contact] activation_distance): bodies must start at least d̂ apart; move them apart by at "
+                        "least ", d_hat - distance, " m (d̂ minus the gap)",
+                        distance > 0.0 ? str(", or set d̂ below the gap, ", distance, " m") : std::string(
+                            " (they touch: no smaller d̂ helps)")));
     };
+    // Pierced or nested first: their pairs are 0 m apart, and the advice differs.
+    const contact::EdgeThroughTriangle crossing =
+        contact::first_edge_through_triangle(mesh.V, surface.edges, surface.triangles, owner.body);
+    if (crossing.found()) {
+        const int e0 = surface.edges(crossing.edge, 0), e1 = surface.edges(crossing.edge, 1);
+        const auto tri = surface.triangles.row(crossing.triangle);
+        throw Error(str(scene.file.string(), ": ", name(e0), " and ", name(tri(0)), " start intersecting: ", name(e0),
+                        " edge ", local({e0, e1}), " passes through ", name(tri(0)), " triangle ",
+                        local({tri(0), tri(1), tri(2)}), " (each body's own vertex numbers); move them apart until ",
+                        "no surface crosses the other and they are at least d̂ = ", d_hat, " m apart"));
+    }
+    // A body wholly inside another crosses no surface: its first surface vertex against each other body.
+    for (std::size_t i = 0; i < scene.bodies.size(); ++i)
+        for (std::size_t j = 0; j < scene.bodies.size(); ++j) {
+            if (i == j)
+                continue;
+            const TetMesh& inner = scene.bodies[i].mesh;
+            const TetMesh& outer = scene.bodies[j].mesh;
+            const TriMesh outer_surface{outer.V, skin::boundary_faces(outer).faces};
+            const int first = contact::surface_primitives(inner).vertices.front();
+            if (skin::winding_number(outer_surface, inner.V.row(first).transpose()) > 0.5)
+                throw Error(str(scene.file.string(), ": body '", scene.bodies[i].name, "' vertex ", first,
+                                " starts inside body '", scene.bodies[j].name, "' (body '", scene.bodies[i].name,
+                                "' lies wholly inside it): move them apart until they are at least d̂ = ", d_hat,
+                                " m apart"));
+        }
     const contact::CandidatePairs pairs = contact::tree_candidates(surface, mesh.V, mesh.V, d_hat);
     for (const auto& [v, t] : pairs.point_triangle) {
         const auto tri = surface.triangles.row(t);
@@ -189,26 +219,6 @@ void check_start_gaps(const SceneSpec& scene)
         if (d < d_hat)
             refuse(str(name(a0), " edge ", local({a0, a1}), " from ", name(b0), " edge ", local({b0, b1})), d);
     }
-    const contact::EdgeThroughTriangle crossing =
-        contact::first_edge_through_triangle(mesh.V, surface.edges, surface.triangles, owner.body);
-    if (crossing.found())
-        throw Error(str(scene.file.string(), ": the bodies start intersecting (",
-                        contact::describe(crossing, surface.edges, surface.triangles),
-                        " in the joined numbering): bodies must start at least d̂ apart"));
-    // A body wholly inside another crosses no surface: its first surface vertex against each other body.
-    for (std::size_t i = 0; i < scene.bodies.size(); ++i)
-        for (std::size_t j = 0; j < scene.bodies.size(); ++j) {
-            if (i == j)
-                continue;
-            const TetMesh& inner = scene.bodies[i].mesh;
-            const TetMesh& outer = scene.bodies[j].mesh;
-            const TriMesh outer_surface{outer.V, skin::boundary_faces(outer).faces};
-            const int first = contact::surface_primitives(inner).vertices.front();
-            if (skin::winding_number(outer_surface, inner.V.row(first).transpose()) > 0.5)
-                throw Error(str(scene.file.string(), ": body '", scene.bodies[i].name, "' vertex ", first,
-                                " starts inside body '", scene.bodies[j].name,
-                                "': bodies must start at least d̂ apart"));
-        }
 }
 
 void check_groups_apart(const SceneSpec& scene, const std::vector<std::vector<int>>& groups,

@@ -14,6 +14,7 @@
 #include "common/mesh.hpp"
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include <memory>
 #include <utility>
@@ -38,6 +39,31 @@ inline TetMesh box_at(const Eigen::Vector3d& corner, const Eigen::Vector3d& size
     TetMesh box = box_mesh(cells, cells, cells, size);
     box.V.rowwise() += corner.transpose();
     return box;
+}
+
+/// Bodies in one mesh (several components) and their start velocity (3n).
+struct ThrownBodies {
+    TetMesh mesh;
+    Eigen::VectorXd velocity;
+};
+
+/// A free plate one tet thick (0.2 × 0.2 m, 8 × 8 cells, thickness [m], its top face at z = 0) and a
+/// one-cell block of edge 5 cm turned by turn [rad] about x (π/4: on its edge), its lowest point
+/// 2 mm above the plate, its centre over the plate's, the block moving down at speed [m/s]: one mesh,
+/// the plate's vertices first. The block's corners lie over the plate's vertices and grid lines.
+inline ThrownBodies block_over_plate(double speed, double thickness = 0.002, double turn = 0.0)
+{
+    TetMesh plate = box_mesh(8, 8, 1, Eigen::Vector3d(0.2, 0.2, thickness));
+    plate.V.rowwise() -= Eigen::RowVector3d(0.1, 0.1, thickness);
+    TetMesh block = box_at(Eigen::Vector3d::Constant(-0.025), Eigen::Vector3d::Constant(0.05));
+    const Eigen::Matrix3d rotation = Eigen::AngleAxisd(turn, Eigen::Vector3d::UnitX()).toRotationMatrix();
+    block.V = (block.V * rotation.transpose()).eval();
+    block.V.col(2).array() += 0.002 - block.V.col(2).minCoeff();
+    ThrownBodies scene{two_bodies(plate, block), {}};
+    scene.velocity = Eigen::VectorXd::Zero(3 * scene.mesh.V.rows());
+    for (Eigen::Index v = plate.V.rows(); v < scene.mesh.V.rows(); ++v)
+        scene.velocity[3 * v + 2] = -speed;
+    return scene;
 }
 
 /// The scene of bodies thrown at each other: mesh of a soft rubber (Y = 10⁵ Pa, ν = 0.3, ρ = 1000

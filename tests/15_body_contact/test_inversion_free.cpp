@@ -177,18 +177,12 @@ struct BodiesRun {
     }
 };
 
-/// Bodies in one mesh (several components) and their start velocity (3n).
-struct ThrownBodies {
-    TetMesh mesh;
-    Eigen::VectorXd velocity;
-};
-
 /// Two soft cubes of edge 0.1 m, 2³ cells each, 1 cm apart along x (the second offset by 1.3 and
 /// 2.1 cm across), thrown at each other at ±speed.
 
-ThrownBodies head_on(double speed, const Eigen::Vector3d& offset = Eigen::Vector3d(0.11, 0.013, 0.021))
+test::ThrownBodies head_on(double speed, const Eigen::Vector3d& offset = Eigen::Vector3d(0.11, 0.013, 0.021))
 {
-    ThrownBodies scene{test::two_bodies(test::box_at(Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(0.1), 2),
+    test::ThrownBodies scene{test::two_bodies(test::box_at(Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(0.1), 2),
                                   test::box_at(offset, Eigen::Vector3d::Constant(0.1), 2)),
                  {}};
     const Eigen::Index half = scene.mesh.V.rows() / 2;
@@ -198,30 +192,16 @@ ThrownBodies head_on(double speed, const Eigen::Vector3d& offset = Eigen::Vector
     return scene;
 }
 
-/// A free plate 2 mm thick, one tet thick (0.2 × 0.2 m, 8 × 8 cells, its top face at z = 0), and a
-/// one-cell block of edge 5 cm resting flat 2 mm above it, the block moving down at speed [m/s]: one
-/// mesh, the plate's vertices first.
-ThrownBodies block_over_plate(double speed)
-{
-    TetMesh plate = box_mesh(8, 8, 1, Eigen::Vector3d(0.2, 0.2, 0.002));
-    plate.V.rowwise() -= Eigen::RowVector3d(0.1, 0.1, 0.002);
-    const TetMesh block = test::box_at(Eigen::Vector3d(-0.025, -0.025, 0.002), Eigen::Vector3d::Constant(0.05));
-    ThrownBodies scene{test::two_bodies(plate, block), {}};
-    scene.velocity = Eigen::VectorXd::Zero(3 * scene.mesh.V.rows());
-    for (Eigen::Index v = plate.V.rows(); v < scene.mesh.V.rows(); ++v)
-        scene.velocity[3 * v + 2] = -speed;
-    return scene;
-}
-
 }  // namespace
 
 TEST_CASE("a block meeting a free plate one tet thick at 2 m/s runs: Newton's system never fails in the "
           "factorization's words", "[ex15.5][slow]")
 {
-    // At Δt = 1/1000 s the block's free flight ends exactly on the plate: the barrier's Hessian at a
-    // distance far below d̂ beside the plate's vertex masses made the definite system fail chapter 08's
-    // pivot test at step 1 ("sparse Cholesky: … the pivot of column …"). Newton solves it shifted.
-    const ThrownBodies scene = block_over_plate(2.0);
+    // At Δt = 1/1000 s the block's free flight ends exactly on the plate: before the minimum
+    // separation (test_minimum_separation.cpp) the step's start left a block edge 1.7·10⁻¹⁸ m from a
+    // plate edge, whose barrier Hessian (10³²) made the definite system fail chapter 08's pivot test at
+    // step 1 ("sparse Cholesky: … the pivot of column …").
+    const test::ThrownBodies scene = test::block_over_plate(2.0);
     BodiesRun run(scene.mesh, scene.velocity, 1.0 / 1000.0, "stable-neo-hookean");
     const std::string error = run.run(30);
     CAPTURE(error);
@@ -278,7 +258,7 @@ TEST_CASE("two soft bodies head-on at 50 m/s: neo-Hookean runs with every tet up
     // Δt = 1/10000 s: 1 cm of approach a step (at 1/400 s, 25 cm a step, 2.5 times the cubes' edge,
     // they are found on either side of each other after one step: a limit of the bodies' CCD that
     // this test does not cover).
-    const ThrownBodies scene = head_on(50.0);
+    const test::ThrownBodies scene = head_on(50.0);
     const double time_step = 1.0 / 10000.0;
     BodiesRun stable(scene.mesh, scene.velocity, time_step, "stable-neo-hookean");
     const std::string refusal = stable.run(200);

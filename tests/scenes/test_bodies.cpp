@@ -245,8 +245,54 @@ TEST_CASE("bodies that start closer than d-hat or intersecting are refused, nami
                           Catch::Contains("closer than d̂ = 0.001 m"));
     CHECK_THROWS_WITH(check_start_gaps(scene_at("gap_small", 0.1005, "[0.1, 0.1, 0.1]")),
                       Catch::Contains("vertex") || Catch::Contains("edge"));
-    // Overlapping by 2 cm: every surface pair far from the other's, but edges cross faces.
-    CHECK_THROWS_WITH(check_start_gaps(scene_at("overlap", 0.08, "[0.1, 0.1, 0.1]")), Catch::Contains("bod"));
+    // The advice helps: apart by d̂ − 0.5 mm = 0.5 mm, or a d̂ below the gap; followed, both pass.
+    CHECK_THROWS_WITH(check_start_gaps(scene_at("gap_small", 0.1005, "[0.1, 0.1, 0.1]")),
+                      Catch::Contains("move them apart by at least 0.0005 m") &&
+                          Catch::Contains("or set d̂ below the gap, 0.0005 m"));
+    CHECK_NOTHROW(check_start_gaps(scene_at("gap_moved", 0.1005 + 0.0005, "[0.1, 0.1, 0.1]")));
+    SceneSpec smaller = scene_at("gap_smaller", 0.1005, "[0.1, 0.1, 0.1]");
+    smaller.contact.activation_distance = 0.0004;
+    CHECK_NOTHROW(check_start_gaps(smaller));
+    // Touching (faces in one plane, 0 m): no d̂ helps, and the refusal does not offer one; moved by
+    // the d̂ it names, they pass.
+    CHECK_THROWS_WITH(check_start_gaps(scene_at("touching", 0.1, "[0.1, 0.1, 0.1]")),
+                      Catch::Contains("body 'a'") && Catch::Contains("body 'b'") && !Catch::Contains("set d̂") &&
+                          (Catch::Contains("move them apart by at least 0.001 m") ||
+                           Catch::Contains("at least d̂ = 0.001 m apart")));
+    CHECK_NOTHROW(check_start_gaps(scene_at("touching_moved", 0.1 + 0.001, "[0.1, 0.1, 0.1]")));
+    // Overlapping by 2 cm: edges cross faces. Both bodies named, each with its own vertex numbers:
+    // b's vertices count from 0 in b (a has 8), so no number of b's reaches 8.
+    const std::string pierced = [&] {
+        try {
+            check_start_gaps(scene_at("overlap", 0.08, "[0.1, 0.1, 0.1]"));
+        } catch (const Error& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    }();
+    CAPTURE(pierced);
+    CHECK_THAT(pierced, Catch::Contains("body 'a' and body 'b' start intersecting") ||
+                            Catch::Contains("body 'b' and body 'a' start intersecting"));
+    CHECK_THAT(pierced, Catch::Contains("own vertex numbers") && !Catch::Contains("joined numbering") &&
+                            !Catch::Contains("set") && Catch::Contains("move them apart"));
+    const auto numbers = [&](const std::string& after) {  // the vertex numbers in the "(i, j, …)" after `after`
+        std::vector<int> found;
+        std::size_t at = pierced.find(after);
+        REQUIRE(at != std::string::npos);
+        at = pierced.find('(', at);
+        for (std::size_t end = pierced.find(')', at); at < end;) {
+            found.push_back(std::stoi(pierced.substr(at + 1)));
+            at = pierced.find_first_of(",)", at + 1);
+            if (pierced[at] == ')')
+                break;
+        }
+        return found;
+    };
+    for (const std::string& primitive : {std::string(" edge "), std::string(" triangle ")})
+        for (int v : numbers(primitive)) {
+            CHECK(v >= 0);
+            CHECK(v < 8);  // a one-cell box has 8 vertices
+        }
     // A small block wholly inside the other: no surface near another, one inside it.
     const SceneSpec inside = testing::scene_from(
         "inside", two_bodies(str("name = \"a\"\nmesh = { generator = \"box\", size = [0.1, 0.1, 0.1] }\n", rubber),
