@@ -2,7 +2,11 @@
 #
 # Registers chapter NN_name, the one way a chapter enters the build:
 #   fem_chNN            its library: the chapter's functions, compiled from solutions/NN_name
-#                       (default) or exercises/NN_name (when NN is in FEM_EXERCISES or it is "all");
+#                       (default) or exercises/NN_name (when NN is in FEM_EXERCISES or it is "all"),
+#                       from two object libraries: fem_chNN_exercises (the files with an exercise
+#                       region, a student's stubs in a build from exercises/; the target
+#                       fem_exercise_files builds every chapter's) and fem_chNN_plain (the other
+#                       files, compiled once and shared with the reference and graded twins);
 #   fem_chNN_own        with OWN files: those files, on top of fem_chNN (below);
 #   fem_chNN_reference  what later chapters link: always the reference solution, so a student
 #                       working on chapter 05 keeps chapters 06+ running;
@@ -33,7 +37,7 @@
 
 set(FEM_ALL_CHAPTERS "" CACHE INTERNAL "registered chapters")
 add_custom_target(fem_tests)
-add_custom_target(fem_chapter_libs)
+add_custom_target(fem_exercise_files)
 if(FEM_GRADING)
   add_custom_target(fem_graded_tests)
 endif()
@@ -93,6 +97,38 @@ function(fem_reference_code target)
   endif()
 endfunction()
 
+# fem_chapter_files(out_var folder_rule file_name...): the paths of a chapter's files, for
+# fem_add_chapter (reads its ${id}): each from solutions/NN_name, or with folder_rule "student" a
+# file with an exercise region from exercises/NN_name (the student's copy).
+function(fem_chapter_files out_var folder_rule)
+  set(paths "")
+  foreach(file_name IN LISTS ARGN)
+    if(folder_rule STREQUAL "student" AND EXISTS ${FEM_ROOT}/exercises/${id}/${file_name})
+      list(APPEND paths ${FEM_ROOT}/exercises/${id}/${file_name})
+    else()
+      list(APPEND paths ${FEM_ROOT}/solutions/${id}/${file_name})
+    endif()
+  endforeach()
+  set(${out_var} ${paths} PARENT_SCOPE)
+endfunction()
+
+# fem_chapter_library(target STATIC|OBJECT sources...): a library of the chapter's code, for
+# fem_add_chapter (reads its ${CH_DEPENDS} and ${plain_objects}): the sources (a static library: and
+# the chapter's shared plain objects), its headers, fem_common and the reference of each chapter it
+# depends on.
+function(fem_chapter_library target type)
+  if(type STREQUAL "OBJECT")
+    add_library(${target} OBJECT ${ARGN})
+  else()
+    add_library(${target} STATIC ${ARGN} ${plain_objects})
+  endif()
+  target_include_directories(${target} PUBLIC ${FEM_ROOT}/chapters)
+  target_link_libraries(${target} PUBLIC fem_common PRIVATE fem_flags)
+  foreach(dep IN LISTS CH_DEPENDS)
+    target_link_libraries(${target} PUBLIC fem_ch${dep}_reference)
+  endforeach()
+endfunction()
+
 function(fem_add_chapter number name)
   cmake_parse_arguments(PARSE_ARGV 2 CH "" "" "DEPENDS;OWN")
   set(id ${number}_${name})
@@ -114,55 +150,72 @@ function(fem_add_chapter number name)
   set(from_exercises OFF)
   if(FEM_EXERCISES STREQUAL "all" OR number IN_LIST FEM_EXERCISES)
     set(from_exercises ON)
+    message(STATUS "chapter ${number}: from exercises/ (your code; later chapters keep the reference solution)")
   endif()
 
-  if(from_exercises)
-    message(STATUS "chapter ${number}: from exercises/ (your code; later chapters keep the reference solution)")
-    set(sources "")
-    # exercises/ holds the files with an exercise region (tools/exercises.py generate); the others
-    # are compiled from solutions/.
-    foreach(src IN LISTS solution_sources)
-      get_filename_component(file_name ${src} NAME)
-      if(EXISTS ${FEM_ROOT}/exercises/${id}/${file_name})
-        list(APPEND sources ${FEM_ROOT}/exercises/${id}/${file_name})
-      else()
-        list(APPEND sources ${src})
-      endif()
-    endforeach()
-  else()
-    set(sources ${solution_sources})
-  endif()
-  # The OWN files apart: `own_sources` for fem_chNN_own, the rest for fem_chNN (and its reference).
-  set(own_sources "")
-  set(shared_solution_sources ${solution_sources})
+  # The chapter's files in three sets:
+  #   exercise_files  the files with an exercise region (exercises/ holds their stubbed copies,
+  #                   tools/exercises.py generate), but the OWN ones;
+  #   own_files       the OWN files (with or without a region);
+  #   plain_files     the rest: compiled once, into the object library fem_chNN_plain, whose objects
+  #                   every variant of the chapter's library shares (a student's, the reference, the
+  #                   graded twin), since those files are the same in all of them.
+  set(exercise_files "")
+  set(own_files "")
+  set(plain_files "")
   foreach(file_name IN LISTS CH_OWN)
     if(NOT EXISTS ${FEM_ROOT}/solutions/${id}/${file_name})
       message(FATAL_ERROR "chapter ${id}: OWN ${file_name} is not a file of solutions/${id}")
     endif()
-    list(FILTER sources EXCLUDE REGEX "/${file_name}$")
-    list(FILTER shared_solution_sources EXCLUDE REGEX "/${file_name}$")
-    if(from_exercises AND EXISTS ${FEM_ROOT}/exercises/${id}/${file_name})
-      list(APPEND own_sources ${FEM_ROOT}/exercises/${id}/${file_name})
+  endforeach()
+  foreach(src IN LISTS solution_sources)
+    get_filename_component(file_name ${src} NAME)
+    if(file_name IN_LIST CH_OWN)
+      list(APPEND own_files ${file_name})
+    elseif(EXISTS ${FEM_ROOT}/exercises/${id}/${file_name})
+      list(APPEND exercise_files ${file_name})
     else()
-      list(APPEND own_sources ${FEM_ROOT}/solutions/${id}/${file_name})
+      list(APPEND plain_files ${file_name})
     endif()
   endforeach()
+  set(folder_rule solutions)
+  if(from_exercises)
+    set(folder_rule student)
+  endif()
 
-  add_library(${lib} STATIC ${sources})
-  target_include_directories(${lib} PUBLIC ${FEM_ROOT}/chapters)
-  target_link_libraries(${lib} PUBLIC fem_common PRIVATE fem_flags)
-  foreach(dep IN LISTS CH_DEPENDS)
-    target_link_libraries(${lib} PUBLIC fem_ch${dep}_reference)
-  endforeach()
+  set(plain_objects "")
+  if(plain_files)
+    fem_chapter_files(plain_sources solutions ${plain_files})
+    fem_chapter_library(${lib}_plain OBJECT ${plain_sources})
+    fem_reference_code(${lib}_plain)
+    fem_unity_code(${lib}_plain)
+    set(plain_objects $<TARGET_OBJECTS:${lib}_plain>)
+  endif()
+  # The files a student edits (in a build from exercises/, the stubs) compile into an object library
+  # of their own, fem_chNN_exercises: the target fem_exercise_files builds only those (the exercises
+  # preset: every stub compiles; the other files are the solutions' own, compiled by any build).
+  fem_chapter_files(exercise_sources ${folder_rule} ${exercise_files})
+  set(exercise_objects "")
+  if(exercise_sources)
+    fem_chapter_library(${lib}_exercises OBJECT ${exercise_sources})
+    set(exercise_objects $<TARGET_OBJECTS:${lib}_exercises>)
+    add_dependencies(fem_exercise_files ${lib}_exercises)
+  endif()
+  fem_chapter_library(${lib} STATIC ${exercise_objects})
   # What the chapter's executable and tests link (`user`): fem_chNN, or fem_chNN_own on top of it;
-  # `code_libraries`: the one or two libraries of the chapter's code (a student's, in a student build).
+  # `code_libraries`: the targets compiling the files a student may edit.
   set(user ${lib})
-  set(code_libraries ${lib})
-  if(own_sources)
+  set(code_libraries "")
+  if(exercise_sources)
+    set(code_libraries ${lib}_exercises)
+  endif()
+  if(own_files)
     set(user ${lib}_own)
+    fem_chapter_files(own_sources ${folder_rule} ${own_files})
     add_library(${user} STATIC ${own_sources})
     target_link_libraries(${user} PUBLIC ${lib} PRIVATE fem_flags)
     list(APPEND code_libraries ${user})
+    add_dependencies(fem_exercise_files ${user})
   endif()
   if(from_exercises)
     # A stub leaves its parameters and the helpers its solution used unused.
@@ -170,13 +223,10 @@ function(fem_add_chapter number name)
       target_compile_options(${target} PRIVATE -Wno-unused-parameter -Wno-unused-variable
                              -Wno-unused-but-set-variable -Wno-unused-function)
     endforeach()
-    # Later chapters keep running on the reference solution of this one.
-    add_library(${lib}_reference STATIC ${shared_solution_sources})
-    target_include_directories(${lib}_reference PUBLIC ${FEM_ROOT}/chapters)
-    target_link_libraries(${lib}_reference PUBLIC fem_common PRIVATE fem_flags)
-    foreach(dep IN LISTS CH_DEPENDS)
-      target_link_libraries(${lib}_reference PUBLIC fem_ch${dep}_reference)
-    endforeach()
+    # Later chapters keep running on the reference solution of this one: the solutions of the
+    # files with exercises, and the shared plain objects.
+    fem_chapter_files(reference_sources solutions ${exercise_files})
+    fem_chapter_library(${lib}_reference STATIC ${reference_sources})
     fem_reference_code(${lib}_reference)
   else()
     add_library(${lib}_reference ALIAS ${lib})
@@ -184,7 +234,6 @@ function(fem_add_chapter number name)
       fem_reference_code(${target})
     endforeach()
   endif()
-  add_dependencies(fem_chapter_libs ${lib})
 
   set(exe ch${number}_${name})
   # The executable: every .cpp of programs/NN_name (main.cpp and its studies, study_*.cpp, with
@@ -194,6 +243,7 @@ function(fem_add_chapter number name)
     message(FATAL_ERROR "chapter ${id}: no programs/${id}/main.cpp")
   endif()
   add_executable(${exe} ${program_sources})
+  fem_unity_code(${exe})
   target_link_libraries(${exe} PRIVATE ${user} fem_flags)
 
   if(FEM_BUILD_TESTS)
@@ -220,22 +270,17 @@ function(fem_add_chapter number name)
       # stay the reference solutions (grading stubs only the chapter's own exercises).
       set(graded_dir ${CMAKE_BINARY_DIR}/graded/${id})
       set(graded_sources "")
-      foreach(src IN LISTS solution_sources)
-        get_filename_component(file_name ${src} NAME)
+      foreach(file_name IN LISTS exercise_files own_files)
         list(APPEND graded_sources ${graded_dir}/${file_name})
       endforeach()
       add_custom_command(
         OUTPUT ${graded_sources}
         COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/exercises.py graded --root ${FEM_ROOT}
-                --chapter ${id} --out ${graded_dir}
+                --chapter ${id} --out ${graded_dir} --files ${exercise_files} ${own_files}
         DEPENDS ${solution_sources} ${FEM_ROOT}/tools/exercises.py
         COMMENT "Generating graded sources of chapter ${id}")
-      add_library(${lib}_graded STATIC EXCLUDE_FROM_ALL ${graded_sources})
-      target_include_directories(${lib}_graded PUBLIC ${FEM_ROOT}/chapters)
-      target_link_libraries(${lib}_graded PUBLIC fem_common PRIVATE fem_flags)
-      foreach(dep IN LISTS CH_DEPENDS)
-        target_link_libraries(${lib}_graded PUBLIC fem_ch${dep}_reference)
-      endforeach()
+      fem_chapter_library(${lib}_graded STATIC ${graded_sources})
+      set_target_properties(${lib}_graded PROPERTIES EXCLUDE_FROM_ALL ON)
       add_executable(${test_exe}_graded EXCLUDE_FROM_ALL)
       target_link_libraries(${test_exe}_graded PRIVATE ${test_exe}_objects ${lib}_graded fem_test_main fem_flags)
       set_target_properties(${test_exe}_graded PROPERTIES OUTPUT_NAME ${test_exe}
@@ -276,10 +321,14 @@ function(fem_add_chapter number name)
   # executable) go in programs/NN_name/chapter.cmake, included here, where ${lib}, ${exe} and
   # ${test_exe} name its targets (the test sources compile in ${test_exe}_objects: a compile
   # option or definition for them goes there) and ${chapter_libraries} lists every library built
-  # from its sources: ${lib}, with OWN files ${lib}_own, in a student build also the reference twin
-  # ${lib}_reference, and with FEM_GRADING the graded twin ${lib}_graded. A package the chapter's
-  # code needs is linked to each of them.
-  set(chapter_libraries ${code_libraries})
+  # from its sources: ${lib} and its object libraries ${lib}_exercises and ${lib}_plain, with OWN
+  # files ${lib}_own, in a student build also the reference twin ${lib}_reference, and with
+  # FEM_GRADING the graded twin ${lib}_graded. A package the chapter's code needs is linked to each
+  # of them.
+  set(chapter_libraries ${lib} ${code_libraries})
+  if(TARGET ${lib}_plain)
+    list(APPEND chapter_libraries ${lib}_plain)
+  endif()
   get_target_property(reference_aliased ${lib}_reference ALIASED_TARGET)
   if(NOT reference_aliased)
     list(APPEND chapter_libraries ${lib}_reference)

@@ -14,7 +14,7 @@ Commands:
   generate  write exercises/ from solutions/ (stubs throw fem::NotImplemented)
   check     fail if exercises/ is not what `generate` would write
   list      print every exercise: id, function, docs section, file:line
-  graded    write one chapter's solutions with each region behind the run-time switch
+  graded    write one chapter's solutions (the files named, else all) with each region behind the run-time switch
             fem::exercise_stubbed(id), for the graded twins of a build (-DFEM_GRADING=ON)
   grade     with a build configured with -DFEM_GRADING=ON whose target fem_graded_tests is built
             (<build>/bin/graded/test_chNN), check every exercise's tests against its stubs
@@ -282,7 +282,10 @@ def command_graded(args):
     root = Path(args.root).resolve()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    for path in sorted((root / "solutions" / args.chapter).glob("*.cpp")):
+    # The files named (the build's files with an exercise region), else every file of the chapter.
+    paths = [root / "solutions" / args.chapter / name for name in args.files] if args.files else \
+        sorted((root / "solutions" / args.chapter).glob("*.cpp"))
+    for path in paths:
         content = graded_source(path, args.chapter)
         target = out / path.name
         if not target.exists() or target.read_text() != content:
@@ -419,6 +422,7 @@ def main():
     parser.add_argument("--root", default=Path(__file__).resolve().parent.parent)
     parser.add_argument("--chapter", help="graded: the chapter folder, e.g. 01_finite_differences")
     parser.add_argument("--out", help="graded: the folder for the generated sources")
+    parser.add_argument("--files", nargs="*", help="graded: the chapter's files to write (default: all)")
     parser.add_argument("--build", help="grade: a build configured with -DFEM_GRADING=ON, "
                         "its target fem_graded_tests built")
     parser.add_argument("--chapters", nargs="*", help="grade: only these chapter numbers (01 05 ...)")

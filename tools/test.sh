@@ -3,7 +3,8 @@
 #   1. grading   each exercise, stubbed alone, fails at least one of its tagged tests, and they
 #                pass with only it and what its docs say it builds on done (a table); built in
 #                build/release (-DFEM_GRADING=ON: graded twins of the tests, target fem_graded_tests)
-#   2. exercises every chapter compiles from exercises/ (the stubs students start from)
+#   2. exercises every stub file of exercises/ compiles (the files students start from; the other
+#                files of a chapter are the solutions' own, compiled by stage 1)
 #   3. asan      under AddressSanitizer + UndefinedBehaviorSanitizer (and float-cast-overflow):
 #                the unit tests (but those tagged [slow], which stage 4 runs), and each
 #                executable's --quick run, bad command lines and the output-folder rule; built with
@@ -33,7 +34,7 @@ cmake --preset release -DFEM_GRADING=ON -DFEM_WERROR=ON >/dev/null
 cmake --build --preset release --target fem_graded_tests -j "$JOBS"
 with_display python3 tools/exercises.py grade --build build/release
 
-step "2/5 every chapter library compiles from exercises/"
+step "2/5 every stub file of exercises/ compiles"
 cmake --preset exercises -DFEM_WERROR=ON >/dev/null
 cmake --build --preset exercises -j "$JOBS"
 

@@ -12,6 +12,7 @@ target_link_libraries(fem_scenes PUBLIC fem_ch15_reference fem_ch14_reference fe
                       PRIVATE tomlplusplus::tomlplusplus fem_flags)
 target_compile_options(fem_scenes PRIVATE ${FEM_FUZZ_FLAGS})  # the scene reader, fuzz_scene's ground
 fem_reference_code(fem_scenes)
+fem_unity_code(fem_scenes)
 
 add_executable(fem_scene ${FEM_ROOT}/programs/scenes/main.cpp)
 target_link_libraries(fem_scene PRIVATE fem_scenes fem_flags)
