@@ -22,12 +22,6 @@
 #include <utility>
 
 namespace fem::contact {
-namespace {
-
-constexpr double infinity = std::numeric_limits<double>::infinity();
-
-}  // namespace
-
 double ContactTerm::smallest_distance(const Eigen::VectorXd& /*u*/, double /*time*/, double /*reach*/) const
 {
     return infinity;

@@ -14,8 +14,6 @@
 namespace fem::contact {
 namespace {
 
-constexpr double infinity = std::numeric_limits<double>::infinity();
-
 void require_finite_point(const Eigen::Vector3d& p, const char* what)
 {
     if (!p.allFinite())

@@ -18,8 +18,6 @@
 namespace fem::contact {
 namespace {
 
-constexpr double infinity = std::numeric_limits<double>::infinity();
-
 /// Vertex i of the motion at time t: (1 − t) x₀ + t x₁.
 Eigen::Vector3d position(const PrimitiveMotion& motion, int i, double t)
 {

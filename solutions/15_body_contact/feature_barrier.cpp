@@ -19,8 +19,6 @@
 namespace fem::contact {
 namespace {
 
-constexpr double infinity = std::numeric_limits<double>::infinity();
-
 using BoundingBox = Eigen::Matrix<double, 2, 3>;
 
 BoundingBox box_of(const Eigen::Vector3d& a, const Eigen::Vector3d& b)

@@ -19,8 +19,6 @@
 namespace fem::contact {
 namespace {
 
-constexpr double infinity = std::numeric_limits<double>::infinity();
-
 /// The distance from p to the box (rows min and max; 0 inside).
 double box_distance(const Eigen::Vector3d& low, const Eigen::Vector3d& high, const Eigen::Vector3d& p)
 {

@@ -14,12 +14,6 @@
 #include <vector>
 
 namespace fem::contact {
-namespace {
-
-constexpr double infinity = std::numeric_limits<double>::infinity();
-
-}  // namespace
-
 double squared_distance_at(PrimitivePair kind, const PrimitiveMotion& motion, double s)
 {
     const Eigen::Matrix<double, 3, 4> x = (1.0 - s) * motion.start + s * motion.end;

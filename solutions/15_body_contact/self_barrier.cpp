@@ -15,12 +15,6 @@
 #include <limits>
 
 namespace fem::contact {
-namespace {
-
-constexpr double infinity = std::numeric_limits<double>::infinity();
-
-}  // namespace
-
 SelfContactBarrier::SelfContactBarrier(const TetMesh& mesh, double activation_distance, std::vector<int> vertex_body,
                                        std::vector<bool> body_self_contact)
     : rest_(mesh.V),

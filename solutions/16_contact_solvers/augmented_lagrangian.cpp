@@ -18,8 +18,6 @@
 namespace fem::contact {
 namespace {
 
-constexpr double infinity = std::numeric_limits<double>::infinity();
-
 /// The chapter 15 potential that bounds the line search: its barrier is never evaluated, only its
 /// collision check, its start velocity, its smallest distance and (as a debug check) its referee.
 BodyContactOptions collision_options(const AugmentedLagrangianOptions& options)

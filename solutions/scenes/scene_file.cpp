@@ -36,7 +36,7 @@ using namespace detail;
 
 /// The scene file's text: refused when it is no regular file, cannot be read or holds more than
 /// max_scene_bytes.
-std::string read_text(const std::filesystem::path& path)
+std::string read_scene_text(const std::filesystem::path& path)
 {
     const std::string file = path.string();
     std::error_code ec;
@@ -344,7 +344,7 @@ SceneSpec read_scene(const std::filesystem::path& path, const std::vector<std::s
                      const ReadLimits& limits)
 {
     const std::string file = path.string();
-    toml::table root = parse_scene(read_text(path), file);
+    toml::table root = parse_scene(read_scene_text(path), file);
     Source source{file, {}, limits};
     if (quick)
         apply_quick_table(root, source);

@@ -146,8 +146,8 @@ void check_web_page_library()
 
 namespace {
 
-/// The whole of a text file; fem::Error naming it when it cannot be read.
-std::string read_text(const std::filesystem::path& file)
+/// The whole of a script file the page inlines; fem::Error naming it when it cannot be read.
+std::string read_script_file(const std::filesystem::path& file)
 {
     std::ifstream in(file, std::ios::binary);
     if (!in)
@@ -404,8 +404,8 @@ Eigen::Vector3d WebPage::write(const std::filesystem::path& path, const std::vec
             title.replace(at, 1, to);
     // From the last placeholder to the first: what is filled in never holds the next one searched.
     fill(page, "@DATA@", data);
-    fill(page, "@ORBIT@", read_text(orbit_controls_js));
-    fill(page, "@THREE@", read_text(three_js));
+    fill(page, "@ORBIT@", read_script_file(orbit_controls_js));
+    fill(page, "@THREE@", read_script_file(three_js));
     fill(page, "@TITLE@", title);
     write_file(path, page);
     return quantisation_bound(q);
