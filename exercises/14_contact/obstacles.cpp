@@ -3,6 +3,7 @@
 #include "14_contact/obstacles.hpp"
 
 #include "common/error.hpp"
+#include "common/types.hpp"
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>

@@ -12,6 +12,7 @@
 #include "04_tet_jacobians/tet_jacobians.hpp"
 
 #include "common/error.hpp"
+#include "common/types.hpp"
 #include "common/timer.hpp"
 
 #include <algorithm>

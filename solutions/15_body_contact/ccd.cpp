@@ -4,6 +4,7 @@
 #include "15_body_contact/ccd.hpp"
 
 #include "common/error.hpp"
+#include "common/types.hpp"
 
 #include <Eigen/Geometry>
 

@@ -10,6 +10,7 @@
 #include "12_hyperelastic_newton/materials.hpp"
 
 #include "common/error.hpp"
+#include "common/types.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -5,6 +5,7 @@
 #include "15_body_contact/distances.hpp"
 
 #include "common/error.hpp"
+#include "common/types.hpp"
 
 #include <Eigen/Geometry>
 

@@ -4,6 +4,8 @@
 
 #include "14_contact/barrier.hpp"
 
+#include "common/types.hpp"
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
