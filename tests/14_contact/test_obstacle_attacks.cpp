@@ -37,7 +37,7 @@ TEST_CASE("obstacle attacks: a half-space whose point lies far along its plane h
 }
 
 TEST_CASE("obstacle attacks: a block slides on a 45° plane given by a point 10⁹ m along it exactly as on the plane "
-          "given by the origin", "[obstacles]")
+          "given by the origin", "[obstacles][ex14.2]")
 {
     BlockSettings settings;
     const Eigen::Vector3d normal(0.0, 1.0, 1.0);

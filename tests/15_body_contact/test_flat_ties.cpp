@@ -86,7 +86,7 @@ std::vector<std::pair<std::string, TriMesh>> floors()
 using namespace flat_ties;
 
 TEST_CASE("flat ties: a point exactly over a shared edge or vertex of a flat floor, or beside it by any small offset, "
-          "feels the plane's one barrier")
+          "feels the plane's one barrier", "[obstacles][ex15.1]")
 {
     const HalfSpace plane(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ());
     const double height = 4e-4;
@@ -117,7 +117,7 @@ TEST_CASE("flat ties: a point exactly over a shared edge or vertex of a flat flo
 }
 
 TEST_CASE("flat ties: a block dropped with its corners on a plate's diagonal, or on a grid floor's lines and vertices, "
-          "lands and rests as on the half-space")
+          "lands and rests as on the half-space", "[obstacles][ex15.4]")
 {
     BlockSettings settings;
     settings.terms = body_contact_term_maker();  // the obstacles' edges and corners too

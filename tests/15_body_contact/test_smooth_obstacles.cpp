@@ -51,7 +51,7 @@ double smallest_surface_gap(const TetMesh& mesh, const MatrixX3d& x, const Obsta
 using namespace smooth_obstacles;
 
 TEST_CASE("smooth obstacles: the barrier of a sphere's and a capsule's core against the body's triangles and edges "
-          "has the derivatives central differences give")
+          "has the derivatives central differences give", "[obstacles][ex15.2]")
 {
     const TetMesh mesh = box_mesh(1, 1, 1, Eigen::Vector3d::Constant(0.1));
     const double dhat = 1e-2;
@@ -93,7 +93,7 @@ TEST_CASE("smooth obstacles: the barrier of a sphere's and a capsule's core agai
 }
 
 TEST_CASE("smooth obstacles: a block fired at a small sphere or a thin capsule between its vertices at 6, 60 and "
-          "600 m/s (6 cm a step) keeps every point of its surface outside")
+          "600 m/s (6 cm a step) keeps every point of its surface outside", "[obstacles][ex15.2]")
 {
     struct Target {
         std::string what;
