@@ -138,7 +138,7 @@ TEST_CASE("obstacle fields: a box's angle and axis and a half-space's normal of 
     const SceneSpec huge = scene_from("red_box_huge", block_and(box + "axis = [1e308, 1e308, 0.0]\nangle = 1.7e308\n"));
     const SceneSpec plain = scene_from(
         "red_box_plain", block_and(box + "axis = [1.0, 1.0, 0.0]\nangle = " + std::to_string(std::fmod(1.7e308, 360.0)) + "\n"));
-    for (const Eigen::Vector3d q : {Eigen::Vector3d(0.3, -0.2, 0.1), Eigen::Vector3d(-0.7, 0.4, -0.2)})
+    for (const Eigen::Vector3d& q : {Eigen::Vector3d(0.3, -0.2, 0.1), Eigen::Vector3d(-0.7, 0.4, -0.2)})
         CHECK(std::abs(huge.obstacles[0].obstacle->distance(q, 0.0) - plain.obstacles[0].obstacle->distance(q, 0.0)) <= 1e-12);
 }
 
