@@ -89,7 +89,7 @@ TEST_CASE("the line search's collision check keeps a minimum separation: a motio
 }
 
 TEST_CASE("a block landing flat or on its edge on a free plate one tet thick at 2 m/s (dt 1/1000 s: its free "
-          "flight ends on the plate) runs, Newton's system never failing to factor", "[ex15.5]")
+          "flight ends on the plate) runs, Newton's system never failing to factor", "[ex15.5][slow]")
 {
     // The four cases of issue 48: before the minimum separation the flat block stopped in chapter 08's
     // words ("sparse Cholesky: … pivot …") on both plates, the block on its edge with "the line search

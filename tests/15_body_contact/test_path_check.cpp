@@ -113,7 +113,7 @@ TEST_CASE("first_crossing_on_segment: a vertex through a triangle, an edge throu
 }
 
 TEST_CASE("the path check proves every segment of a block hitting a thin plate face-on at 20 m/s, and catches "
-          "a planted blind collision check, naming step, segment, bodies and primitives", "[ex15.5]")
+          "a planted blind collision check, naming step, segment, bodies and primitives", "[ex15.5][slow]")
 {
     // 20 m/s at Δt = 1/400 s: 5 cm a step against a plate 2 mm thick and a gap of 2 mm.
     long long segments = 0;

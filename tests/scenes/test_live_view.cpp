@@ -37,7 +37,7 @@ using testing::output;
 using testing::read_text;
 using testing::start_scene;
 
-TEST_CASE("the live view shows the PNG frame of the same step, pixel for pixel", "[scenes]")
+TEST_CASE("the live view shows the PNG frame of the same step, pixel for pixel", "[scenes][slow]")
 {
     if (std::getenv("DISPLAY") == nullptr) {
         WARN("SKIPPED: no X display: run the tests under xvfb-run -a to check the live view");
