@@ -6,17 +6,21 @@
 #                       from two object libraries: fem_chNN_exercises (the files with an exercise
 #                       region, a student's stubs in a build from exercises/; the target
 #                       fem_exercise_files builds every chapter's) and fem_chNN_plain (the other
-#                       files, compiled once and shared with the reference and graded twins);
+#                       files, compiled once and shared with the reference twin); with
+#                       FEM_GRADING=ON the files with a region compile from their graded copies
+#                       (below);
 #   fem_chNN_own        with OWN files: those files, on top of fem_chNN (below);
 #   fem_chNN_reference  what later chapters link: always the reference solution, so a student
 #                       working on chapter 05 keeps chapters 06+ running;
 #   chNN_name           its executable in <build>/bin, from programs/NN_name/*.cpp (main.cpp, study_*.cpp);
 #   test_chNN           its Catch2 tests from tests/NN_name/*.cpp (ctest label chNN); a target of
 #                       its own: `cmake --build --preset student --target test_chNN`;
-#   fem_chNN_graded,    with FEM_GRADING=ON, built by the target fem_graded_tests only: the
-#   test_chNN_graded    solutions with every exercise region behind a run-time stub switch, and the
-#                       same test objects as test_chNN linked against it, as <build>/bin/graded/
-#                       test_chNN (for tools/exercises.py grade; no ctest entries);
+#                       With FEM_GRADING=ON (a build from the solutions), the files with an
+#                       exercise region compile from copies with every region behind a run-time
+#                       stub switch (tools/exercises.py graded; environment FEM_STUB_EXERCISE=05.2),
+#                       so that test_chNN is also the binary tools/exercises.py grade runs; with the
+#                       variable unset each region runs its solution. The target fem_graded_tests
+#                       builds every chapter's tests;
 #   chNN_quick_run      ctest: the executable in --quick mode, its files and figures against
 #                       tests/NN_name/expected (label chNN, run);
 #   chNN_docs           ctest: docs/NN_name.md names only functions and exercises that exist and
@@ -39,7 +43,7 @@ set(FEM_ALL_CHAPTERS "" CACHE INTERNAL "registered chapters")
 add_custom_target(fem_tests)
 add_custom_target(fem_exercise_files)
 if(FEM_GRADING)
-  add_custom_target(fem_graded_tests)
+  add_custom_target(fem_graded_tests)  # every test_chNN, each a graded binary in this build
 endif()
 
 include(${CMAKE_CURRENT_LIST_DIR}/FemExercises.cmake)
@@ -158,8 +162,8 @@ function(fem_add_chapter number name)
   #                   tools/exercises.py generate), but the OWN ones;
   #   own_files       the OWN files (with or without a region);
   #   plain_files     the rest: compiled once, into the object library fem_chNN_plain, whose objects
-  #                   every variant of the chapter's library shares (a student's, the reference, the
-  #                   graded twin), since those files are the same in all of them.
+  #                   every variant of the chapter's library shares (a student's, the reference),
+  #                   since those files are the same in all of them.
   set(exercise_files "")
   set(own_files "")
   set(plain_files "")
@@ -182,6 +186,25 @@ function(fem_add_chapter number name)
   if(from_exercises)
     set(folder_rule student)
   endif()
+  # A grading build compiles the files with exercise regions (and the OWN files) once, from copies
+  # generated at build time with each region behind the run-time switch fem::exercise_stubbed, so
+  # that tools/exercises.py grade proves, one exercise at a time, that its tests fail on a stub,
+  # without a rebuild and without a second copy of the library. Chapters built from exercises/ are
+  # a student's and are not graded.
+  set(graded_dir "")
+  if(FEM_GRADING AND NOT from_exercises AND (exercise_files OR own_files))
+    set(graded_dir ${CMAKE_BINARY_DIR}/graded/${id})
+    set(graded_outputs "")
+    foreach(file_name IN LISTS exercise_files own_files)
+      list(APPEND graded_outputs ${graded_dir}/${file_name})
+    endforeach()
+    add_custom_command(
+      OUTPUT ${graded_outputs}
+      COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/exercises.py graded --root ${FEM_ROOT}
+              --chapter ${id} --out ${graded_dir} --files ${exercise_files} ${own_files}
+      DEPENDS ${solution_sources} ${FEM_ROOT}/tools/exercises.py
+      COMMENT "Generating graded sources of chapter ${id}")
+  endif()
 
   set(plain_objects "")
   if(plain_files)
@@ -195,6 +218,9 @@ function(fem_add_chapter number name)
   # of their own, fem_chNN_exercises: the target fem_exercise_files builds only those (the exercises
   # preset: every stub compiles; the other files are the solutions' own, compiled by any build).
   fem_chapter_files(exercise_sources ${folder_rule} ${exercise_files})
+  if(graded_dir)
+    list(TRANSFORM exercise_files PREPEND ${graded_dir}/ OUTPUT_VARIABLE exercise_sources)
+  endif()
   set(exercise_objects "")
   if(exercise_sources)
     fem_chapter_library(${lib}_exercises OBJECT ${exercise_sources})
@@ -212,6 +238,9 @@ function(fem_add_chapter number name)
   if(own_files)
     set(user ${lib}_own)
     fem_chapter_files(own_sources ${folder_rule} ${own_files})
+    if(graded_dir)
+      list(TRANSFORM own_files PREPEND ${graded_dir}/ OUTPUT_VARIABLE own_sources)
+    endif()
     add_library(${user} STATIC ${own_sources})
     target_link_libraries(${user} PUBLIC ${lib} PRIVATE fem_flags)
     list(APPEND code_libraries ${user})
@@ -252,8 +281,8 @@ function(fem_add_chapter number name)
       message(FATAL_ERROR "chapter ${id}: no tests in tests/${id}")
     endif()
     set(test_exe test_ch${number})
-    # The test sources are compiled once (an object library), for test_chNN and its graded twin;
-    # they see the chapters' headers, not a chapter library, so that each links its own.
+    # The test sources are compiled as an object library that sees the chapters' headers, not a
+    # chapter library, so that the test executable links the chapter's library of this build.
     add_library(${test_exe}_objects OBJECT ${test_sources})
     target_include_directories(${test_exe}_objects PRIVATE ${FEM_ROOT}/chapters)
     target_link_libraries(${test_exe}_objects PRIVATE fem_test_main fem_flags)
@@ -264,28 +293,7 @@ function(fem_add_chapter number name)
     fem_discover_tests(${test_exe} "ch${number}" ${test_sources})
     add_dependencies(fem_tests ${test_exe})
     if(FEM_GRADING)
-      # The solutions with every exercise region behind a run-time switch (environment variable
-      # FEM_STUB_EXERCISE=05.2), generated at build time, so that tools/exercises.py grade can prove,
-      # one exercise at a time, that the tests fail on a stub without rebuilding. Earlier chapters
-      # stay the reference solutions (grading stubs only the chapter's own exercises).
-      set(graded_dir ${CMAKE_BINARY_DIR}/graded/${id})
-      set(graded_sources "")
-      foreach(file_name IN LISTS exercise_files own_files)
-        list(APPEND graded_sources ${graded_dir}/${file_name})
-      endforeach()
-      add_custom_command(
-        OUTPUT ${graded_sources}
-        COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/exercises.py graded --root ${FEM_ROOT}
-                --chapter ${id} --out ${graded_dir} --files ${exercise_files} ${own_files}
-        DEPENDS ${solution_sources} ${FEM_ROOT}/tools/exercises.py
-        COMMENT "Generating graded sources of chapter ${id}")
-      fem_chapter_library(${lib}_graded STATIC ${graded_sources})
-      set_target_properties(${lib}_graded PROPERTIES EXCLUDE_FROM_ALL ON)
-      add_executable(${test_exe}_graded EXCLUDE_FROM_ALL)
-      target_link_libraries(${test_exe}_graded PRIVATE ${test_exe}_objects ${lib}_graded fem_test_main fem_flags)
-      set_target_properties(${test_exe}_graded PROPERTIES OUTPUT_NAME ${test_exe}
-                            RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/bin/graded)
-      add_dependencies(fem_graded_tests ${test_exe}_graded)
+      add_dependencies(fem_graded_tests ${test_exe})
     endif()
 
     add_test(NAME ch${number}_quick_run
@@ -322,9 +330,8 @@ function(fem_add_chapter number name)
   # ${test_exe} name its targets (the test sources compile in ${test_exe}_objects: a compile
   # option or definition for them goes there) and ${chapter_libraries} lists every library built
   # from its sources: ${lib} and its object libraries ${lib}_exercises and ${lib}_plain, with OWN
-  # files ${lib}_own, in a student build also the reference twin ${lib}_reference, and with
-  # FEM_GRADING the graded twin ${lib}_graded. A package the chapter's code needs is linked to each
-  # of them.
+  # files ${lib}_own, in a student build also the reference twin ${lib}_reference. A package the
+  # chapter's code needs is linked to each of them.
   set(chapter_libraries ${lib} ${code_libraries})
   if(TARGET ${lib}_plain)
     list(APPEND chapter_libraries ${lib}_plain)
@@ -332,9 +339,6 @@ function(fem_add_chapter number name)
   get_target_property(reference_aliased ${lib}_reference ALIASED_TARGET)
   if(NOT reference_aliased)
     list(APPEND chapter_libraries ${lib}_reference)
-  endif()
-  if(TARGET ${lib}_graded)
-    list(APPEND chapter_libraries ${lib}_graded)
   endif()
   if(EXISTS ${FEM_ROOT}/programs/${id}/chapter.cmake)
     include(${FEM_ROOT}/programs/${id}/chapter.cmake)

@@ -15,9 +15,9 @@ Commands:
   check     fail if exercises/ is not what `generate` would write
   list      print every exercise: id, function, docs section, file:line
   graded    write one chapter's solutions (the files named, else all) with each region behind the run-time switch
-            fem::exercise_stubbed(id), for the graded twins of a build (-DFEM_GRADING=ON)
+            fem::exercise_stubbed(id), for a grading build (-DFEM_GRADING=ON)
   grade     with a build configured with -DFEM_GRADING=ON whose target fem_graded_tests is built
-            (<build>/bin/graded/test_chNN), check every exercise's tests against its stubs
+            (<build>/bin/test_chNN), check every exercise's tests against its stubs
             (see command_grade)
 
 What an exercise builds on is written in its chapter's docs, on the line right under its heading:
@@ -382,7 +382,7 @@ def command_grade(args):
     print(f"{'':9} {'':30} {'':24} {'':>6} {'failed':>8} {'passed':>9}")
     problems = []
     for chapter in sorted({e.chapter for e in exercises}):
-        binary = build / "bin" / "graded" / f"test_ch{chapter[:2]}"
+        binary = build / "bin" / f"test_ch{chapter[:2]}"
         in_chapter = [e for e in exercises if e.chapter == chapter]
         if not binary.exists():
             problems.append(f"chapter {chapter}: no test binary {binary} (configure with -DFEM_GRADING=ON "

@@ -2,7 +2,7 @@
 # The course's full check (what CI runs): every stage must pass.
 #   1. grading   each exercise, stubbed alone, fails at least one of its tagged tests, and they
 #                pass with only it and what its docs say it builds on done (a table); built in
-#                build/release (-DFEM_GRADING=ON: graded twins of the tests, target fem_graded_tests)
+#                build/release (-DFEM_GRADING=ON: the exercise regions behind a run-time stub switch)
 #   2. exercises every stub file of exercises/ compiles (the files students start from; the other
 #                files of a chapter are the solutions' own, compiled by stage 1)
 #   3. asan      under AddressSanitizer + UndefinedBehaviorSanitizer (and float-cast-overflow):
@@ -27,8 +27,9 @@ export OMP_NUM_THREADS=1
 step "exercises/ in sync with solutions/"
 python3 tools/exercises.py check
 
-# The grading stage builds in the release build folder: its graded twins (-DFEM_GRADING=ON) link
-# the same compiled test objects as the release tests, which stage 4 then only links and runs.
+# The grading stage builds in the release build folder (-DFEM_GRADING=ON: the exercise regions
+# behind a run-time switch, off unless FEM_STUB_EXERCISE names them): stage 4 runs the same test
+# binaries on the solutions and only builds the executables on top.
 step "1/5 grading build: every exercise fails its tests as a stub and needs only what it builds on"
 cmake --preset release -DFEM_GRADING=ON -DFEM_WERROR=ON >/dev/null
 cmake --build --preset release --target fem_graded_tests -j "$JOBS"
