@@ -6,9 +6,10 @@
 #   2. exercises every stub file of exercises/ compiles (the files students start from; the other
 #                files of a chapter are the solutions' own, compiled by stage 1)
 #   3. asan      under AddressSanitizer + UndefinedBehaviorSanitizer (and float-cast-overflow):
-#                the unit tests (but those tagged [slow], which stage 4 runs), and each
-#                executable's --quick run, bad command lines and the output-folder rule; built with
-#                clang 14, which also builds stage 5's fuzzers in the same tree
+#                the unit tests (but those tagged [slow], which stage 4 runs), the scene runner's
+#                tests and gallery quick runs, and chapters 01 and 14's executables (--quick run,
+#                bad command lines, output-folder rule; the other executables run in stage 4:
+#                FEM_PROGRAMS); built with clang 14, which also builds stage 5's fuzzers there
 #   4. release   (the rest of build/release) every test passes on the reference solutions: unit
 #                tests, the layout and exercise-sync checks, each executable's --quick run against
 #                stored numbers, and each chapter's docs against its executable

@@ -2,7 +2,7 @@
 # CCD benchmark's unit-test queries, its table against tests/15_body_contact/expected_ccd_queries.
 # Labelled ch15_slow: the sanitizer stage leaves it out (34 s there); its unit test "inclusion CCD: no
 # false negative on the benchmark's … queries" runs the same queries under the sanitizers.
-if(FEM_BUILD_TESTS)
+if(FEM_BUILD_TESTS AND program_checked)  # program_checked: fem_add_chapter (FEM_PROGRAMS)
   set(ccd_data ${FEM_ROOT}/data/ccd-unit-tests)
   add_test(NAME ch15_ccd_queries
            COMMAND ${Python3_EXECUTABLE} ${FEM_ROOT}/tools/check_run.py --exe $<TARGET_FILE:${exe}>
