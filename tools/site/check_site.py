@@ -419,16 +419,26 @@ def main():
 
 
 def take_screenshots(browser, site, folder):
-    """site_home.png, site_chapter.png and site_gallery.png of the site, as a reader sees them."""
+    """What a reader sees, saved into folder: site_home.png, site_chapter.png (chapter 10), site_search.png
+    (chapter 10 with "Rayleigh damping" typed into the search box), site_gallery.png (a scene's page,
+    one with a video if any) and site_gallery_index.png."""
     folder.mkdir(parents=True, exist_ok=True)
-    gallery = next((p for p in sorted((site / "gallery").glob("*.html")) if "fem-player" in p.read_text(encoding="utf-8")),
-                   site / "gallery" / "index.html")
-    for name, page in (("home", site / "index.html"), ("chapter", site / "10_linear_dynamics.html"), ("gallery", gallery)):
+    players = [p for p in sorted((site / "gallery").glob("*.html")) if "fem-player" in p.read_text(encoding="utf-8")]
+    gallery = next((p for p in players if "<video" in p.read_text(encoding="utf-8")), players[0] if players else None)
+    shots = [("home", site / "index.html", ""), ("chapter", site / "10_linear_dynamics.html", ""),
+             ("search", site / "10_linear_dynamics.html", "Rayleigh damping"),
+             ("gallery", gallery or site / "gallery" / "index.html", ""), ("gallery_index", site / "gallery" / "index.html", "")]
+    for name, page, query in shots:
         browser.open(page.as_uri())
-        browser.evaluate("""(async () => { const f = document.querySelector(".fem-player iframe");
-                              if (f) { f.loading = "eager"; await new Promise((r) => setTimeout(r, 2500)); } })()""")
+        browser.evaluate(f"""(async () => {{
+            const f = document.querySelector(".fem-player iframe");
+            if (f) {{ f.loading = "eager"; await new Promise((r) => setTimeout(r, 2500)); }}
+            const query = {json.dumps(query)}, input = document.getElementById("fem-search-input");
+            if (query && input) {{ input.focus(); input.value = query; input.dispatchEvent(new Event("input"));
+                                   await new Promise((r) => setTimeout(r, 500)); }}
+        }})()""")
         browser.screenshot(folder / f"site_{name}.png", {"x": 0, "y": 0, "width": WIDTH, "height": HEIGHT})
-        print(f"screenshot: {folder / f'site_{name}.png'} ({page.relative_to(site)})")
+        print(f"screenshot: {folder / f'site_{name}.png'} ({page.relative_to(site)}{', searching ' + repr(query) if query else ''})")
 
 
 if __name__ == "__main__":
