@@ -444,6 +444,7 @@ def main():
 
     shutil.rmtree(staging, ignore_errors=True)
     (staging / "docs").mkdir(parents=True)
+    (staging / "extras").mkdir()
     site = Site(staging / "docs", staging / "extras", args.source_url)
     shutil.copytree(ROOT / "docs" / "figures", site.staging / "figures")
     shutil.copytree(HERE / "assets", site.staging / "assets")
