@@ -15,6 +15,13 @@
 #                stored numbers, and each chapter's docs against its executable
 #   5. fuzz      every file reader's libFuzzer target runs 15 s from its seed corpus without a
 #                finding (tools/fuzz.sh; built by stage 3)
+#   6. site      the course's website (tools/site.sh) built into build/site from the docs and one scene
+#                page the stage makes itself (a --quick run of scenes/block_stack.toml by stage 4's
+#                fem_scene into build/site_runs; tools/run_course.sh is not run, so the other scenes
+#                are listed as missing), then used in headless Chromium with the network off: every
+#                page loads with no request off the machine and no console error, no broken link or
+#                image, search finds "Rayleigh" on chapter 10, the embedded scene page draws and moves
+#                (tools/site/check_site.py; about a minute)
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 cd "$FEM_ROOT"
@@ -51,5 +58,8 @@ with_display ctest --preset release
 
 step "5/5 the file readers fuzzed: each libFuzzer target 15 s from its seeds, no crash, sanitizer report, stray exception or runaway allocation"
 tools/fuzz.sh --seconds 15
+
+step "6/6 the website: built, then every page, link, search and the embedded scene page checked in headless Chromium"
+tools/site.sh --quick-scene --site build/site --check
 
 step "done: every stage passed"

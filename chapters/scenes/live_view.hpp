@@ -11,6 +11,7 @@
 #include "common/timer.hpp"
 #include "common/vtk_io.hpp"
 
+#include <array>
 #include <cstddef>
 #include <map>
 #include <filesystem>
@@ -58,6 +59,7 @@ private:
     Timer clock_;  // since the last frame shown
     PullRequest pull_;
     std::string name_;  // the window's name, before the timing
+    std::array<double, 6> seen_ = fig::empty_bounds();  // the bodies' bounds as drawn, every frame shown so far
 };
 
 }  // namespace fem::scenes

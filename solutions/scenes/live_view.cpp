@@ -61,19 +61,30 @@ void LiveView::frame(const io::MeshData& frame, int step, double time, const std
         if (scene_.output.warp != 1.0)
             view.outline = frame;  // the rest shape, as the PNG frames draw it (its points are at rest)
         // The body's box: the scene's fixed one, as the PNG frames take it (runner.cpp), else the
-        // rest shape grown by half its size each way; the camera frames the obstacles under it too.
+        // bodies as drawn in every frame shown so far, grown by a tenth of their size each way: the
+        // body fills the window at the start, and the camera backs off only when the body leaves
+        // what it framed. The camera frames the obstacles under it too.
         std::array<double, 6> box = fig::empty_bounds();
         if (scene_.output.frame_box) {
             box = *scene_.output.frame_box;
         } else {
-            fig::grow_bounds(box, frame.points);
-            const double margin = 0.5 * (frame.points.colwise().maxCoeff() - frame.points.colwise().minCoeff()).norm();
+            fig::grow_bounds(seen_, shown.points);
+            if (scene_.output.warp != 1.0)
+                fig::grow_bounds(seen_, frame.points);  // the rest shape drawn behind it
+            box = seen_;
+            const double margin = 0.1 * std::hypot(box[1] - box[0], box[3] - box[2], box[5] - box[4]);
             for (int axis = 0; axis < 3; ++axis) {
                 box[2 * axis] -= margin;
                 box[2 * axis + 1] += margin;
             }
         }
         view.props = obstacle_props(scene_, box, time);
+        if (!view.frame_bounds) {  // the body's box and the obstacles, not the pull's spring (which the camera
+            std::array<double, 6> framed = box;  // chasing would move the pointer's point under the hand)
+            for (const fig::Prop& prop : view.props)
+                fig::grow_bounds(framed, prop.shape.points);
+            view.frame_bounds = framed;
+        }
         if (pull_.body >= 0) {  // the spring: a red rod from the pulled vertex to the pointer's point
             int first = 0;
             for (int b = 0; b < pull_.body; ++b)
@@ -92,11 +103,6 @@ void LiveView::frame(const io::MeshData& frame, int step, double time, const std
                 spring.shape.cells = shape.F;
                 view.props.push_back(std::move(spring));
             }
-        }
-        if (!view.frame_bounds) {
-            for (const fig::Prop& prop : view.props)
-                fig::grow_bounds(box, prop.shape.points);
-            view.frame_bounds = box;
         }
         window_.show(shown, view);
     };

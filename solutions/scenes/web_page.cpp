@@ -434,7 +434,13 @@ html, body { margin: 0; height: 100%; overflow: hidden; background: #fff; color:
 #ticks { position: relative; width: 90px; }
 #ticks div { position: absolute; left: 0; transform: translateY(-50%); }
 #bar-text { flex: 1; white-space: pre-line; }
-#energy { width: 100%; height: 50%; margin-top: 10px; }
+#energy { width: 100%; height: 42%; margin-top: 10px; }
+#series { font-size: 11px; line-height: 1.5; max-height: 12%; overflow-y: auto; }
+#series .body { display: flex; flex-wrap: wrap; gap: 0 10px; }
+#series button { font: inherit; border: 0; background: none; padding: 0; cursor: pointer; color: inherit; }
+#series .name { font-weight: bold; min-width: 3em; text-align: left; }
+#series .swatch { display: inline-block; width: 14px; height: 3px; vertical-align: middle; margin-right: 3px; }
+#series .off { opacity: 0.35; text-decoration: line-through; }
 #help { color: #666; font-size: 12px; margin-top: 4px; }
 #controls { position: absolute; left: 0; right: 0; bottom: 0; height: 52px; display: flex; align-items: center;
             gap: 8px; padding: 0 12px; border-top: 1px solid #ddd; box-sizing: border-box; }
@@ -451,6 +457,7 @@ html, body { margin: 0; height: 100%; overflow: hidden; background: #fff; color:
 <div id="side">
   <div id="legend"><canvas id="bar" width="1" height="256"></canvas><div id="ticks"></div><div id="bar-text"></div></div>
   <svg id="energy" xmlns="http://www.w3.org/2000/svg"></svg>
+  <div id="series"></div>
   <div id="help">space: play/pause · ← →: one frame · Home/End: first/last · drag: orbit · wheel: zoom ·
     right-drag: pan · #frame=N in the address: open at frame N, paused</div>
 </div>
@@ -607,10 +614,42 @@ html, body { margin: 0; height: 100%; overflow: hidden; background: #fff; color:
   })();
   window.addEventListener("resize", () => { if (view3d) view3d.resize(); plot(); });
 
-  // the energy plot: an SVG of each series over time, a cursor at the frame's time
+  // the energy plot: an SVG of each series over time, a cursor at the frame's time; its legend below it,
+  // a row per body ("bottom: kinetic elastic H - W_in"): a click on a series hides or shows it, on a
+  // body's name all of its series (the plot's range follows the series shown)
   const svg = document.getElementById("energy"), NS = "http://www.w3.org/2000/svg";
   const palette = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#17becf", "#7f7f7f"];
   let cursor = null, xOf = null;
+  const shown = D.energy.series.map(() => true);
+  (function legend() {
+    const list = document.getElementById("series"), groups = new Map();
+    D.energy.series.forEach((s, k) => {
+      const cut = s.name.lastIndexOf(" ", s.name.endsWith(" H - W_in") ? s.name.length - 9 : s.name.length);
+      const body = cut > 0 ? s.name.slice(0, cut) : "", quantity = cut > 0 ? s.name.slice(cut + 1) : s.name;
+      if (!groups.has(body)) groups.set(body, []);
+      groups.get(body).push({ k: k, quantity: quantity });
+    });
+    for (const [body, entries] of groups) {
+      const row = document.createElement("div"); row.className = "body";
+      const buttons = entries.map((e) => {
+        const b = document.createElement("button"); b.className = "entry"; b.dataset.series = e.k;
+        b.title = "show or hide " + D.energy.series[e.k].name;
+        b.innerHTML = '<span class="swatch"></span>'; b.firstChild.style.background = palette[e.k % palette.length];
+        b.appendChild(document.createTextNode(e.quantity));
+        b.onclick = () => { shown[e.k] = !shown[e.k]; b.classList.toggle("off", !shown[e.k]); plot(); };
+        return b;
+      });
+      if (body) {
+        const name = document.createElement("button"); name.className = "name"; name.textContent = body;
+        name.title = "show or hide every series of " + body;
+        name.onclick = () => { const on = !entries.every((e) => shown[e.k]);
+          entries.forEach((e, i) => { shown[e.k] = on; buttons[i].classList.toggle("off", !on); }); plot(); };
+        row.appendChild(name);
+      }
+      buttons.forEach((b) => row.appendChild(b));
+      list.appendChild(row);
+    }
+  })();
   function element(name, attributes, text) { const e = document.createElementNS(NS, name);
     for (const k in attributes) e.setAttribute(k, attributes[k]); if (text !== undefined) e.textContent = text; svg.appendChild(e); return e; }
   function plot() {
@@ -618,22 +657,23 @@ html, body { margin: 0; height: 100%; overflow: hidden; background: #fff; color:
     const W = svg.clientWidth || 300, H = svg.clientHeight || 200, L = 58, R = 22, T = 18, B = 30;
     const t = D.energy.times; if (t.length === 0) return;
     let lo = Infinity, hi = -Infinity;
-    for (const s of D.energy.series) for (const v of s.values) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
+    D.energy.series.forEach((s, k) => { if (shown[k]) for (const v of s.values) { lo = Math.min(lo, v); hi = Math.max(hi, v); } });
+    if (!(lo <= hi)) { lo = 0; hi = 1; }
     if (!(hi > lo)) { hi = lo + 1; }
     const pad = 0.05 * (hi - lo); lo -= pad; hi += pad;
     const t0 = t[0], t1 = t[t.length - 1] > t0 ? t[t.length - 1] : t0 + 1;
     xOf = (x) => L + (W - L - R) * (x - t0) / (t1 - t0);
     const yOf = (y) => T + (H - T - B) * (1 - (y - lo) / (hi - lo));
-    element("rect", { x: L, y: T, width: W - L - R, height: H - T - B, fill: "none", stroke: "#888" });
+    element("rect", { id: "plot-frame", x: L, y: T, width: W - L - R, height: H - T - B, fill: "none", stroke: "#888" });
     element("text", { x: L, y: 12, "font-size": 12 }, "energy [J]");
     element("text", { x: W - R, y: H - 4, "font-size": 12, "text-anchor": "end" }, "time [s]");
     for (let i = 0; i <= 2; ++i) { const y = lo + (hi - lo) * i / 2, x = t0 + (t1 - t0) * i / 2;
       element("text", { x: L - 4, y: yOf(y) + 4, "font-size": 11, "text-anchor": "end" }, fmt(y));
       element("text", { x: xOf(x), y: H - 16, "font-size": 11, "text-anchor": "middle" }, fmt(x)); }
     D.energy.series.forEach((s, k) => {
+      if (!shown[k]) return;
       const d = s.values.map((v, i) => (i ? "L" : "M") + xOf(t[i]).toFixed(1) + " " + yOf(v).toFixed(1)).join(" ");
       element("path", { d: d, fill: "none", stroke: palette[k % palette.length], "stroke-width": 1.5 });
-      element("text", { x: L + 6, y: T + 14 + 13 * k, "font-size": 11, fill: palette[k % palette.length] }, s.name);
     });
     cursor = element("line", { y1: T, y2: H - B, stroke: "#000", "stroke-dasharray": "3 3" });
     show(frame);

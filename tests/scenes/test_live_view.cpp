@@ -431,3 +431,35 @@ TEST_CASE("the live view's mouse: pressing on the body pulls it toward the point
         std::getline(fields, field, ',');
     CHECK(std::stod(field) > 0.0);
 }
+
+TEST_CASE("the live view frames the body at the start: the coarse bunny fills 40 % of the window's height, uncut",
+          "[scenes]")
+{
+    if (std::getenv("DISPLAY") == nullptr) {
+        WARN("SKIPPED: no X display: run the tests under xvfb-run -a to check the live view");
+        return;
+    }
+    // bunny.toml fixes no camera box: the window frames the body as drawn so far, grown by a tenth of
+    // its size (it framed the rest shape grown by half its size each way before, and the bunny spanned
+    // 156 of the 720 rows).
+    const std::filesystem::path out = output / "view_framing";
+    std::filesystem::remove_all(out);
+    const std::string view = "'" FEM_SCENE_EXE "' '" + (gallery / "bunny.toml").string() +
+                             "' --quick --no-progress --no-figures --view --screenshot 0 --out '" + out.string() +
+                             "' >/dev/null 2>&1";
+    REQUIRE(std::system(view.c_str()) == 0);
+    const Picture picture = read_picture(out / "view_0.png");
+    int top = picture.height, bottom = -1;
+    for (int y = 0; y < picture.height; ++y)
+        for (int x = 0; x < picture.width * 3 / 4; ++x) {
+            const auto [r, g, b] = picture.rgb(x, y);
+            if (std::max({r, g, b}) - std::min({r, g, b}) > 40.0) {
+                top = std::min(top, y);
+                bottom = std::max(bottom, y);
+            }
+        }
+    CAPTURE(top, bottom, picture.height);
+    CHECK(bottom - top > 0.4 * picture.height);
+    CHECK(top > 0);
+    CHECK(bottom < picture.height - 1);
+}
