@@ -38,25 +38,25 @@ python3 tools/exercises.py check
 # The grading stage builds in the release build folder (-DFEM_GRADING=ON: the exercise regions
 # behind a run-time switch, off unless FEM_STUB_EXERCISE names them): stage 4 runs the same test
 # binaries on the solutions and only builds the executables on top.
-step "1/5 grading build: every exercise fails its tests as a stub and needs only what it builds on"
+step "1/6 grading build: every exercise fails its tests as a stub and needs only what it builds on"
 cmake --preset release -DFEM_GRADING=ON -DFEM_WERROR=ON >/dev/null
 cmake --build --preset release --target fem_graded_tests -j "$JOBS"
 with_display python3 tools/exercises.py grade --build build/release
 
-step "2/5 every stub file of exercises/ compiles"
+step "2/6 every stub file of exercises/ compiles"
 cmake --preset exercises -DFEM_WERROR=ON >/dev/null
 cmake --build --preset exercises -j "$JOBS"
 
-step "3/5 unit tests and executables under AddressSanitizer + UndefinedBehaviorSanitizer"
+step "3/6 unit tests, the scene runner and two executables under AddressSanitizer + UndefinedBehaviorSanitizer"
 cmake --preset asan -DFEM_WERROR=ON >/dev/null
 cmake --build --preset asan -j "$JOBS"
 with_display ctest --preset asan
 
-step "4/5 release: all tests on the reference solutions"
+step "4/6 release: all tests on the reference solutions"
 cmake --build --preset release -j "$JOBS"
 with_display ctest --preset release
 
-step "5/5 the file readers fuzzed: each libFuzzer target 15 s from its seeds, no crash, sanitizer report, stray exception or runaway allocation"
+step "5/6 the file readers fuzzed: each libFuzzer target 15 s from its seeds, no crash, sanitizer report, stray exception or runaway allocation"
 tools/fuzz.sh --seconds 15
 
 step "6/6 the website: built, then every page, link, search and the embedded scene page checked in headless Chromium"
