@@ -253,7 +253,9 @@ struct AugmentedLagrangianReport {
 /// the step's start with al as potential, warm-started from the last solution) and multiplier
 /// updates (then, with converged_friction, relag_friction) until outer_converged and no friction
 /// normal force moved by more than 10⁻⁶ of the largest; StepInfo's Newton and solver iterations
-/// summed over the solves.
+/// summed over the solves, its boundary_work the last solve's (the pins') plus the contact forces'
+/// work f_c(u⁺)·(u⁺ − uᵗ), f_c = Σ λ⁺ ∇g at the step's end (a body pushed out to δ is given that
+/// energy; chapter 10's loop books it as work in, as contact_step books the barrier's).
 /// fem::Error (the state left at the step's start) when max_outer_iterations pass, naming the pair
 /// with the largest violation. newton must have al set as its potential.
 /// docs/16_contact_solvers.md#the-algorithm

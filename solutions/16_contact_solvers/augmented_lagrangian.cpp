@@ -554,6 +554,9 @@ dynamics::StepInfo augmented_lagrangian_step(hyper::NewtonBackwardEuler& newton,
         if (outer_converged(r.residuals, options.gap, options.violation_tolerance, options.dual_tolerance) &&
             friction_settled) {
             al.end_step();
+            // The contact forces' work, as backward Euler takes it: the forces at the step's end
+            // (Σ λ⁺ ∇g, λ⁺ what each pair exerted there) along the step's displacement.
+            total.boundary_work += al.contact_forces(solution.u).dot(solution.u - state.u);
             state = std::move(solution);
             return total;
         }
