@@ -395,7 +395,7 @@ TEST_CASE("friction between bodies reaches the solve: a block sliding on a slab 
 }
 
 TEST_CASE("[contact] solver: a block sliding on a slab resting on the floor, with either solver nothing crosses at any "
-          "frame; the augmented Lagrangian holds the slab at d-hat, IPC's barrier inside it", "[scenes][bodies][contact]")
+          "frame, the augmented Lagrangian holds the slab at d-hat and IPC's barrier inside it", "[scenes][bodies][contact]")
 {
     // The block of the friction test below on its slab, frictionless between them, 0.2 s.
     const std::string solver = GENERATE(as<std::string>(), "ipc", "augmented_lagrangian");
