@@ -104,6 +104,10 @@ struct AugmentedLagrangianOptions {
     double violation_tolerance = 1e-2;  ///< stop when max_k max(0, −g_k) ≤ this × δ
     double dual_tolerance = 1e-2;       ///< … and max_k min(λ_k/μ, max(g_k, 0)) ≤ this × δ
     double filter_gap = 1.0;            ///< drop a pair with λ = 0 and g > this × δ (ActiveSetFilter)
+    /// Whether a step starts from the multipliers the last step left (its contact forces: a warm
+    /// start), else from λ = 0 on every pair (the alternative the study measures,
+    /// docs/16_contact_solvers.md#the-choices).
+    bool warm_multipliers = true;
     int stale_steps = 2;                ///< drop a pair ending this many steps in a row with λ = 0, ≥ 1
     int max_outer_iterations = 30;      ///< outer iterations per step before fem::Error
     double safety = 0.9;                ///< the line search starts at safety × the time of impact, in (0, 1)

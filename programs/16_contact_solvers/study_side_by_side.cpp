@@ -226,8 +226,8 @@ void side_by_side_study(const RunContext& run, const std::vector<SolverScene>& s
     friction_table(run);
 
     std::cout << "\n   The augmented Lagrangian's open choices against their alternatives\n\n";
-    Table choices("The augmented Lagrangian's choices (docs: the penalty, the active set) against their alternatives "
-                  "on the fired block at 10 m/s and the two bodies",
+    Table choices("The augmented Lagrangian's choices (docs: the penalty, the active set, the warm start) against "
+                  "their alternatives on the fired block at 10 m/s, the two bodies and the stack",
                   {{"scene", Format::text, 0}, {"variant", Format::text, 0}, {"Newton iterations", Format::integer, 0},
                    {"Newton iterations in contact", Format::integer, 0}, {"time per step [ms]", Format::fixed, 3},
                    {"error", Format::text, 0}});
@@ -235,7 +235,7 @@ void side_by_side_study(const RunContext& run, const std::vector<SolverScene>& s
         const char* name;
         AugmentedLagrangianOptions options;
     };
-    std::vector<Variant> variants(4);
+    std::vector<Variant> variants(5);
     variants[0].name = "default (mu from the kinetic energy, filter 1 delta, 2 stale steps)";
     variants[1].name = "mu = 100 m / dt^2 alone (no kinetic bound)";
     variants[1].options.kinetic_penalty = false;
@@ -243,10 +243,13 @@ void side_by_side_study(const RunContext& run, const std::vector<SolverScene>& s
     variants[2].options.filter_gap = 10.0;
     variants[3].name = "penalty growth 1 (mu never raised)";
     variants[3].options.penalty_growth = 1.0;
-    // The fired block at 10 m/s, and (not with --quick: most of its time) the two blocks.
+    variants[4].name = "multipliers from 0 each step (no warm start)";
+    variants[4].options.warm_multipliers = false;
+    // The fired block at 10 m/s, and (not with --quick: most of its time) the two blocks and the
+    // stack (resting contact, where the multipliers carry over from step to step).
     std::vector<const SolverScene*> chosen{&scenes[1]};
     if (!run.quick)
-        chosen.push_back(&scenes[4]);
+        chosen.insert(chosen.end(), {&scenes[4], &scenes[3]});
     for (const SolverScene* scene : chosen)
         for (const Variant& variant : variants) {
             const SolverRun result = run_scene(*scene, ContactSolver::augmented_lagrangian, variant.options);

@@ -214,6 +214,9 @@ void AugmentedLagrangianContact::begin_step(dynamics::Body& body, const dynamics
     time_step_ = time_step;
     step_start_ = state.u;
     lag_friction(state.u, state.u);  // the multipliers the last step left: its contact forces
+    if (!options_.warm_multipliers)  // the alternative: the solve starts from no force (friction keeps its lag)
+        for (ContactConstraint& c : constraints_)
+            c.multiplier = 0.0;
 }
 
 void AugmentedLagrangianContact::lag_friction(const Eigen::VectorXd& u, const Eigen::VectorXd& start)
