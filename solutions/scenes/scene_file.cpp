@@ -218,11 +218,19 @@ void read_contact(const Fields& top, SceneSpec& scene)
     scene.contact.solver = c.text("solver", scene.contact.solver, contact_solvers());
 }
 
-/// With [contact] solver = "augmented_lagrangian", what chapter 16's solver does not have, refused at
-/// the solver field: friction between bodies, the path check, a moving obstacle (it does not stage
-/// the obstacles' motion). docs/scenes.md#the-contact-solver
+/// [contact] solver, refused at its field in a scene without contact, and with "augmented_lagrangian"
+/// where the scene needs what chapter 16's solver does not have: friction between bodies, the path
+/// check, a moving obstacle (it does not stage the obstacles' motion). docs/scenes.md#the-contact-solver
 void check_contact_solver(const Fields& top, const SceneSpec& scene)
 {
+    const toml::table* given = top.subtable("contact");
+    if (given == nullptr || given->get("solver") == nullptr)
+        return;
+    const Fields contact(*given, "contact", top.source(), {});
+    if (!has_contact(scene))  // a setting never silently ignored
+        contact.fail(*given->get("solver"), "solver",
+                     "a contact solver needs contact: an [[obstacle]], [contact] bodies = true with two or more "
+                     "bodies, or a body's self_contact = true");
     if (scene.contact.solver != "augmented_lagrangian")
         return;
     std::string missing;
@@ -233,13 +241,10 @@ void check_contact_solver(const Fields& top, const SceneSpec& scene)
     for (std::size_t i = 0; i < scene.obstacles.size() && missing.empty(); ++i)
         if (scene.obstacles[i].obstacle->velocity().norm() > 0.0)
             missing = str("moving obstacles (obstacle[", i, "] moves: the solver does not stage their motion)");
-    if (missing.empty())
-        return;
-    const toml::table& given = *top.subtable("contact");
-    Fields(given, "contact", top.source(), {})
-        .fail(*given.get("solver"), "solver",
-              str("'augmented_lagrangian' has no ", missing, " (docs/16_contact_solvers.md#what-is-guaranteed): use "
-                  "solver = \"ipc\""));
+    if (!missing.empty())
+        contact.fail(*given->get("solver"), "solver",
+                     str("'augmented_lagrangian' has no ", missing,
+                         " (docs/16_contact_solvers.md#what-is-guaranteed): use solver = \"ipc\""));
 }
 
 /// With obstacles, the contact constants and gravity against the size D of the smallest body (the

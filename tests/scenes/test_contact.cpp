@@ -350,6 +350,15 @@ TEST_CASE("[contact] solver: ipc by default, augmented_lagrangian read, an unkno
                                                              "[contact]\nsolver = \"augmented_lagrangian\"\n")),
                       Catch::Matches(".*solver_moving\\.toml:9:10: contact\\.solver: 'augmented_lagrangian' has no "
                                      "moving obstacles.*use solver = \"ipc\".*"));
+    // Without contact the field would be ignored: refused at its line.
+    {
+        const std::filesystem::path file = output / "solver_no_contact.toml";
+        std::ofstream(file) << "[[body]]\nmesh = { generator = \"box\" }\n"
+                               "material = { model = \"auto\", youngs_modulus = 1e5, poisson_ratio = 0.3, density = 1000.0 }\n"
+                               "[contact]\nsolver = \"ipc\"\n";
+        CHECK_THROWS_WITH(read_scene(file), Catch::Matches(".*solver_no_contact\\.toml:5:10: contact\\.solver: a contact solver "
+                                                           "needs contact.*"));
+    }
     // The same scene with IPC runs (chapter 14 stages the obstacles' motion).
     CHECK(read_scene(drop_scene("solver_moving_ipc", "type = \"half-space\"\nvelocity = [0.0, 0.0, 0.01]\n"
                                                      "[contact]\nsolver = \"ipc\"\n"))
