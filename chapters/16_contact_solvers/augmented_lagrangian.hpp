@@ -104,6 +104,10 @@ struct AugmentedLagrangianOptions {
     double violation_tolerance = 1e-2;  ///< stop when max_k max(0, −g_k) ≤ this × δ
     double dual_tolerance = 1e-2;       ///< … and max_k min(λ_k/μ, max(g_k, 0)) ≤ this × δ
     double filter_gap = 1.0;            ///< drop a pair with λ = 0 and g > this × δ (ActiveSetFilter)
+    /// Whether a step starts from the multipliers the last step left (its contact forces: a warm
+    /// start), else from λ = 0 on every pair (the alternative the study measures,
+    /// docs/16_contact_solvers.md#the-choices).
+    bool warm_multipliers = true;
     int stale_steps = 2;                ///< drop a pair ending this many steps in a row with λ = 0, ≥ 1
     int max_outer_iterations = 30;      ///< outer iterations per step before fem::Error
     double safety = 0.9;                ///< the line search starts at safety × the time of impact, in (0, 1)
@@ -253,7 +257,9 @@ struct AugmentedLagrangianReport {
 /// the step's start with al as potential, warm-started from the last solution) and multiplier
 /// updates (then, with converged_friction, relag_friction) until outer_converged and no friction
 /// normal force moved by more than 10⁻⁶ of the largest; StepInfo's Newton and solver iterations
-/// summed over the solves.
+/// summed over the solves, its boundary_work the last solve's (the pins') plus the contact forces'
+/// work f_c(u⁺)·(u⁺ − uᵗ), f_c = Σ λ⁺ ∇g at the step's end (a body pushed out to δ is given that
+/// energy; chapter 10's loop books it as work in, as contact_step books the barrier's).
 /// fem::Error (the state left at the step's start) when max_outer_iterations pass, naming the pair
 /// with the largest violation. newton must have al set as its potential.
 /// docs/16_contact_solvers.md#the-algorithm

@@ -7,6 +7,8 @@
 
 #include "16_contact_solvers/augmented_lagrangian.hpp"
 
+#include "15_body_contact/body_scenes.hpp"
+
 #include "14_contact/obstacles.hpp"
 
 #include "12_hyperelastic_newton/newton.hpp"
@@ -114,21 +116,17 @@ SolverScene slope_scene(double slope, double friction, int steps);
 /// onto the bowl's wall, g = 9.81 m/s², Δt = 1/100 s.
 SolverScene bowl_scene(int cells, int steps);
 
-/// A box of half extent 3 cm turned by the rotation of 0.6 rad about (1, 2, 3)/√14, its highest
-/// point at z = 0 under the centre of a 10 cm cube whose lowest face is 0.2 m up: its corners and
-/// edges meet the cube's lower face between its vertices.
+/// Chapter 15's box under the fired block (box_under_block) turned by the rotation of 0.6 rad about
+/// (1, 2, 3)/√14: its corners and edges meet the cube's lower face between its vertices.
 std::shared_ptr<const Obstacle> turned_box();
 
 /// The cube (one cell, lowest face 0.2 m up, no gravity) fired straight down at speed [m/s] at
 /// obstacle for 10 steps of 1/100 s (chapter 15's fired block).
 SolverScene fired_scene(std::shared_ptr<const Obstacle> obstacle, double speed);
 
-/// Three one-cell cubes of 30, 20 and 10 cm, each on the one below and off its centre, the lowest on
-/// the floor — chapter 15's stack, one mesh of three bodies with self-contact — 1.2 reach apart at
-/// rest, started 0.5 reach apart, g = 9.81 m/s², Δt = 1/100 s, Newton's tolerance 10⁻⁹.
+/// Chapter 15's stack of three (block_stack(reach): one mesh of three bodies with self-contact, the
+/// body of vertex v stack_block(v)) on the floor, g = 9.81 m/s², Δt = 1/100 s, Newton's tolerance 10⁻⁹.
 SolverScene stack_scene(double reach, int steps);
-/// The body (0, 1, 2: bottom to top) of each of stack_scene's 24 vertices: vertex / 8.
-inline int stack_block(int vertex) { return vertex / 8; }
 
 /// Two copies of mesh (scaled so its largest extent is size [m]), the second gap [m] beyond the first
 /// along x, closing at 2 × speed [m/s] while each spins at ±spin [rad/s] about its vertical axis:

@@ -11,7 +11,9 @@
 // the force model of the body's current level, raised to corotational first if it is linear: the
 // linear energy ½ uᵀK u of a body that has moved far from where it started is round-off (its terms
 // cancel), so the line search could not tell a decrease from noise (the rule that refuses model
-// linear with obstacles, applied to auto's choice of the moment).
+// linear with obstacles, applied to auto's choice of the moment). With [contact] solver =
+// "augmented_lagrangian" the contact step is chapter 16's augmented_lagrangian_step instead (the
+// multipliers on d ≥ d̂, the same collision check cutting every line search, no barrier).
 
 #include "scenes/contact_cost.hpp"
 #include "scenes/model_auto.hpp"
@@ -20,6 +22,7 @@
 #include "14_contact/contact.hpp"
 #include "14_contact/surface.hpp"
 #include "15_body_contact/timed_solver.hpp"
+#include "16_contact_solvers/augmented_lagrangian.hpp"
 
 #include "12_hyperelastic_newton/newton.hpp"
 
@@ -56,7 +59,9 @@ public:
     /// bodies of a group against each other, and each member whose self_contacts entry is true — one
     /// a member, in order — against itself; vertex_body: the member of each vertex), with the scene's
     /// friction between bodies, Newton with the scene's solver and tolerance; body_names: each
-    /// member's name (the path check's messages, [contact] check_path). fem::Error as ContactPotential.
+    /// member's name (the path check's messages, [contact] check_path). With the scene's solver
+    /// "augmented_lagrangian", chapter 16's AugmentedLagrangianContact with δ = d̂ and the same ε_v,
+    /// bodies and self-contact. fem::Error as ContactPotential (or AugmentedLagrangianContact).
     ContactIntegrator(dynamics::Integrator& own, std::vector<SceneForces*> levels, const dynamics::Body& body,
                       std::vector<std::shared_ptr<const contact::Obstacle>> obstacles, const SceneSpec& scene,
                       bool self_contact = false, std::vector<int> vertex_body = {}, std::vector<bool> self_contacts = {},
@@ -66,7 +71,8 @@ public:
     int order() const override { return 1; }
     bool is_explicit() const override { return !last_contact_ && own_.is_explicit(); }
     /// One step from state (time t) to t + Δt (header comment). A contact step is chapter 14's
-    /// contact::contact_step, which books the obstacles' work on the body in StepInfo::boundary_work
+    /// contact::contact_step (or, with the augmented Lagrangian, chapter 16's
+    /// augmented_lagrangian_step: no barrier stores energy, and its obstacles do not move), which books the obstacles' work on the body in StepInfo::boundary_work
     /// (the barrier's store and the moving obstacles' push: chapter 10's loop counts it as work put
     /// in, so it is not mistaken for dissipation or divergence); a level raised for the step adds the
     /// jump of H it makes at the step's start (dynamics::apply_step_hook's booking).
@@ -77,10 +83,14 @@ public:
     int contact_steps() const { return contact_steps_; }
     /// Whether the last step needed contact.
     bool last_contact() const { return last_contact_; }
-    const contact::ContactPotential& potential() const { return *potential_; }
+    /// IPC's contact potential, or the augmented Lagrangian's collision check (a chapter 15 potential
+    /// whose barrier is never evaluated): what decides out_of_contact and counts the pairs.
+    const contact::ContactPotential& potential() const { return *checks_; }
     /// The last step's time in the barrier, the collision check and the linear solves, and its new
     /// matrix patterns (contact_cost.hpp; chapter 14's ContactClocks of the contact step's potential
-    /// and TimedSolver around its solver): zeros when it was out of contact.
+    /// and TimedSolver around its solver): zeros when it was out of contact. With the augmented
+    /// Lagrangian, its terms' time is in none of the three (the barrier's is its collision check's
+    /// begin_step).
     const ContactStepCost& last_cost() const { return last_cost_; }
     /// The contact pairs at u (3n) at time t (contact_cost.hpp): the self-contact barrier's pairs
     /// within d̂ by kind, and the surface vertices closer than d̂ to each obstacle (one pair per
@@ -93,7 +103,9 @@ private:
     dynamics::Integrator& own_;
     std::vector<SceneForces*> levels_;
     std::vector<std::shared_ptr<const contact::Obstacle>> obstacles_;
-    std::unique_ptr<contact::ContactPotential> potential_;
+    std::unique_ptr<contact::ContactPotential> barrier_;                  // IPC's (null with the augmented Lagrangian)
+    std::unique_ptr<contact::AugmentedLagrangianContact> multipliers_;  // chapter 16's (null with IPC)
+    const contact::ContactPotential* checks_ = nullptr;                 // barrier_, or multipliers_'s collision check
     contact::TimedSolver* solver_ = nullptr;  // Newton's solver, timed (owned by newton_)
     hyper::NewtonBackwardEuler newton_;
     contact::SurfacePrimitives surface_;

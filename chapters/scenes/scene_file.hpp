@@ -177,6 +177,14 @@ struct ContactSpec {
     /// segment of every contact step's path between bodies, and every step's chord without contact,
     /// proven free of crossings by a second CCD; a debug mode. docs/scenes.md#bodies-against-bodies
     bool check_path = false;
+    /// The solver of every contact step, one of contact_solvers(): "ipc" (chapter 14's barrier, its
+    /// Newton's line search cut by the collision check) or "augmented_lagrangian" (chapter 16's
+    /// multipliers on d ≥ d̂, no barrier). IPC by default: the augmented Lagrangian takes fewer Newton
+    /// iterations on every scene chapter 16 measures, but it has no friction between bodies, does not
+    /// stage moving obstacles, and just below the friction threshold its block creeps 5–22 times the
+    /// mollifier's bound where IPC's keeps it (docs/16_contact_solvers.md#the-goals-of-issue-49).
+    /// docs/scenes.md#the-contact-solver
+    std::string solver = "ipc";
 };
 
 /// A whole scene, as read from its file.
@@ -268,6 +276,10 @@ bool has_contact(const SceneSpec& scene);
 /// "sphere", "box", "mesh", …): the registry in solutions/scenes/scene_obstacles.cpp, one entry a
 /// type, its own fields and how they are read, checked and built. docs/scenes.md#obstacles
 std::vector<std::string> obstacle_types();
+
+/// The names [contact] solver allows: "ipc", "augmented_lagrangian" (ContactSpec::solver).
+/// docs/scenes.md#the-contact-solver
+std::vector<std::string> contact_solvers();
 
 /// The vertices of mesh a selector selects, ascending. fem::Error (naming selector.where) if none.
 std::vector<int> select_vertices(const TetMesh& mesh, const Selector& selector);

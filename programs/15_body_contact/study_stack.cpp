@@ -5,6 +5,7 @@
 // tolerance costs in Newton iterations and time per step.
 // docs/15_body_contact.md#newtons-tolerance-against-the-closed-form
 #include "15_body_contact/body_contact.hpp"
+#include "15_body_contact/body_scenes.hpp"
 #include "14_contact/obstacles.hpp"
 #include "15_body_contact/self_barrier.hpp"
 #include "studies.hpp"
@@ -39,24 +40,15 @@ struct StackRun {
 };
 
 /// Three one-cell cubes of 30, 20 and 10 cm (27, 8 and 1 kg), each on the one below and off its
-/// centre, the lowest on the floor z = 0 — test_stack.cpp's stack, its gaps in units of d̂: at rest
+/// centre, the lowest on the floor z = 0 — test_stack.cpp's stack (block_stack), its gaps in units of d̂: at rest
 /// 1.2 d̂ apart, started 0.5 d̂ apart. Stepped `steps` times at Δt = 1/100 s with Newton's relative
 /// tolerance `tolerance`; the closed form checked after each of the last 50.
 StackRun settled_stack(double reach, double tolerance, int steps)
 {
     const double g = 9.81, time_step = 1.0 / 100.0;
-    const double sizes[3] = {0.3, 0.2, 0.1};
-    const Eigen::Vector3d corners[3] = {{0.0, 0.0, 0.5 * reach}, {0.05, 0.045, 0.3 + 1.7 * reach},
-                                        {0.1, 0.08, 0.5 + 2.9 * reach}};
-    const auto block_of = [](int vertex) { return vertex / 8; };
+    BlockStack blocks = block_stack(reach);
     dynamics::Scene scene;
-    scene.mesh.V.resize(24, 3);
-    scene.mesh.T.resize(18, 4);
-    for (int k = 0; k < 3; ++k) {
-        const TetMesh block = box_mesh(1, 1, 1, Eigen::Vector3d::Constant(sizes[k]));
-        scene.mesh.V.middleRows(8 * k, 8) = block.V.rowwise() + corners[k].transpose();
-        scene.mesh.T.middleRows(6 * k, 6) = block.T.array() + 8 * k;
-    }
+    scene.mesh = std::move(blocks.mesh);
     scene.material = {1e6, 0.3, 1000.0};
     scene.gravity = Eigen::Vector3d(0, 0, -g);
     scene.time_step = time_step;
@@ -72,10 +64,7 @@ StackRun settled_stack(double reach, double tolerance, int steps)
     newton_options.max_iterations = 200;
     hyper::NewtonBackwardEuler newton(newton_options);
     newton.set_potential(&contact);
-    Eigen::VectorXd u0 = Eigen::VectorXd::Zero(3 * 24);
-    for (int v = 0; v < 24; ++v)
-        u0[3 * v + 2] = -0.7 * reach * block_of(v);
-    dynamics::State state = dynamics::initial_state(body, u0, {});
+    dynamics::State state = dynamics::initial_state(body, blocks.start, {});
 
     // The closed form of docs/14's "A stack at rest": summed over the blocks above interface k, the
     // internal forces cancel, so F_{k→k+1} − W_above ẑ = Σ_above m Δv/Δt − Σ_above r/Δt. Measured
@@ -83,21 +72,21 @@ StackRun settled_stack(double reach, double tolerance, int steps)
     const Eigen::VectorXd& m = body.dof_masses();
     double weight[3] = {0, 0, 0};
     for (int v = 0; v < 24; ++v)
-        weight[block_of(v)] += m[3 * v] * g;
+        weight[stack_block(v)] += m[3 * v] * g;
     StackRun run;
     const auto measure = [&](const dynamics::State& before) {
         Eigen::Vector3d momentum_change[3] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
         for (int v = 0; v < 24; ++v)
-            momentum_change[block_of(v)] += m[3 * v] * (state.v - before.v).segment<3>(3 * v);
+            momentum_change[stack_block(v)] += m[3 * v] * (state.v - before.v).segment<3>(3 * v);
         Eigen::Vector3d on_upper[2] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
         for (const SurfacePair& pair : contact.term<BodyContactTerm>()->barrier().pairs(state.u, true)) {
-            const int lower = block_of(*std::min_element(pair.vertices, pair.vertices + 4));
-            const int upper = block_of(*std::max_element(pair.vertices, pair.vertices + 4));
+            const int lower = stack_block(*std::min_element(pair.vertices, pair.vertices + 4));
+            const int upper = stack_block(*std::max_element(pair.vertices, pair.vertices + 4));
             if (lower == upper)
                 continue;
             run.gaps[1 + lower] = std::min(run.gaps[1 + lower], pair.distance);
             for (int i = 0; i < 4; ++i)
-                if (block_of(pair.vertices[i]) == upper)
+                if (stack_block(pair.vertices[i]) == upper)
                     on_upper[lower] -= contact.stiffness() * pair.barrier.gradient.segment<3>(3 * i);
         }
         for (int k = 0; k < 2; ++k) {

@@ -10,9 +10,10 @@
 
 namespace fem::contact::study {
 
-/// The scenes both solvers run: the block dropped on the floor, fired at the turned box at 10 and
-/// 100 m/s, the stack of three, two bodies thrown at each other (the coarse bunnies; --quick: two
-/// blocks of 3³ cells; the coarse bunnies only with bunnies, a run of minutes).
+/// The scenes both solvers run, in this order: the block dropped on the floor, fired at the turned
+/// box at 10 and 100 m/s, the stack of three, two blocks of 3³ cells (--quick: 2³) thrown at each other, the block
+/// in the bowl; without --quick the block fired at chapter 15's mesh triangle at 10 and 100 m/s; with
+/// bunnies the two coarse bunnies (a run of minutes).
 std::vector<SolverScene> comparison_scenes(const RunContext& run, bool bunnies);
 
 /// A run with its Newton iterations of the steps in contact counted by kind: the first trial cut

@@ -5,6 +5,8 @@
 // against their alternatives. docs/16_contact_solvers.md#side-by-side
 #include "studies.hpp"
 
+#include "15_body_contact/body_scenes.hpp"
+
 #include "common/figures.hpp"
 #include "common/files.hpp"
 #include "common/mesh.hpp"
@@ -115,15 +117,24 @@ void friction_table(const RunContext& run)
 std::vector<SolverScene> comparison_scenes(const RunContext& run, bool bunnies)
 {
     // The block dropped on the floor, fired at the turned box, the stack, the block in the bowl (0.15 s,
-    // 0.6 s without --quick) and two 10 cm blocks of 3³ cells 5 mm apart closing at 1 m/s while each spins at ±5 rad/s about
+    // 0.6 s without --quick), fired at the mesh triangle (not with --quick) and two 10 cm blocks of 3³ cells (2³ with --quick) 5 mm apart closing at 1 m/s while each spins at ±5 rad/s about
     // its vertical axis; with bunnies, the coarse bunny (data/bunny_coarse: 2,199 vertices) scaled to
     // 20 cm in their place: chapter 15's study 4.
-    SolverScene two = two_bodies_scene(box_mesh(3, 3, 3, Eigen::Vector3d::Constant(0.1)), 0.1, 5e-3, 0.5, 5.0, 8);
+    const int cells = run.quick ? 2 : 3;  // --quick: 2³ cells, a fifth of the time (CI's sanitizer run)
+    SolverScene two = two_bodies_scene(box_mesh(cells, cells, cells, Eigen::Vector3d::Constant(0.1)), 0.1, 5e-3, 0.5, 5.0, 8);
     two.name = "two blocks";
     SolverScene drop = drop_scene(0.05, 40);
     SolverScene stack = stack_scene(1e-3, run.quick ? 50 : 100);
     std::vector<SolverScene> scenes{drop,  fired_scene(turned_box(), 10.0), fired_scene(turned_box(), 100.0),
                                     stack, two, bowl_scene(1, run.quick ? 15 : 60)};
+    // Chapter 15's single mesh triangle, its corner up under the fired block (the full run only:
+    // the docs' table).
+    for (double speed : {10.0, 100.0})
+        if (!run.quick) {
+            SolverScene fired = fired_scene(triangle_under_block(), speed);
+            fired.name = str("block fired at ", speed, " m/s at the mesh triangle");
+            scenes.push_back(fired);
+        }
     if (bunnies) {
         SolverScene pair = two_bodies_scene(io::read_tet_mesh(data_path("bunny_coarse.node")), 0.2, 5e-3, 0.5, 5.0, 8);
         pair.name = "two bunnies";
@@ -215,8 +226,8 @@ void side_by_side_study(const RunContext& run, const std::vector<SolverScene>& s
     friction_table(run);
 
     std::cout << "\n   The augmented Lagrangian's open choices against their alternatives\n\n";
-    Table choices("The augmented Lagrangian's choices (docs: the penalty, the active set) against their alternatives "
-                  "on the fired block at 10 m/s and the two bodies",
+    Table choices("The augmented Lagrangian's choices (docs: the penalty, the active set, the warm start) against "
+                  "their alternatives on the fired block at 10 m/s, the two bodies and the stack",
                   {{"scene", Format::text, 0}, {"variant", Format::text, 0}, {"Newton iterations", Format::integer, 0},
                    {"Newton iterations in contact", Format::integer, 0}, {"time per step [ms]", Format::fixed, 3},
                    {"error", Format::text, 0}});
@@ -224,7 +235,7 @@ void side_by_side_study(const RunContext& run, const std::vector<SolverScene>& s
         const char* name;
         AugmentedLagrangianOptions options;
     };
-    std::vector<Variant> variants(4);
+    std::vector<Variant> variants(5);
     variants[0].name = "default (mu from the kinetic energy, filter 1 delta, 2 stale steps)";
     variants[1].name = "mu = 100 m / dt^2 alone (no kinetic bound)";
     variants[1].options.kinetic_penalty = false;
@@ -232,7 +243,14 @@ void side_by_side_study(const RunContext& run, const std::vector<SolverScene>& s
     variants[2].options.filter_gap = 10.0;
     variants[3].name = "penalty growth 1 (mu never raised)";
     variants[3].options.penalty_growth = 1.0;
-    for (const SolverScene* scene : {&scenes[1], &scenes[4]})  // the fired block at 10 m/s, the two blocks
+    variants[4].name = "multipliers from 0 each step (no warm start)";
+    variants[4].options.warm_multipliers = false;
+    // The fired block at 10 m/s, and (not with --quick: most of its time) the two blocks and the
+    // stack (resting contact, where the multipliers carry over from step to step).
+    std::vector<const SolverScene*> chosen{&scenes[1]};
+    if (!run.quick)
+        chosen.insert(chosen.end(), {&scenes[4], &scenes[3]});
+    for (const SolverScene* scene : chosen)
         for (const Variant& variant : variants) {
             const SolverRun result = run_scene(*scene, ContactSolver::augmented_lagrangian, variant.options);
             choices.add_row({scene->name, std::string(variant.name), double(result.newton_iterations),

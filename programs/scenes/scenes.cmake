@@ -8,7 +8,7 @@ find_package(tomlplusplus 3 REQUIRED)  # Debian's libtomlplusplus-dev (tools/set
 file(GLOB scene_sources CONFIGURE_DEPENDS ${FEM_ROOT}/solutions/scenes/*.cpp)
 add_library(fem_scenes STATIC ${scene_sources})
 target_include_directories(fem_scenes PUBLIC ${FEM_ROOT}/chapters)
-target_link_libraries(fem_scenes PUBLIC fem_ch15_reference fem_ch14_reference fem_ch13_reference fem_ch12_reference fem_ch11_reference fem_ch10_reference
+target_link_libraries(fem_scenes PUBLIC fem_ch16_reference fem_ch15_reference fem_ch14_reference fem_ch13_reference fem_ch12_reference fem_ch11_reference fem_ch10_reference
                       PRIVATE tomlplusplus::tomlplusplus fem_flags)
 target_compile_options(fem_scenes PRIVATE ${FEM_FUZZ_FLAGS})  # the scene reader, fuzz_scene's ground
 fem_reference_code(fem_scenes)

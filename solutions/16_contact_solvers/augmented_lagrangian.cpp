@@ -214,6 +214,9 @@ void AugmentedLagrangianContact::begin_step(dynamics::Body& body, const dynamics
     time_step_ = time_step;
     step_start_ = state.u;
     lag_friction(state.u, state.u);  // the multipliers the last step left: its contact forces
+    if (!options_.warm_multipliers)  // the alternative: the solve starts from no force (friction keeps its lag)
+        for (ContactConstraint& c : constraints_)
+            c.multiplier = 0.0;
 }
 
 void AugmentedLagrangianContact::lag_friction(const Eigen::VectorXd& u, const Eigen::VectorXd& start)
@@ -554,6 +557,9 @@ dynamics::StepInfo augmented_lagrangian_step(hyper::NewtonBackwardEuler& newton,
         if (outer_converged(r.residuals, options.gap, options.violation_tolerance, options.dual_tolerance) &&
             friction_settled) {
             al.end_step();
+            // The contact forces' work, as backward Euler takes it: the forces at the step's end
+            // (Σ λ⁺ ∇g, λ⁺ what each pair exerted there) along the step's displacement.
+            total.boundary_work += al.contact_forces(solution.u).dot(solution.u - state.u);
             state = std::move(solution);
             return total;
         }

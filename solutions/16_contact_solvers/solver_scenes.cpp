@@ -1,5 +1,6 @@
 #include "16_contact_solvers/solver_runs.hpp"
 
+#include "15_body_contact/body_scenes.hpp"
 #include "15_body_contact/mesh_obstacle.hpp"
 
 #include "common/files.hpp"
@@ -71,12 +72,7 @@ SolverScene bowl_scene(int cells, int steps)
 
 std::shared_ptr<const Obstacle> turned_box()
 {
-    const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.6, Eigen::Vector3d(1.0, 2.0, 3.0).normalized()).toRotationMatrix();
-    const Eigen::Vector3d half = Eigen::Vector3d::Constant(0.03);
-    double top = 0.0;  // the highest corner's height above the centre
-    for (int k = 0; k < 8; ++k)
-        top = std::max(top, (turn * Eigen::Vector3d((k & 1) ? 1 : -1, (k & 2) ? 1 : -1, (k & 4) ? 1 : -1).cwiseProduct(half)).z());
-    return std::make_shared<Box>(Eigen::Vector3d(0.05, 0.05, -top), half, turn);
+    return box_under_block(Eigen::AngleAxisd(0.6, Eigen::Vector3d(1.0, 2.0, 3.0).normalized()).toRotationMatrix());
 }
 
 SolverScene fired_scene(std::shared_ptr<const Obstacle> obstacle, double speed)
@@ -94,30 +90,16 @@ SolverScene fired_scene(std::shared_ptr<const Obstacle> obstacle, double speed)
 
 SolverScene stack_scene(double reach, int steps)
 {
-    const double sizes[3] = {0.3, 0.2, 0.1};
-    // At rest 1.2 δ apart (closer than δ at rest, the IPC barrier would push the blocks apart at
-    // rest), started 0.5 δ apart: block k moved down by 0.7 k δ.
-    const Eigen::Vector3d corners[3] = {{0.0, 0.0, 0.5 * reach}, {0.05, 0.045, 0.3 + 1.7 * reach},
-                                        {0.1, 0.08, 0.5 + 2.9 * reach}};
-    TetMesh mesh;
-    mesh.V.resize(24, 3);
-    mesh.T.resize(18, 4);
-    for (int k = 0; k < 3; ++k) {
-        const TetMesh block = cube_at(sizes[k], 1, corners[k]);
-        mesh.V.middleRows(8 * k, 8) = block.V;
-        mesh.T.middleRows(6 * k, 6) = block.T.array() + 8 * k;
-    }
+    BlockStack blocks = block_stack(reach);
     SolverScene stack;
     stack.name = "stack of three";
-    stack.scene = rubber_scene(std::move(mesh), 9.81, 1.0 / 100.0);
+    stack.scene = rubber_scene(std::move(blocks.mesh), 9.81, 1.0 / 100.0);
     stack.obstacles = {std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ())};
     stack.self_contact = true;
     stack.vertex_body.resize(24);
     for (int v = 0; v < 24; ++v)
         stack.vertex_body[static_cast<std::size_t>(v)] = stack_block(v);
-    stack.u0 = Eigen::VectorXd::Zero(3 * 24);
-    for (int v = 0; v < 24; ++v)
-        stack.u0[3 * v + 2] = -0.7 * reach * stack_block(v);
+    stack.u0 = std::move(blocks.start);
     stack.steps = steps;
     stack.newton_tolerance = 1e-9;
     return stack;

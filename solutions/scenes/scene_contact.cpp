@@ -36,6 +36,20 @@ contact::BodyContactOptions contact_options(const SceneSpec& scene, bool self_co
     return options;
 }
 
+/// Chapter 16's augmented Lagrangian for the scene: δ = d̂, the scene's ε_v, bodies and self-contact
+/// as contact_options.
+contact::AugmentedLagrangianOptions multiplier_options(const SceneSpec& scene, bool self_contact,
+                                                      std::vector<int> vertex_body, std::vector<bool> self_contacts)
+{
+    contact::AugmentedLagrangianOptions options;
+    options.gap = scene.contact.activation_distance;
+    options.friction_velocity = scene.contact.friction_velocity;
+    options.self_contact = self_contact;
+    options.vertex_body = std::move(vertex_body);
+    options.body_self_contact = std::move(self_contacts);
+    return options;
+}
+
 /// Newton's options for a contact step: the scene's solver, made timed (*timed receives it when
 /// Newton makes it) and its tolerance, contact_newton_iterations.
 hyper::NewtonOptions contact_newton_options(const SceneSpec& scene, contact::TimedSolver** timed)
@@ -61,14 +75,23 @@ ContactIntegrator::ContactIntegrator(dynamics::Integrator& own, std::vector<Scen
     : own_(own),
       levels_(std::move(levels)),
       obstacles_(obstacles),
-      potential_(std::make_unique<contact::ContactPotential>(contact::body_contact_potential(
-          body, std::move(obstacles),
-          contact_options(scene, self_contact, std::move(vertex_body), std::move(self_contacts), std::move(body_names))))),
       newton_(contact_newton_options(scene, &solver_)),
       surface_(contact::surface_primitives(body.mesh())),
       rest_(body.mesh().V)
 {
-    newton_.set_potential(potential_.get());
+    if (scene.contact.solver == "augmented_lagrangian") {
+        multipliers_ = std::make_unique<contact::AugmentedLagrangianContact>(
+            body, std::move(obstacles),
+            multiplier_options(scene, self_contact, std::move(vertex_body), std::move(self_contacts)));
+        checks_ = &multipliers_->collision_check();
+        newton_.set_potential(multipliers_.get());
+    } else {
+        barrier_ = std::make_unique<contact::ContactPotential>(contact::body_contact_potential(
+            body, std::move(obstacles),
+            contact_options(scene, self_contact, std::move(vertex_body), std::move(self_contacts), std::move(body_names))));
+        checks_ = barrier_.get();
+        newton_.set_potential(barrier_.get());
+    }
 }
 
 ContactPairs ContactIntegrator::pairs(const Eigen::VectorXd& u, double time) const
@@ -77,10 +100,10 @@ ContactPairs ContactIntegrator::pairs(const Eigen::VectorXd& u, double time) con
         throw Error(str("ContactIntegrator::pairs: u has ", u.size(), " entries, expected 3 x ", rest_.rows(),
                         " vertices"));
     ContactPairs counted;
-    if (const auto* bodies = potential_->term<contact::BodyContactTerm>())
+    if (const auto* bodies = checks_->term<contact::BodyContactTerm>())
         for (const contact::SurfacePair& pair : bodies->barrier().pairs(u, false))
             ++(pair.kind == contact::PrimitivePair::point_triangle ? counted.point_triangle : counted.edge_edge);
-    const double reach = potential_->options().activation_distance;
+    const double reach = checks_->options().activation_distance;
     for (int v : surface_.vertices) {
         const Eigen::Vector3d x = rest_.row(v).transpose() + u.segment<3>(3 * v);
         for (const auto& obstacle : obstacles_)
@@ -99,10 +122,10 @@ dynamics::StepInfo ContactIntegrator::step(dynamics::Body& body, double time_ste
     const double end = state.time + time_step;
     last_cost_ = {};
     // Near an obstacle at the start already: contact at once, without trying the own step.
-    if (potential_->out_of_contact(state.u, state.time, state.u, end)) {
+    if (checks_->out_of_contact(state.u, state.time, state.u, end)) {
         dynamics::State trial = state;
         const dynamics::StepInfo info = own_.step(body, time_step, trial);
-        if (potential_->out_of_contact(state.u, state.time, trial.u, end)) {
+        if (checks_->out_of_contact(state.u, state.time, trial.u, end)) {
             state = std::move(trial);
             last_contact_ = false;
             return info;
@@ -123,14 +146,15 @@ dynamics::StepInfo ContactIntegrator::step(dynamics::Body& body, double time_ste
                 return true;
             },
             body, state, end);
-    potential_->reset_clocks();
+    const contact::ContactClocks before = checks_->clocks();
     const double solves = solver_->seconds;
     const int patterns = solver_->new_patterns;
-    dynamics::StepInfo info = contact::contact_step(newton_, *potential_, body, time_step, state);
+    dynamics::StepInfo info = multipliers_ ? contact::augmented_lagrangian_step(newton_, *multipliers_, body, time_step, state)
+                                           : contact::contact_step(newton_, *barrier_, body, time_step, state);
     info.boundary_work += model_change;
-    const contact::ContactClocks clocks = potential_->clocks();
-    last_cost_ = {clocks.barrier_seconds, clocks.collision_seconds, solver_->seconds - solves,
-                  solver_->new_patterns - patterns};
+    const contact::ContactClocks after = checks_->clocks();
+    last_cost_ = {after.barrier_seconds - before.barrier_seconds, after.collision_seconds - before.collision_seconds,
+                  solver_->seconds - solves, solver_->new_patterns - patterns};
     return info;
 }
 

@@ -201,20 +201,50 @@ void read_bodies(const Fields& top, SceneSpec& scene)
 }
 
 /// [contact]: the barrier's activation distance d̂, the friction's ε_v, whether bodies meet and the
-/// friction between them.
+/// friction between them, the solver.
 void read_contact(const Fields& top, SceneSpec& scene)
 {
     const toml::table* contact_table = top.subtable("contact");
     if (contact_table == nullptr)
         return;
     const Fields c(*contact_table, "contact", top.source(),
-                   {"activation_distance", "friction_velocity", "bodies", "friction", "check_path"});
+                   {"activation_distance", "friction_velocity", "bodies", "friction", "check_path", "solver"});
     scene.contact.activation_distance = c.positive("activation_distance", scene.contact.activation_distance);
     scene.contact.friction_velocity = c.positive("friction_velocity", scene.contact.friction_velocity);
     scene.contact.bodies = c.flag("bodies", scene.contact.bodies);
     scene.contact.check_path = c.flag("check_path", scene.contact.check_path);
     scene.contact.friction =
         c.number("friction", scene.contact.friction, [](double mu) { return mu >= 0.0 && mu <= 10.0; }, "a number in [0, 10]");
+    scene.contact.solver = c.text("solver", scene.contact.solver, contact_solvers());
+}
+
+/// [contact] solver, refused at its field in a scene without contact, and with "augmented_lagrangian"
+/// where the scene needs what chapter 16's solver does not have: friction between bodies, the path
+/// check, a moving obstacle (it does not stage the obstacles' motion). docs/scenes.md#the-contact-solver
+void check_contact_solver(const Fields& top, const SceneSpec& scene)
+{
+    const toml::table* given = top.subtable("contact");
+    if (given == nullptr || given->get("solver") == nullptr)
+        return;
+    const Fields contact(*given, "contact", top.source(), {});
+    if (!has_contact(scene))  // a setting never silently ignored
+        contact.fail(*given->get("solver"), "solver",
+                     "a contact solver needs contact: an [[obstacle]], [contact] bodies = true with two or more "
+                     "bodies, or a body's self_contact = true");
+    if (scene.contact.solver != "augmented_lagrangian")
+        return;
+    std::string missing;
+    if (scene.contact.friction > 0.0)
+        missing = str("friction between bodies (contact.friction = ", scene.contact.friction, ")");
+    else if (scene.contact.check_path)
+        missing = "the path check (contact.check_path = true)";
+    for (std::size_t i = 0; i < scene.obstacles.size() && missing.empty(); ++i)
+        if (scene.obstacles[i].obstacle->velocity().norm() > 0.0)
+            missing = str("moving obstacles (obstacle[", i, "] moves: the solver does not stage their motion)");
+    if (!missing.empty())
+        contact.fail(*given->get("solver"), "solver",
+                     str("'augmented_lagrangian' has no ", missing,
+                         " (docs/16_contact_solvers.md#what-is-guaranteed): use solver = \"ipc\""));
 }
 
 /// With obstacles, the contact constants and gravity against the size D of the smallest body (the
@@ -364,6 +394,7 @@ SceneSpec read_scene(const std::filesystem::path& path, const std::vector<std::s
     read_contact(top, scene);
     read_obstacles(top, scene);
     check_contact_scales(top, scene);
+    check_contact_solver(top, scene);
     read_skin(top, scene);
     check_bodies(scene);
     return scene;
@@ -386,6 +417,11 @@ std::vector<std::filesystem::path> input_files(const SceneSpec& scene)
         if (!obstacle.file.empty())
             files.push_back(obstacle.file);
     return files;
+}
+
+std::vector<std::string> contact_solvers()
+{
+    return {"ipc", "augmented_lagrangian"};
 }
 
 bool bodies_meet(const SceneSpec& scene)

@@ -6,6 +6,7 @@
 #include "15_body_contact/broad_phase.hpp"
 #include "15_body_contact/ccd.hpp"
 #include "15_body_contact/body_contact.hpp"
+#include "15_body_contact/body_scenes.hpp"
 #include "14_contact/contact.hpp"
 #include "14_contact/contact_scenes.hpp"
 #include "15_body_contact/intersections.hpp"
@@ -138,29 +139,6 @@ Impact fire(std::shared_ptr<const Obstacle> obstacle, double speed)
     return impact;
 }
 
-/// A box of half extent 3 cm under the block's centre, turned by turn, its highest point at z = 0:
-/// its corners and edges meet the block's lower face between its vertices.
-std::shared_ptr<const Obstacle> box_under(const Eigen::Matrix3d& turn)
-{
-    const Eigen::Vector3d half = Eigen::Vector3d::Constant(0.03);
-    double top = 0.0;
-    for (int k = 0; k < 8; ++k)
-        top = std::max(top, (turn * Eigen::Vector3d((k & 1) ? 1 : -1, (k & 2) ? 1 : -1, (k & 4) ? 1 : -1)
-                                        .cwiseProduct(half)).z());
-    return std::make_shared<Box>(Eigen::Vector3d(0.05, 0.05, -top), half, turn);
-}
-
-/// One triangle, its corner (0.05, 0.05, 0) pointing up under the block's centre.
-std::shared_ptr<const Obstacle> triangle_under()
-{
-    TriMesh triangle;
-    triangle.V.resize(3, 3);
-    triangle.V << 0.05, 0.05, 0.0, 0.6, -0.2, -0.1, -0.2, 0.6, -0.1;
-    triangle.F.resize(1, 3);
-    triangle.F << 0, 1, 2;
-    return std::make_shared<MeshObstacle>(triangle);
-}
-
 /// The tent: the square [-1, 1]² at z = 0 cut into four triangles at a raised apex (0.05, 0.05, 0.02)
 /// under the block's centre.
 std::shared_ptr<const Obstacle> tent()
@@ -183,9 +161,9 @@ const Eigen::Matrix3d turned = Eigen::AngleAxisd(0.6, Eigen::Vector3d(1.0, 2.0, 
 TEST_CASE("probe: the block fired at obstacles with corners at 10, 100 and 1000 m/s", "[.probe]")
 {
     const std::pair<const char*, std::shared_ptr<const Obstacle>> obstacles[] = {
-        {"turned box", box_under(turned)},
-        {"aligned box", box_under(Eigen::Matrix3d::Identity())},
-        {"triangle", triangle_under()},
+        {"turned box", box_under_block(turned)},
+        {"aligned box", box_under_block(Eigen::Matrix3d::Identity())},
+        {"triangle", triangle_under_block()},
         {"tent", tent()},
         {"floor", std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ())}};
     for (const auto& [name, obstacle] : obstacles)
@@ -205,9 +183,9 @@ TEST_CASE("fired at a turned box, an axis-aligned box, a mesh triangle and the f
     // their edges at its edges: only the edge and corner barrier holds them off. The step carries the
     // block 0.1 or 1 m, 0.5 or 5 times its size.
     const auto [name, obstacle] = GENERATE(table<const char*, std::shared_ptr<const Obstacle>>(
-        {{"turned box", box_under(turned)},
-         {"axis-aligned box", box_under(Eigen::Matrix3d::Identity())},
-         {"mesh triangle", triangle_under()},
+        {{"turned box", box_under_block(turned)},
+         {"axis-aligned box", box_under_block(Eigen::Matrix3d::Identity())},
+         {"mesh triangle", triangle_under_block()},
          {"floor", std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ())}}));
     const double speed = GENERATE(10.0, 100.0);
     const Impact impact = fire(obstacle, speed);
@@ -223,7 +201,7 @@ TEST_CASE("fired at a turned box or a mesh triangle at 1000 m/s, every step conv
 {
     // 10 m a step: the block meets the corner and slides off it within the first step.
     const auto [name, obstacle] = GENERATE(table<const char*, std::shared_ptr<const Obstacle>>(
-        {{"turned box", box_under(turned)}, {"mesh triangle", triangle_under()}}));
+        {{"turned box", box_under_block(turned)}, {"mesh triangle", triangle_under_block()}}));
     const Impact impact = fire(obstacle, 1000.0);
     INFO(name << ": " << impact.error << impact.inside);
     CHECK(impact.steps == 10);
@@ -241,7 +219,7 @@ TEST_CASE("fired at the floor or flat on an axis-aligned box at 1000 m/s, the im
     // with advice that test_inversion_free.cpp follows (neo-Hookean runs it).
     const auto [name, obstacle] = GENERATE(table<const char*, std::shared_ptr<const Obstacle>>(
         {{"floor", std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ())},
-         {"axis-aligned box", box_under(Eigen::Matrix3d::Identity())}}));
+         {"axis-aligned box", box_under_block(Eigen::Matrix3d::Identity())}}));
     const Impact impact = fire(obstacle, 1000.0);
     INFO(name << ": " << impact.error << impact.inside);
     CHECK(impact.steps == 0);

@@ -2,6 +2,7 @@
 // self-contact on: the barrier force that block k + 1 puts on block k (the self-contact pairs between
 // them, SelfContactBarrier::pairs) equals the weight of the blocks above.
 // docs/15_body_contact.md#a-stack-at-rest
+#include "15_body_contact/body_scenes.hpp"
 #include "15_body_contact/body_contact.hpp"
 #include "14_contact/obstacles.hpp"
 #include "15_body_contact/self_barrier.hpp"
@@ -10,7 +11,6 @@
 
 #include "10_linear_dynamics/body.hpp"
 
-#include "common/mesh.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -25,23 +25,12 @@ TEST_CASE("a stack at rest: the barrier force between blocks k and k+1 equals th
           "[self][ex15.5]")
 {
     // Three one-cell cubes of 30, 20 and 10 cm (27, 8 and 1 kg), each on the one below and off its
-    // centre (no vertex on a diagonal), the lowest on the floor z = 0. At rest they are 1.2 d̂ apart
-    // (self-contact asks for more than d̂ between bodies at rest) and start 0.5 d̂ apart (u₀).
+    // centre (no vertex on a diagonal), the lowest on the floor z = 0 (block_stack). At rest they are
+    // 1.2 d̂ apart (self-contact asks for more than d̂ between bodies at rest) and start 0.5 d̂ apart (u₀).
     const double reach = 1e-3, g = 9.81;  // d̂ [m]
-    const double sizes[3] = {0.3, 0.2, 0.1};
-    const Eigen::Vector3d corners[3] = {{0.0, 0.0, 0.5 * reach}, {0.05, 0.045, 0.3 + 1.7 * reach},
-                                        {0.1, 0.08, 0.5 + 2.9 * reach}};
-    TetMesh mesh;
-    mesh.V.resize(24, 3);
-    mesh.T.resize(18, 4);
-    for (int k = 0; k < 3; ++k) {
-        const TetMesh block = box_mesh(1, 1, 1, Eigen::Vector3d::Constant(sizes[k]));
-        mesh.V.middleRows(8 * k, 8) = block.V.rowwise() + corners[k].transpose();
-        mesh.T.middleRows(6 * k, 6) = block.T.array() + 8 * k;
-    }
-    const auto block_of = [](int vertex) { return vertex / 8; };
+    const BlockStack blocks = block_stack(reach);
     dynamics::Scene scene;
-    scene.mesh = mesh;
+    scene.mesh = blocks.mesh;
     scene.material = {1e6, 0.3, 1000.0};
     scene.gravity = Eigen::Vector3d(0, 0, -g);
     scene.time_step = 1.0 / 100.0;
@@ -49,11 +38,8 @@ TEST_CASE("a stack at rest: the barrier force between blocks k and k+1 equals th
     options.self_contact = true;
     options.check_intersections = true;  // every Newton iterate and line-search trial
     options.activation_distance = reach;
-    Eigen::VectorXd u0 = Eigen::VectorXd::Zero(3 * 24);
-    for (int v = 0; v < 24; ++v)
-        u0[3 * v + 2] = -0.7 * reach * block_of(v);
     test::ContactRun stack(scene, options, {std::make_shared<HalfSpace>(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ())},
-                           u0, {}, 1e-10);
+                           blocks.start, {}, 1e-10);
     // Settled: backward Euler damps the blocks' bounces on the barrier (1.5 s).
     for (int s = 0; s < 150; ++s)
         stack.step();
@@ -69,8 +55,8 @@ TEST_CASE("a stack at rest: the barrier force between blocks k and k+1 equals th
     for (int k = 0; k < 3; ++k)
         momentum_change[k].setZero();
     for (int v = 0; v < 24; ++v) {
-        weight[block_of(v)] += m[3 * v] * g;
-        momentum_change[block_of(v)] += m[3 * v] * (state.v - before.v).segment<3>(3 * v);
+        weight[stack_block(v)] += m[3 * v] * g;
+        momentum_change[stack_block(v)] += m[3 * v] * (state.v - before.v).segment<3>(3 * v);
     }
     // The barrier force of block k + 1 on block k and of block k on block k + 1 (3 each) [N]: −κ ∇(m b)
     // of every pair with vertices in both, summed over each block's vertices.
@@ -81,15 +67,15 @@ TEST_CASE("a stack at rest: the barrier force between blocks k and k+1 equals th
     for (const SurfacePair& pair : contact.term<BodyContactTerm>()->barrier().pairs(state.u, true)) {
         int lowest = 3, highest = -1;
         for (int v : pair.vertices) {
-            lowest = std::min(lowest, block_of(v));
-            highest = std::max(highest, block_of(v));
+            lowest = std::min(lowest, stack_block(v));
+            highest = std::max(highest, stack_block(v));
         }
         REQUIRE(highest - lowest <= 1);  // no pair reaches past the next block
         if (highest == lowest)
             continue;
         nearest[lowest] = std::min(nearest[lowest], pair.distance);
         for (int i = 0; i < 4; ++i)
-            (block_of(pair.vertices[i]) == lowest ? on_lower : on_upper)[lowest] -=
+            (stack_block(pair.vertices[i]) == lowest ? on_lower : on_upper)[lowest] -=
                 contact.stiffness() * pair.barrier.gradient.segment<3>(3 * i);
     }
     for (int k = 0; k < 2; ++k) {

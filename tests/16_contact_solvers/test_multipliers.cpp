@@ -70,6 +70,7 @@ TEST_CASE("active-set filter: keeps pushing pairs and near ones, drops far idle 
     CHECK(keeps_constraint(0.5, 2.0, delta, 1.0));       // far but still pushing (λ > 0)
     CHECK(keeps_constraint(0.9e-3, 0.0, delta, 1.0));    // idle but within filter_gap δ
     CHECK(keeps_constraint(-1e-4, 0.0, delta, 1.0));     // violated
+    CHECK(keeps_constraint(-5e-3, 0.0, delta, 1.0));     // violated by more than filter_gap δ: g ≤ filter_gap δ all the same
     CHECK_FALSE(keeps_constraint(1.1e-3, 0.0, delta, 1.0));
     CHECK_FALSE(keeps_constraint(2e-4, 0.0, delta, 0.1));
 }
@@ -90,4 +91,8 @@ TEST_CASE("stopping rule: violation, complementarity and the time of impact, eac
     OuterResiduals locked = r;
     locked.impact_complete = false;
     CHECK_FALSE(outer_converged(locked, delta, 1e-2, 1e-2));
+    // Each residual against its own tolerance: the violation against violation_tolerance, the
+    // complementarity against dual_tolerance.
+    CHECK(outer_converged(r, delta, 1e-2, 6e-3));
+    CHECK_FALSE(outer_converged(r, delta, 6e-3, 1e-2));
 }

@@ -393,3 +393,42 @@ TEST_CASE("friction between bodies reaches the solve: a block sliding on a slab 
     CHECK(sliding > 0.45);
     CHECK(std::abs(rubbed) < 0.05);
 }
+
+TEST_CASE("[contact] solver: a block sliding on a slab resting on the floor, with either solver nothing crosses at any "
+          "frame, the augmented Lagrangian holds the slab at d-hat and IPC's barrier inside it", "[scenes][bodies][contact]")
+{
+    // The block of the friction test below on its slab, frictionless between them, 0.2 s.
+    const std::string solver = GENERATE(as<std::string>(), "ipc", "augmented_lagrangian");
+    const SceneSpec scene = testing::scene_from(
+        "slab_" + solver,
+        str("title = \"slab\"\n[[body]]\nname = \"slab\"\nmesh = { generator = \"box\", size = [0.3, 0.3, 0.05], "
+            "cells = [3, 3, 1], translate = [-0.15, -0.15, 0.002] }\n",
+            rubber, "\n[[body]]\nname = \"block\"\nmesh = { generator = \"box\", size = [0.05, 0.05, 0.05], "
+            "cells = [1, 1, 1], translate = [-0.1, -0.025, 0.054] }\n",
+            rubber, "\ninitial_velocity = [0.5, 0.0, 0.0]\n[[obstacle]]\ntype = \"half-space\"\nfriction = 1.0\n",
+            "[time]\nstep = 0.01\nduration = 0.2\n[contact]\nbodies = true\nsolver = \"", solver, "\"\n",
+            "[output]\npvd = false\npng = false\ncsv = false\ncharts = false\nvideo = \"none\"\nframe_rate = 100\n"));
+    REQUIRE(scene.contact.solver == solver);
+    const RunResult run = run_positions(scene);
+    REQUIRE(run.frames[0].size() == 21);
+    const TetMesh joined = joined_mesh(scene, all_bodies(scene));
+    const double reach = scene.contact.activation_distance;
+    CAPTURE(solver);
+    for (std::size_t k = 0; k < run.frames[0].size(); ++k) {
+        INFO("frame " << k);
+        CHECK(run.frames[0][k].col(2).minCoeff() > 0.0);  // the slab above the floor
+        CHECK(run.frames[1][k].col(2).minCoeff() > 0.0);
+        CHECK(crossing_at(run, k, joined, vertex_owners(scene)).empty());
+        // The block over the slab's top face (its lowest vertices above the slab's highest).
+        CHECK(run.frames[1][k].col(2).minCoeff() > run.frames[0][k].col(2).maxCoeff());
+    }
+    // At rest on the floor at the end: the augmented Lagrangian's stopping rule holds the pressed
+    // vertices at d-hat within 1e-2 d-hat (violation below, complementarity above: chapter 16's
+    // tolerances); IPC's barrier balances the weight well inside d-hat.
+    const double lowest = run.frames[0].back().col(2).minCoeff();
+    CAPTURE(lowest, reach);
+    if (solver == "augmented_lagrangian")
+        CHECK(std::abs(lowest - reach) <= 1e-2 * reach);
+    else
+        CHECK(lowest < 0.5 * reach);
+}

@@ -333,3 +333,34 @@ TEST_CASE("auto raised to corotational for a contact step books the jump of H, a
     CAPTURE(linear, corotational, barrier, info.boundary_work);
     CHECK(std::abs(info.boundary_work - (corotational - linear + barrier)) <= 1e-9 * linear);
 }
+
+TEST_CASE("[contact] solver: ipc by default, augmented_lagrangian read, an unknown name and what the augmented "
+          "Lagrangian lacks refused at the field", "[scenes][contact]")
+{
+    CHECK(read_scene(drop_scene("solver_default")).contact.solver == "ipc");
+    CHECK(read_scene(drop_scene("solver_al", "type = \"half-space\"\nfriction = 0.5\n"
+                                             "[contact]\nsolver = \"augmented_lagrangian\"\n"))
+              .contact.solver == "augmented_lagrangian");
+    // The file, the field's line and column, the value and the names allowed.
+    CHECK_THROWS_WITH(read_scene(drop_scene("solver_unknown", "type = \"half-space\"\n[contact]\nsolver = \"barrier\"\n")),
+                      Catch::Matches(".*solver_unknown\\.toml:8:10: contact\\.solver: must be one of .*ipc.*"
+                                     "augmented_lagrangian.*, got 'barrier'.*"));
+    // A moving obstacle (the augmented Lagrangian does not stage the obstacles' motion), at the solver field.
+    CHECK_THROWS_WITH(read_scene(drop_scene("solver_moving", "type = \"half-space\"\nvelocity = [0.0, 0.0, 0.01]\n"
+                                                             "[contact]\nsolver = \"augmented_lagrangian\"\n")),
+                      Catch::Matches(".*solver_moving\\.toml:9:10: contact\\.solver: 'augmented_lagrangian' has no "
+                                     "moving obstacles.*use solver = \"ipc\".*"));
+    // Without contact the field would be ignored: refused at its line.
+    {
+        const std::filesystem::path file = output / "solver_no_contact.toml";
+        std::ofstream(file) << "[[body]]\nmesh = { generator = \"box\" }\n"
+                               "material = { model = \"auto\", youngs_modulus = 1e5, poisson_ratio = 0.3, density = 1000.0 }\n"
+                               "[contact]\nsolver = \"ipc\"\n";
+        CHECK_THROWS_WITH(read_scene(file), Catch::Matches(".*solver_no_contact\\.toml:5:10: contact\\.solver: a contact solver "
+                                                           "needs contact.*"));
+    }
+    // The same scene with IPC runs (chapter 14 stages the obstacles' motion).
+    CHECK(read_scene(drop_scene("solver_moving_ipc", "type = \"half-space\"\nvelocity = [0.0, 0.0, 0.01]\n"
+                                                     "[contact]\nsolver = \"ipc\"\n"))
+              .obstacles.size() == 1);
+}
