@@ -263,8 +263,8 @@ double FeatureBarrier::earliest_impact(const MatrixX3d& x0, const MatrixX3d& x1,
         const auto end = [&](int v) -> Eigen::Vector3d { return x1.row(v).transpose() - back; };
         const auto corner = [&](int c) -> Eigen::Vector3d { return features.vertices.row(c).transpose() + at; };
         // A rounded core's reach, and the minimum separation's: a pair whose swept boxes stay apart
-        // but come within d̂ may still end nearer than its gap (line_search_time_of_impact).
-        const Eigen::Vector3d round = Eigen::Vector3d::Constant(features.radius + activation_distance_);
+        // but come within its gap ≤ d̂/10 may still end nearer than that (line_search_time_of_impact).
+        const Eigen::Vector3d round = Eigen::Vector3d::Constant(features.radius + 0.1 * activation_distance_);
         PrimitiveMotion motion;
         if (features.edges.rows() > 0)
             for (Eigen::Index e = 0; e < edges_.rows(); ++e) {
