@@ -226,7 +226,7 @@ TEST_CASE("fired at 10 m/s at a small triangle under its corner, the block runs 
 }
 
 TEST_CASE("fired at a small triangle on its face, its corner or its sharp edge at 10 and 100 m/s, no segment of "
-          "Newton's path meets it; nor does a frame as it rises into the block", "[ex15.4][slow]")
+          "Newton's path meets it, nor does a frame as it rises into the block", "[ex15.4][slow]")
 {
     const auto [name, t] = GENERATE(table<const char*, TriMesh>({
         {"face under the block's corner", under_the_corner()},
