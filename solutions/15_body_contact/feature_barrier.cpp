@@ -262,7 +262,9 @@ double FeatureBarrier::earliest_impact(const MatrixX3d& x0, const MatrixX3d& x1,
         const auto start = [&](int v) -> Eigen::Vector3d { return x0.row(v).transpose(); };
         const auto end = [&](int v) -> Eigen::Vector3d { return x1.row(v).transpose() - back; };
         const auto corner = [&](int c) -> Eigen::Vector3d { return features.vertices.row(c).transpose() + at; };
-        const Eigen::Vector3d round = Eigen::Vector3d::Constant(features.radius);  // a rounded core's reach
+        // A rounded core's reach, and the minimum separation's: a pair whose swept boxes stay apart
+        // but come within its gap ≤ d̂/10 may still end nearer than that (line_search_time_of_impact).
+        const Eigen::Vector3d round = Eigen::Vector3d::Constant(features.radius + 0.1 * activation_distance_);
         PrimitiveMotion motion;
         if (features.edges.rows() > 0)
             for (Eigen::Index e = 0; e < edges_.rows(); ++e) {
@@ -275,7 +277,7 @@ double FeatureBarrier::earliest_impact(const MatrixX3d& x0, const MatrixX3d& x1,
                     motion.end << end(i), end(j), b0, b1;
                     earliest = std::min(earliest, features.radius > 0.0
                                                       ? additive_time_of_impact(PrimitivePair::edge_edge, motion, features.radius)
-                                                      : line_search_time_of_impact(PrimitivePair::edge_edge, motion));
+                                                      : line_search_time_of_impact(PrimitivePair::edge_edge, motion, activation_distance_));
                 }
             }
         for (Eigen::Index t = 0; t < triangles_.rows(); ++t) {
@@ -290,7 +292,7 @@ double FeatureBarrier::earliest_impact(const MatrixX3d& x0, const MatrixX3d& x1,
                 motion.end << p, end(a), end(b), end(c);
                 earliest = std::min(earliest, features.radius > 0.0
                                                   ? additive_time_of_impact(PrimitivePair::point_triangle, motion, features.radius)
-                                                  : line_search_time_of_impact(PrimitivePair::point_triangle, motion));
+                                                  : line_search_time_of_impact(PrimitivePair::point_triangle, motion, activation_distance_));
             }
         }
     }

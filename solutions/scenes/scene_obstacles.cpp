@@ -283,6 +283,50 @@ int tet_holding(const TetMesh& mesh, const Eigen::Vector3d& p)
     return -1;
 }
 
+/// Refuses a squeeze the prescribed motions make impossible: the obstacle (scene.obstacles.back())
+/// moving onto a pinned vertex of body i (at its velocity field), or a pin's prescribed motion
+/// driving a vertex into the obstacle (at its table): neither can give way. A pinned vertex
+/// moves as the contact step moves it, on the chord between its prescribed places at two step ends
+/// (one chord over the run for a fixed pin), and the obstacle at its velocity w: their relative path
+/// x(t₁) − x(t₀) − (t₁ − t₀) w against the obstacle at t₀ (Obstacle::time_of_impact).
+void check_pins_clear(const Fields& top, const toml::node& node, const std::string& name, const SceneSpec& scene,
+                      std::size_t i)
+{
+    const contact::Obstacle& obstacle = *scene.obstacles.back().obstacle;
+    const Eigen::Vector3d& w = obstacle.velocity();
+    const BodySpec& body = scene.bodies[i];
+    const Fields fields(*node.as_table(), name, top.source(), {});
+    const int steps = static_cast<int>(std::lround(scene.duration / scene.time_step));
+    for (std::size_t j = 0; j < body.pins.size(); ++j) {
+        const Motion& motion = body.pins[j].motion;
+        if (motion.kind == Motion::Kind::fixed && w.isZero(0.0))
+            continue;  // a still pin clear of a still obstacle at the start (check_bodies_clear) stays clear
+        const int chords = motion.kind == Motion::Kind::fixed ? 1 : steps;
+        for (int v : select_vertices(body.mesh, body.pins[j].select)) {
+            const Eigen::Vector3d X = body.mesh.V.row(v).transpose();
+            for (int k = 0; k < chords; ++k) {
+                const double t0 = scene.duration * k / chords, t1 = scene.duration * (k + 1) / chords;
+                const Eigen::Vector3d x0 = X + prescribed_displacement(motion, X, t0),
+                                      x1 = X + prescribed_displacement(motion, X, t1);
+                const double s = obstacle.time_of_impact(x0, x1 - x0 - (t1 - t0) * w, t0);
+                if (s <= 1.0 && w.isZero(0.0))
+                    top.fail(node, name,
+                             str("is reached by pinned vertex ", v, " of body '", body.name, "' (body[", i, "].pin[", j,
+                                 "], its prescribed motion) at t = ", t0 + s * (t1 - t0), " s: the obstacle cannot ",
+                                 "give way, so no motion of the body can make room; end the run before ",
+                                 "(time.duration), or move the pin's path or the obstacle"));
+                if (s <= 1.0)
+                    fields.fail(*fields.get("velocity"), "velocity",
+                                str("moves the ", obstacle.name(), " onto pinned vertex ", v, " of body '", body.name,
+                                    "' (body[", i, "].pin[", j, "]) at t = ", t0 + s * (t1 - t0),
+                                    " s: a pinned vertex cannot give way, so no motion of the body can make room; ",
+                                    "end the run before (time.duration), slow or turn the obstacle, or unpin the ",
+                                    "vertex"));
+            }
+        }
+    }
+}
+
 }  // namespace
 
 void check_bodies_clear(const Fields& top, const toml::node& node, const std::string& name, const SceneSpec& scene)
@@ -342,6 +386,7 @@ void check_bodies_clear(const Fields& top, const toml::node& node, const std::st
                              " to ", surface.edges(e, 1), " through it (both ends outside): move the body or the ",
                              "obstacle so that they start apart"));
         }
+        check_pins_clear(top, node, name, scene, i);
         if (obstacle.name() == "half-space")
             continue;  // a body apart from a plane has every vertex above it
         const TriMesh drawn = obstacle.local_surface({});

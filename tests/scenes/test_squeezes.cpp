@@ -1,0 +1,70 @@
+// Squeezes (issue 48, item 6d): a pinned body and prescribed obstacle motions that leave it no room
+// are refused before stepping, naming the obstacle, the body, the pinned vertex, the time and the
+// field's place; the same squeezes ended before that time are not refused, and run with every tet
+// upright (chapter 12's volume filter). docs/scenes.md#obstacles
+#include "scene_text.hpp"
+
+#include "scenes/runner.hpp"
+
+#include "common/error.hpp"
+#include "common/parallel.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <string>
+
+using namespace fem;
+using namespace fem::scenes;
+
+namespace {
+
+/// A 10 cm neo-Hookean block pinned at pin (a [[body.pin]] table's body), and obstacle, for duration.
+std::string pinned_block(const std::string& pin, const std::string& obstacle, double duration)
+{
+    return str("[[body]]\n"
+               "mesh = { generator = \"box\", size = [0.1, 0.1, 0.1], cells = [1, 1, 1] }\n"
+               "material = { model = \"neo-hookean\", youngs_modulus = 1e5, poisson_ratio = 0.3, density = 1000.0 }\n"
+               "[[body.pin]]\n", pin, "\n",
+               "[[obstacle]]\n", obstacle, "\n",
+               "[time]\nstep = 0.01\nduration = ", duration, "\n");
+}
+
+const std::string base_pin = "plane = { point = [0.0, 0.0, 0.0], normal = [0.0, 0.0, 1.0] }";
+const std::string top_pin = "plane = { point = [0.0, 0.0, 0.1], normal = [0.0, 0.0, 1.0] }";
+const std::string falling_box = "type = \"box\"\ncenter = [0.05, 0.05, 0.2]\nsize = [0.3, 0.3, 0.1]\nvelocity = [0.0, 0.0, -1.0]";
+const std::string rising_floor = "type = \"half-space\"\npoint = [0.0, 0.0, -0.05]\nnormal = [0.0, 0.0, 1.0]\nvelocity = [0.0, 0.0, 1.0]";
+const std::string still_floor = "type = \"half-space\"\npoint = [0.0, 0.0, -0.05]\nnormal = [0.0, 0.0, 1.0]";
+const std::string driven_down =
+    "plane = { point = [0.0, 0.0, 0.1], normal = [0.0, 0.0, 1.0] }\nmotion = \"translate\"\ndisplacement = [0.0, 0.0, -0.3]\nstart = 0.0\nend = 0.2";
+
+}  // namespace
+
+TEST_CASE("squeezes the prescribed motions make impossible are refused before stepping, at the field, naming the "
+          "obstacle, the body, the pinned vertex and the time", "[scenes]")
+{
+    // The box comes down on the top face at t = 0.05 s and reaches the pinned base at 0.15 s; the
+    // floor rises to the free base at 0.05 s and to the pinned top at 0.15 s.
+    CHECK_THROWS_WITH(testing::scene_from("squeeze_box", pinned_block(base_pin, falling_box, 0.2)),
+                      Catch::Contains(":10:12: obstacle[0].velocity: moves the box onto pinned vertex") &&
+                          Catch::Contains("of body 'body0' (body[0].pin[0]) at t = 0.15 s"));
+    CHECK_THROWS_WITH(testing::scene_from("squeeze_floor", pinned_block(top_pin, rising_floor, 0.2)),
+                      Catch::Contains("obstacle[0].velocity: moves the half-space onto pinned vertex") &&
+                          Catch::Contains("at t = 0.15 s"));
+    // The top face driven down 30 cm in 0.2 s (a ramp) into a still floor 5 cm under the base.
+    CHECK_THROWS_WITH(testing::scene_from("squeeze_pin_into_floor", pinned_block(driven_down, still_floor, 0.2)),
+                      Catch::Contains(": obstacle[0]: is reached by pinned vertex") &&
+                          Catch::Contains("(body[0].pin[0], its prescribed motion) at t = "));
+}
+
+TEST_CASE("the same squeezes ended before the pinned vertices are reached read and run, every tet upright",
+          "[scenes]")
+{
+    const ScopedThreadCount one_thread(1);
+    RunOptions options;
+    options.print_models = false;
+    const RunResult box = run_scene(testing::scene_from("squeeze_box_short", pinned_block(base_pin, falling_box, 0.14)), options);
+    CHECK(box.steps == 14);
+    const RunResult floor =
+        run_scene(testing::scene_from("squeeze_floor_short", pinned_block(top_pin, rising_floor, 0.14)), options);
+    CHECK(floor.steps == 14);
+}
