@@ -322,6 +322,7 @@ void read_obstacles(const Fields& top, SceneSpec& scene)
             read_obstacle(table_in_array(top, *list.get(i), "obstacle"), name, top.source(), scene.file));
         check_obstacle_scale(top, *list.get(i), name, scene);
         check_bodies_clear(top, *list.get(i), name, scene);
+        check_half_spaces_apart(top, *list.get(i), name, scene);
     }
     if (scene.integrator != "backward-euler") {
         const toml::table& time_table = *top.subtable("time");  // where a non-default integrator was set

@@ -329,6 +329,33 @@ void check_pins_clear(const Fields& top, const toml::node& node, const std::stri
 
 }  // namespace
 
+void check_half_spaces_apart(const Fields& top, const toml::node& node, const std::string& name, const SceneSpec& scene)
+{
+    const auto* last = dynamic_cast<const contact::HalfSpace*>(scene.obstacles.back().obstacle.get());
+    if (last == nullptr)
+        return;
+    const double room = 2.0 * scene.contact.activation_distance;
+    for (std::size_t a = 0; a + 1 < scene.obstacles.size(); ++a) {
+        const auto* other = dynamic_cast<const contact::HalfSpace*>(scene.obstacles[a].obstacle.get());
+        if (other == nullptr || other->normal().dot(last->normal()) > -1.0 + 1e-12)
+            continue;  // a wedge or parallel floors: a body can leave through the open side
+        // A point of the other's plane at t = 0 (the one nearest the origin), moved with it.
+        const Eigen::Vector3d on_other = -other->distance(Eigen::Vector3d::Zero(), 0.0) * other->normal();
+        const auto gap = [&](double t) { return last->distance(on_other + t * other->velocity(), t); };
+        const double start = gap(0.0), end = gap(scene.duration);
+        if (!(start > room) || end > room)
+            continue;  // no room at the start is check_bodies_clear's refusal; a gap that stays is the run's
+        const double t = scene.duration * (start - room) / (start - end);
+        const std::string message =
+            str("closes the gap between the half-spaces obstacle[", a, "] and ", name, " (facing each other) to ",
+                room, " m = 2 d̂ at t = ", t, " s: a body between them would have to flatten below that or pass ",
+                "through one; end the run before (time.duration), slow the obstacles, or let them stop farther apart");
+        if (!last->velocity().isZero(0.0))
+            Fields(*node.as_table(), name, top.source(), {}).fail(*node.as_table()->get("velocity"), "velocity", message);
+        top.fail(node, name, str("with the moving obstacle[", a, "]: ", message));
+    }
+}
+
 void check_bodies_clear(const Fields& top, const toml::node& node, const std::string& name, const SceneSpec& scene)
 {
     const contact::Obstacle& obstacle = *scene.obstacles.back().obstacle;

@@ -52,6 +52,15 @@ void check_obstacle_scale(const Fields& top, const toml::node& node, const std::
 /// material.model field). Each refusal names the body, its vertex, edge, triangle or tet.
 void check_bodies_clear(const Fields& top, const toml::node& node, const std::string& name, const SceneSpec& scene);
 
+/// Refuses two half-spaces facing each other (antiparallel normals, the bodies between them) whose
+/// prescribed motions close the gap between their planes to 2 d̂ or less within the run: the last
+/// obstacle (scene.obstacles.back(), read from node, called name) against each one before it, at
+/// its velocity field (or its table if it is the other that moves), naming both and the time. A
+/// body between them would have to flatten below 2 d̂ or pass through one; a gap that stays wider
+/// is left to the run (a body squeezed thin but not flat). The gap of two planes is
+/// g(t) = n_b·(x_a + t w_a − p_b − t w_b), linear in t.
+void check_half_spaces_apart(const Fields& top, const toml::node& node, const std::string& name, const SceneSpec& scene);
+
 /// Refuses a mesh obstacle of this many triangles when its memory (bytes_per_obstacle_triangle each,
 /// scene_memory.cpp) with the bodies' and obstacles' before it passes the scene's budget: at field key.
 void check_obstacle_memory(const Fields& fields, const toml::node& node, const std::string& key, long long triangles);

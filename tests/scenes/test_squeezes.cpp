@@ -1,6 +1,6 @@
-// Squeezes (issue 48, item 6d): a pinned body and prescribed obstacle motions that leave it no room
-// are refused before stepping, naming the obstacle, the body, the pinned vertex, the time and the
-// field's place; the same squeezes ended before that time are not refused, and run with every tet
+// Squeezes (issue 48, item 6d): a pinned body and prescribed obstacle motions, or two floors
+// closing, that leave it no room are refused before stepping, naming the obstacle, the body, the
+// pinned vertex, the time and the field's place; the same squeezes ended before that time are not refused, and run with every tet
 // upright (chapter 12's volume filter). docs/scenes.md#obstacles
 #include "scene_text.hpp"
 
@@ -67,4 +67,31 @@ TEST_CASE("the same squeezes ended before the pinned vertices are reached read a
     const RunResult floor =
         run_scene(testing::scene_from("squeeze_floor_short", pinned_block(top_pin, rising_floor, 0.14)), options);
     CHECK(floor.steps == 14);
+}
+
+TEST_CASE("two floors closing on a free block: refused before stepping where their gap reaches 2 d-hat within the "
+          "run, at the moving one's velocity field; run where they stop wider", "[scenes]")
+{
+    // A 10 cm block resting 2 mm above a floor, a ceiling 20 cm up coming down at 0.5 m/s: the planes
+    // are 2 d̂ = 2 mm apart at t = (0.2 − 0.002)/0.5 = 0.396 s.
+    const auto two_floors = [](double duration) {
+        return str("[[body]]\n"
+                   "mesh = { generator = \"box\", size = [0.1, 0.1, 0.1], cells = [2, 2, 2], translate = [0.0, 0.0, 0.002] }\n"
+                   "material = { model = \"neo-hookean\", youngs_modulus = 1e5, poisson_ratio = 0.3, density = 1000.0 }\n"
+                   "[[obstacle]]\ntype = \"half-space\"\npoint = [0.0, 0.0, 0.0]\nnormal = [0.0, 0.0, 1.0]\n"
+                   "[[obstacle]]\ntype = \"half-space\"\npoint = [0.0, 0.0, 0.2]\nnormal = [0.0, 0.0, -1.0]\n"
+                   "velocity = [0.0, 0.0, -0.5]\n"
+                   "[contact]\nactivation_distance = 1e-3\n"
+                   "[time]\nstep = 0.01\nduration = ", duration, "\n");
+    };
+    CHECK_THROWS_WITH(testing::scene_from("two_floors_closing", two_floors(0.5)),
+                      Catch::Contains(":12:12: obstacle[1].velocity: closes the gap between the half-spaces obstacle[0] "
+                                      "and obstacle[1]") &&
+                          Catch::Contains("at t = 0.396 s"));
+    // Ended at 0.22 s the ceiling stops 9 cm above the floor: the block is pressed by 1 cm and the
+    // run goes on (the check refuses only what no body could survive).
+    const ScopedThreadCount one_thread(1);
+    RunOptions options;
+    options.print_models = false;
+    CHECK(run_scene(testing::scene_from("two_floors_pressing", two_floors(0.22)), options).steps == 22);
 }
