@@ -54,6 +54,10 @@ TEST_CASE("squeezes the prescribed motions make impossible are refused before st
     CHECK_THROWS_WITH(testing::scene_from("squeeze_pin_into_floor", pinned_block(driven_down, still_floor, 0.2)),
                       Catch::Contains(": obstacle[0]: is reached by pinned vertex") &&
                           Catch::Contains("(body[0].pin[0], its prescribed motion) at t = "));
+    // … and through a plate 2 mm thick (a thin box) 5 cm under the base: the pinned top reaches it at 0.1 s.
+    const std::string plate = "type = \"box\"\ncenter = [0.05, 0.05, -0.051]\nsize = [2.0, 2.0, 0.002]";
+    CHECK_THROWS_WITH(testing::scene_from("squeeze_pin_through_plate", pinned_block(driven_down, plate, 0.2)),
+                      Catch::Contains(": obstacle[0]: is reached by pinned vertex") && Catch::Contains("at t = 0.1"));
 }
 
 TEST_CASE("the same squeezes ended before the pinned vertices are reached read and run, every tet upright",
