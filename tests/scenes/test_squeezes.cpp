@@ -74,7 +74,7 @@ TEST_CASE("the same squeezes ended before the pinned vertices are reached read a
 }
 
 TEST_CASE("two floors closing on a free block: refused before stepping where their gap reaches 2 d-hat within the "
-          "run, at the moving one's velocity field; run where they stop wider", "[scenes]")
+          "run, at the moving one's velocity field, and run where they stop wider", "[scenes]")
 {
     // A 10 cm block resting 2 mm above a floor, a ceiling 20 cm up coming down at 0.5 m/s: the planes
     // are 2 d̂ = 2 mm apart at t = (0.2 − 0.002)/0.5 = 0.396 s.
@@ -100,7 +100,7 @@ TEST_CASE("two floors closing on a free block: refused before stepping where the
     CHECK(run_scene(testing::scene_from("two_floors_pressing", two_floors(0.22)), options).steps == 22);
 }
 
-TEST_CASE("a jelly bunny dropped on the floor: at 1 kPa every model runs; at 10 Pa neo-Hookean runs and stable "
+TEST_CASE("a jelly bunny dropped on the floor: at 1 kPa every model runs, at 10 Pa neo-Hookean runs and stable "
           "neo-Hookean is refused with advice that works", "[scenes][slow]")
 {
     // The gallery's bunny_drop, quick (a lattice of 5 cubes), for 0.6 s: the fall, the squash and
