@@ -346,13 +346,14 @@ void check_half_spaces_apart(const Fields& top, const toml::node& node, const st
         if (!(start > room) || end > room)
             continue;  // no room at the start is check_bodies_clear's refusal; a gap that stays is the run's
         const double t = scene.duration * (start - room) / (start - end);
-        const std::string message =
-            str("closes the gap between the half-spaces obstacle[", a, "] and ", name, " (facing each other) to ",
-                room, " m = 2 d̂ at t = ", t, " s: a body between them would have to flatten below that or pass ",
-                "through one; end the run before (time.duration), slow the obstacles, or let them stop farther apart");
+        const std::string closes =
+            str("the gap between the half-spaces obstacle[", a, "] and ", name, " (facing each other) to ", room,
+                " m = 2 d̂ at t = ", t, " s: a body between them would have to flatten below that or pass through ",
+                "one; end the run before (time.duration), slow the obstacles, or let them stop farther apart");
         if (!last->velocity().isZero(0.0))
-            Fields(*node.as_table(), name, top.source(), {}).fail(*node.as_table()->get("velocity"), "velocity", message);
-        top.fail(node, name, str("with the moving obstacle[", a, "]: ", message));
+            Fields(*node.as_table(), name, top.source(), {})
+                .fail(*node.as_table()->get("velocity"), "velocity", "closes " + closes);
+        top.fail(node, name, str("the motion of obstacle[", a, "] closes ", closes));
     }
 }
 

@@ -92,6 +92,13 @@ TEST_CASE("two floors closing on a free block: refused before stepping where the
                       Catch::Contains(":12:12: obstacle[1].velocity: closes the gap between the half-spaces obstacle[0] "
                                       "and obstacle[1]") &&
                           Catch::Contains("at t = 0.396 s"));
+    // The same, the floor rising instead: refused at the still ceiling's table, naming the mover.
+    std::string rising = two_floors(0.5);
+    rising.replace(rising.find("velocity = [0.0, 0.0, -0.5]\n"), 28, "");
+    rising.replace(rising.find("normal = [0.0, 0.0, 1.0]\n"), 25, "normal = [0.0, 0.0, 1.0]\nvelocity = [0.0, 0.0, 0.5]\n");
+    CHECK_THROWS_WITH(testing::scene_from("two_floors_rising", rising),
+                      Catch::Contains(": obstacle[1]: the motion of obstacle[0] closes the gap between the half-spaces") &&
+                          Catch::Contains("at t = 0.396 s"));
     // Ended at 0.22 s the ceiling stops 9 cm above the floor: the block is pressed by 1 cm and the
     // run goes on (the check refuses only what no body could survive).
     const ScopedThreadCount one_thread(1);
